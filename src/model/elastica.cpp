@@ -1,0 +1,626 @@
+// Method. With phi = theta + psi + pi/2 the elastica is the pendulum phi'' = -alpha sin(phi),
+// released at phi0 = psi + pi/2 and reaching its turning point A = phi(1) at the tip; on the first
+// mode phi rises monotonically. With k = sin(A/2), k' = cos(A/2) (ElasticaSolution::modulus_k,
+// modulus_kc) and the root amplitude u0, sin(u0) = sin(phi0/2) / k (ElasticaSolution::u0):
+// sin(phi/2) = k sn(tau), cos(phi/2) = dn(tau), theta' = 2 sqrt(alpha) k cn(tau) with
+// tau = F(u0|k) + sqrt(alpha) s. The end condition sqrt(alpha) = K(k) - F(u0|k), folded into one
+// incomplete integral by the addition theorem, reads
+//     alpha = D R_F(k'^2 s0^2, k'^2 k^2, k^2 c0^2)^2,   D = k^2 - s0^2 = sin(t/2) sin(phi0 + t/2),
+// with t = theta(1), s0 = sin(phi0/2), c0 = cos(phi0/2): products of positive factors only. It is
+// solved by a bracketed Newton iteration in log t, or in log(pi - A) when the tip nearly aligns
+// with the load, so that k' = sin((pi - A)/2) stays exact down to exp(-sqrt(alpha)) ~ 1e-44. The
+// tip angle, root curvature 2 sqrt(alpha D) and bending energy
+// (2/3) sqrt(alpha) k^2 k'^2 D^(3/2) R_D(k'^2 s0^2, k^2 c0^2, k'^2 k^2) carry no cancellation.
+// The tip position comes from the energy identity (along the load) and the root moment (across);
+// those subtract the straight rod, losing ~1e-16 / alpha^2, so for alpha <= 0.5 it is integrated
+// instead (10-point Gauss) from sin(theta/2) written without cancellation via the addition
+// theorem about the root. Below alpha = 1e-3 a perturbation series in alpha is used (cheap, and
+// the elliptic solve would underflow as alpha -> 0). Measured against a 120-digit evaluation the
+// tip figures are accurate to ~1e-13 relative (typically a few 1e-15) for all alpha and psi,
+// except where the problem itself is ill-conditioned: pure compression within ~1e-8 of Euler's
+// load. The shape uses Jacobi functions from descending Landen transformations written in k', at
+// arguments <= K/2 only (reflecting the far half), so they stay accurate when k' is tiny.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+
+#include <boost/math/special_functions/ellint_rd.hpp>
+#include <boost/math/special_functions/ellint_rf.hpp>
+
+#include <tubeplan/model/elastica.hpp>
+
+namespace tubeplan::model {
+namespace {
+
+// pi/2 as the double nearest to it: psi = +-kHalfPi is taken as exactly axial, so
+// std::numbers::pi / 2 passed by a caller means pure tension or compression.
+constexpr double kHalfPi = 1.5707963267948966;
+// Euler's load pi^2/4 of the cantilever.
+constexpr double kEulerAlpha = 2.4674011002723395;
+constexpr double kMaxAlpha = 1e4;
+// Below this the perturbation series (order kSeriesOrder) replaces the elliptic solution. Both
+// agree to the elliptic forms' rounding (<= 1e-14) for 1e-5 <= alpha <= 3e-3 over all psi; the
+// truncation error ~(alpha / 2.5)^6 of the series grows past that above ~3e-3.
+constexpr double kSeriesMaxAlpha = 1e-3;
+constexpr int kSeriesOrder = 6;
+// Below this the closed forms for the tip position lose more than ~1e-14 to cancellation and
+// quadrature takes over; above it sqrt(alpha) could exceed K/2, the range of the Jacobi functions
+// used there.
+constexpr double kQuadratureMaxAlpha = 0.5;
+constexpr int kSeriesDegree = 2 * kSeriesOrder + 1;  // x(s) and h(s) have degree 2N + 1
+// A load within this angle of the axis is treated as axial: the lateral response is then below
+// 1e-60 and keeping it would underflow k'^2 at large alpha.
+constexpr double kAxialAngle = 1e-60;
+
+// Boost's default promotes double to long double inside the Carlson forms; plain double is
+// accurate to a few ulp here and four times faster.
+using CarlsonPolicy = boost::math::policies::policy<boost::math::policies::promote_double<false>>;
+
+double Rf(double x, double y, double z) { return boost::math::ellint_rf(x, y, z, CarlsonPolicy()); }
+double Rd(double x, double y, double z) { return boost::math::ellint_rd(x, y, z, CarlsonPolicy()); }
+
+[[noreturn]] void ThrowBad(const char* what, double value, const char* range) {
+  char buffer[160];
+  std::snprintf(buffer, sizeof(buffer), "SolveElastica: %s = %.17g is %s", what, value, range);
+  throw std::invalid_argument(buffer);
+}
+
+// The load direction in the forms the formulas need, each computed without cancellation.
+struct Loading {
+  double psi = 0.0;
+  double phi0 = 0.0;  // psi + pi/2: angle of the root tangent in the pendulum
+  double gap = 0.0;   // pi/2 - psi = pi - phi0: how far the root tangent is from the load
+  double s0 = 0.0;    // sin(phi0 / 2)
+  double c0 = 0.0;    // cos(phi0 / 2) = sin(gap / 2)
+  double cos_psi = 0.0;
+  double sin_psi = 0.0;
+};
+
+Loading MakeLoading(double psi_rad) {
+  Loading load;
+  load.psi = psi_rad;
+  // Both sums are exact or rounded relative to their own size, so neither axial end loses digits.
+  load.phi0 = psi_rad + kHalfPi;
+  load.gap = kHalfPi - psi_rad;
+  if (load.phi0 < kAxialAngle) load.phi0 = 0.0;
+  if (load.gap < kAxialAngle) load.gap = 0.0;
+  load.s0 = std::sin(0.5 * load.phi0);
+  load.c0 = std::sin(0.5 * load.gap);
+  load.cos_psi = std::sin(std::min(load.phi0, load.gap));
+  load.sin_psi = std::sin(psi_rad);
+  return load;
+}
+
+// The pendulum at a trial tip angle t (with y = gap - t, both passed so that whichever is small
+// is exact). Arguments of R_F are scaled by 1/c0^2 so that nothing underflows near tension.
+struct Trial {
+  double t = 0.0;
+  double y = 0.0;
+  double k = 0.0;   // sin(A/2)
+  double kc = 0.0;  // cos(A/2) = sin(y/2)
+  double d = 0.0;   // k^2 - s0^2
+  double r = 0.0;   // kc / c0 = dn at the root (<= 1)
+  double rf = 0.0;  // R_F(r^2 s0^2, r^2 k^2, k^2) = c0 R_F(k'^2 s0^2, k'^2 k^2, k^2 c0^2)
+};
+
+Trial MakeTrial(const Loading& load, double t, double y) {
+  Trial trial;
+  trial.t = t;
+  trial.y = y;
+  trial.k = std::sin(0.5 * (load.phi0 + t));
+  trial.kc = std::sin(0.5 * y);
+  // sin(phi0 + t/2) = sin(y + t/2): take the smaller angle so the sine keeps its relative digits.
+  trial.d = std::sin(0.5 * t) * std::sin(std::min(load.phi0, y) + 0.5 * t);
+  trial.r = trial.kc / load.c0;
+  const double r_sq = trial.r * trial.r;
+  const double k_sq = trial.k * trial.k;
+  trial.rf = Rf(r_sq * load.s0 * load.s0, r_sq * k_sq, k_sq);
+  return trial;
+}
+
+// log(alpha(t)) - log(alpha): increasing in t.
+double Residual(const Loading& load, const Trial& trial, double log_alpha) {
+  return std::log(trial.d / (load.c0 * load.c0)) + 2.0 * std::log(trial.rf) - log_alpha;
+}
+
+// d Residual / dt, from dk^2/dt = k k', dk'^2/dt = -k k' and dR_F/dx = -R_D(y, z, x) / 6.
+double ResidualSlope(const Loading& load, const Trial& trial) {
+  const double kkc = trial.k * trial.kc;
+  const double r_sq = trial.r * trial.r;
+  const double k_sq = trial.k * trial.k;
+  const double x = r_sq * load.s0 * load.s0;
+  const double y = r_sq * k_sq;
+  const double z = k_sq;
+  const double c0_sq = load.c0 * load.c0;
+  const double dy = kkc * (trial.kc * trial.kc - k_sq) / c0_sq;
+  const double dz = kkc;
+  double sum = Rd(x, z, y) * dy + Rd(x, y, z) * dz;
+  // With s0 = 0 the first argument is identically zero and its term vanishes.
+  if (load.s0 > 0.0) sum += Rd(y, z, x) * (-load.s0 * load.s0 * kkc / c0_sq);
+  return kkc / trial.d - sum / (3.0 * trial.rf);
+}
+
+struct RootResult {
+  Trial trial;
+  int iterations = 0;
+  bool straight = false;  // pure compression within rounding of Euler's load: no buckle found
+};
+
+// Newton on an increasing residual(v), kept inside the bracket residual(lo) < 0 < residual(hi)
+// by bisection whenever a step would leave it or fails to halve.
+template <typename Eval>
+Trial BracketedNewton(Eval&& eval, double lo, double hi, double residual_lo, double residual_hi,
+                      double start, int& iterations) {
+  double v = start;
+  double step_prev = hi - lo;
+  double residual = 0.0;
+  double slope = 0.0;
+  Trial trial = eval(v, residual, slope);
+  for (int i = 0; i < 200 && residual != 0.0; ++i) {
+    ++iterations;
+    if (residual < 0.0) {
+      lo = v;
+      residual_lo = residual;
+    } else {
+      hi = v;
+      residual_hi = residual;
+    }
+    const double step = residual / slope;
+    double next = v - step;
+    // Newton must stay inside the bracket and must at least halve the step; otherwise bisect.
+    const bool newton =
+        slope > 0.0 && next >= lo && next <= hi && std::abs(step) <= 0.5 * std::abs(step_prev);
+    // After a Newton step this small, quadratic convergence has reached rounding level.
+    if (newton && std::abs(step) <= 1e-9 * std::max(1.0, std::abs(v))) {
+      if (next != v) trial = eval(next, residual, slope);
+      break;
+    }
+    if (!newton) {
+      // Just above Euler's load the residual is flat and its rounding noise (a few 1e-15) hides
+      // the root; once the whole bracket is within that noise, bisecting further is pointless.
+      if (residual_hi - residual_lo <= 1e-14) break;
+      next = 0.5 * (lo + hi);
+    }
+    step_prev = next - v;
+    v = next;
+    trial = eval(v, residual, slope);
+    if (hi - lo <= 4e-16 * std::max(1.0, std::abs(v))) break;
+  }
+  return trial;
+}
+
+RootResult SolveAmplitude(const Loading& load, double alpha) {
+  RootResult result;
+  const double log_alpha = std::log(alpha);
+  const double gap = load.gap;
+  const Trial middle = MakeTrial(load, 0.5 * gap, 0.5 * gap);
+  const double middle_residual = Residual(load, middle, log_alpha);
+  ++result.iterations;
+  if (middle_residual == 0.0) {
+    result.trial = middle;
+    return result;
+  }
+  if (middle_residual > 0.0) {
+    // Tip angle below half its range: unknown p = log t, residual increasing in p.
+    auto eval = [&](double p, double& residual, double& slope) {
+      const double t = std::exp(p);
+      const Trial trial = MakeTrial(load, t, gap - t);
+      residual = Residual(load, trial, log_alpha);
+      slope = t * ResidualSlope(load, trial);
+      return trial;
+    };
+    const double hi = std::log(0.5 * gap);
+    // Linear theory t = alpha cos(psi) / 2 is a good start; compression amplifies it (so it is
+    // then a lower end already), tension shrinks it, and the slope in p is about 1 for small t.
+    double lo = std::min(hi - 1e-3, std::log(std::max(0.5 * alpha * load.cos_psi, 1e-3 * gap)));
+    const double lowest = std::log(gap) - 300.0;
+    double residual = 0.0;
+    double slope = 0.0;
+    for (;;) {
+      eval(lo, residual, slope);
+      ++result.iterations;
+      if (residual < 0.0) break;
+      if (lo <= lowest) {
+        // Only pure compression within rounding of Euler's load gets here (its residual tends
+        // to log(pi^2/4 / alpha) >= 0 as t -> 0): the straight rod is the answer.
+        result.straight = true;
+        return result;
+      }
+      lo = std::max(lowest, lo - (residual + 1.0));
+    }
+    const double start = (residual > -1.0) ? lo : 0.5 * (lo + hi);
+    result.trial =
+        BracketedNewton(eval, lo, hi, residual, middle_residual, start, result.iterations);
+  } else {
+    // Tip nearly along the load: unknown v = -log y, in which the residual increases.
+    auto eval = [&](double q, double& residual, double& slope) {
+      const double y = std::exp(-q);
+      const Trial trial = MakeTrial(load, gap - y, y);
+      residual = Residual(load, trial, log_alpha);
+      slope = y * ResidualSlope(load, trial);
+      return trial;
+    };
+    const double lo = -std::log(0.5 * gap);  // residual < 0 here (the middle)
+    // Large-alpha asymptotics k' ~ 4 exp(-sqrt(alpha) - atanh(s0)) give the start.
+    const double guess_y = 8.0 * load.c0 / (1.0 + load.s0) * std::exp(-std::sqrt(alpha));
+    double hi = std::max(lo + 1.0, -std::log(guess_y) + 3.0);
+    double residual = 0.0;
+    double slope = 0.0;
+    for (int i = 0; i < 60; ++i) {
+      eval(hi, residual, slope);
+      ++result.iterations;
+      if (residual > 0.0) break;
+      // The residual grows only like 2 log(q): double q until it turns positive.
+      hi = std::min(2.0 * hi + 1.0, -std::log(gap) + 300.0);
+    }
+    result.trial = BracketedNewton(eval, lo, hi, middle_residual, residual, 0.5 * (lo + hi),
+                                   result.iterations);
+  }
+  return result;
+}
+
+// ---- Jacobi elliptic functions --------------------------------------------------------------
+
+// sn, cn, dn of z for modulus k with complement kc, for 0 <= z <= K(k)/2: descending Landen
+// transformations in the complement, which only multiply and add positive numbers, down to a
+// modulus below 1e-9 where they are sin, cos, 1; at z <= K/2 that bottom angle is <= pi/4.
+struct Jacobi {
+  double sn = 0.0;
+  double cn = 1.0;
+  double dn = 1.0;
+};
+
+Jacobi JacobiFunctions(double z, double k, double kc) {
+  constexpr int kMaxLevels = 24;
+  std::array<double, kMaxLevels> ks{};
+  std::array<double, kMaxLevels> kcs{};
+  int n = 0;
+  ks[0] = k;
+  kcs[0] = kc;
+  while (ks[n] > 1e-9 && n + 1 < kMaxLevels) {
+    const double one_plus = 1.0 + kcs[n];
+    ks[n + 1] = ks[n] * ks[n] / (one_plus * one_plus);
+    kcs[n + 1] = 2.0 * std::sqrt(kcs[n]) / one_plus;
+    ++n;
+    z /= 1.0 + ks[n];
+  }
+  double sn = std::sin(z);
+  double cn = std::cos(z);
+  for (int level = n; level >= 1; --level) {
+    const double dn = std::sqrt(kcs[level] * kcs[level] + ks[level] * ks[level] * cn * cn);
+    const double den = 1.0 + ks[level] * sn * sn;
+    sn = (1.0 + ks[level]) * sn / den;
+    cn = cn * dn / den;
+  }
+  return {sn, cn, std::sqrt(kc * kc + k * k * cn * cn)};
+}
+
+// ---- Tip displacement by quadrature (moderate alpha) ---------------------------------------
+
+// Gauss-Legendre rule on [0, 1]. The integrands are analytic well beyond [0, 1] for
+// alpha <= kQuadratureMaxAlpha: 8 points already reach rounding level there, 6 lose 1e-11 at
+// alpha = 0.4 (measured); 10 leave a margin.
+constexpr int kGaussPoints = 10;
+static_assert(kGaussPoints % 2 == 0, "the rule is built in symmetric pairs");
+
+struct GaussRule {
+  std::array<double, kGaussPoints> node{};
+  std::array<double, kGaussPoints> weight{};
+};
+
+const GaussRule& Gauss() {
+  static const GaussRule rule = [] {
+    GaussRule r;
+    constexpr int n = kGaussPoints;
+    for (int i = 0; i < n / 2; ++i) {
+      // Newton on the Legendre polynomial P_n from the usual asymptotic start.
+      double x = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
+      double derivative = 1.0;
+      for (int iteration = 0; iteration < 50; ++iteration) {
+        double p_prev = 1.0;
+        double p = x;
+        for (int j = 2; j <= n; ++j) {
+          const double p_next = ((2.0 * j - 1.0) * x * p - (j - 1.0) * p_prev) / j;
+          p_prev = p;
+          p = p_next;
+        }
+        derivative = n * (x * p - p_prev) / (x * x - 1.0);
+        const double dx = p / derivative;
+        x -= dx;
+        if (std::abs(dx) < 1e-16) break;
+      }
+      const double w = 1.0 / ((1.0 - x * x) * derivative * derivative);  // half of 2/(...)
+      r.node[i] = 0.5 * (1.0 - x);
+      r.weight[i] = w;
+      r.node[n - 1 - i] = 0.5 * (1.0 + x);
+      r.weight[n - 1 - i] = w;
+    }
+    return r;
+  }();
+  return rule;
+}
+
+// x(1) and h(1) as integrals of sin(theta) and 2 sin^2(theta/2). The closed forms for them
+// subtract the straight rod (losing ~1e-16 / alpha^2 at small alpha); here sin(theta/2) and
+// cos(theta/2) come from the addition theorem about the root, tau = tau0 + sigma, which leaves
+// sums of positive terms except one benign difference (a factor <= ~2).
+void TipDisplacementByQuadrature(const Loading& load, const Trial& trial, double sqrt_alpha,
+                                 double& deflection, double& shortening) {
+  const GaussRule& rule = Gauss();
+  const double root_d = std::sqrt(trial.d);  // k cn(tau0)
+  const double s0 = load.s0;
+  const double c0 = load.c0;
+  double sum_x = 0.0;
+  double sum_h = 0.0;
+  for (int i = 0; i < kGaussPoints; ++i) {
+    const Jacobi j = JacobiFunctions(sqrt_alpha * rule.node[i], trial.k, trial.kc);
+    const double sn_sq = j.sn * j.sn;
+    const double den = 1.0 - s0 * s0 * sn_sq;
+    const double mix = c0 * c0 + s0 * s0 * j.cn;
+    const double one_minus_cn = sn_sq / (1.0 + j.cn);
+    const double sin_half = (root_d * j.sn * mix - s0 * c0 * j.dn * one_minus_cn) / den;
+    const double cos_half = (j.dn * mix + s0 * c0 * root_d * j.sn * one_minus_cn) / den;
+    sum_x += rule.weight[i] * 2.0 * sin_half * cos_half;
+    sum_h += rule.weight[i] * 2.0 * sin_half * sin_half;
+  }
+  deflection = sum_x;
+  shortening = sum_h;
+}
+
+// ---- Small-alpha series ----------------------------------------------------------------------
+
+// theta = sum_n alpha^n theta_n(s), each theta_n a polynomial of degree 2n in s, built from
+// theta_n'' = -(cos psi C_{n-1} - sin psi S_{n-1}) with cos(theta) = sum C_n alpha^n,
+// sin(theta) = sum S_n alpha^n, then summed into polynomials in s for the given alpha.
+struct SeriesShape {
+  std::array<double, kSeriesDegree + 1> theta{};  // theta(s)
+  std::array<double, kSeriesDegree + 1> x{};      // x(s) = int_0^s sin(theta)
+  std::array<double, kSeriesDegree + 1> h{};      // s - z(s) = int_0^s 2 sin^2(theta/2)
+};
+
+using SeriesTable = std::array<std::array<double, kSeriesDegree + 1>, kSeriesOrder + 1>;
+
+SeriesShape BuildSeries(double alpha, const Loading& load) {
+  SeriesTable theta{};  // theta[n], degree 2n
+  SeriesTable cosine{};
+  SeriesTable sine{};
+  cosine[0][0] = 1.0;
+  for (int n = 1; n <= kSeriesOrder; ++n) {
+    // Load term g = cos(psi) C_{n-1} - sin(psi) S_{n-1} (degree 2n - 2); theta_n'' = -g with
+    // theta_n(0) = 0, theta_n'(1) = 0.
+    const int deg_g = 2 * n - 2;
+    double slope_root = 0.0;  // theta_n'(0) = int_0^1 g
+    for (int i = 0; i <= deg_g; ++i) {
+      const double g = load.cos_psi * cosine[n - 1][i] - load.sin_psi * sine[n - 1][i];
+      slope_root += g / (i + 1);
+      theta[n][i + 2] = -g / ((i + 1.0) * (i + 2.0));
+    }
+    theta[n][1] = slope_root;
+    // Composition recurrences n S_n = sum_j j theta_j C_{n-j}, n C_n = -sum_j j theta_j S_{n-j},
+    // accumulated per output coefficient.
+    for (int m = 0; m <= 2 * n; ++m) {
+      double sum_sine = 0.0;
+      double sum_cosine = 0.0;
+      for (int j = 1; j <= n; ++j) {
+        const int i_lo = std::max(0, m - 2 * (n - j));
+        const int i_hi = std::min(2 * j, m);
+        double part_sine = 0.0;
+        double part_cosine = 0.0;
+        for (int i = i_lo; i <= i_hi; ++i) {
+          part_sine += theta[j][i] * cosine[n - j][m - i];
+          part_cosine += theta[j][i] * sine[n - j][m - i];
+        }
+        sum_sine += j * part_sine;
+        sum_cosine += j * part_cosine;
+      }
+      sine[n][m] = sum_sine / n;
+      cosine[n][m] = -sum_cosine / n;
+    }
+  }
+  SeriesShape shape;
+  double power = 1.0;
+  for (int n = 1; n <= kSeriesOrder; ++n) {
+    power *= alpha;
+    for (int p = 0; p <= 2 * n; ++p) {
+      shape.theta[p] += power * theta[n][p];
+      shape.x[p + 1] += power * sine[n][p] / (p + 1);
+      shape.h[p + 1] -= power * cosine[n][p] / (p + 1);
+    }
+  }
+  return shape;
+}
+
+double EvalPolynomial(const std::array<double, kSeriesDegree + 1>& c, double s) {
+  double value = 0.0;
+  for (int p = kSeriesDegree; p >= 0; --p) value = value * s + c[p];
+  return value;
+}
+
+double SumCoefficients(const std::array<double, kSeriesDegree + 1>& c) {
+  double sum = 0.0;
+  for (int p = kSeriesDegree; p >= 0; --p) sum += c[p];
+  return sum;
+}
+
+void SolveSeries(const Loading& load, ElasticaSolution& solution) {
+  const SeriesShape shape = BuildSeries(solution.alpha, load);
+  ElasticaTip& tip = solution.tip;
+  tip.tip_angle_rad = SumCoefficients(shape.theta);
+  tip.deflection = SumCoefficients(shape.x);
+  tip.shortening = SumCoefficients(shape.h);
+  tip.root_curvature = shape.theta[1];
+  // U = 1/2 int theta'^2 with theta' = sum_p p theta_p s^(p-1).
+  double energy = 0.0;
+  for (int p = 1; p <= kSeriesDegree; ++p) {
+    for (int q = 1; q <= kSeriesDegree; ++q) {
+      energy += p * shape.theta[p] * q * shape.theta[q] / (p + q - 1);
+    }
+  }
+  tip.energy = 0.5 * energy;
+  solution.series = true;
+  // The pendulum parameters, for information only (the shape comes from the series).
+  const double amplitude = load.phi0 + tip.tip_angle_rad;
+  solution.modulus_k = std::sin(0.5 * amplitude);
+  solution.modulus_kc = std::sin(0.5 * (load.gap - tip.tip_angle_rad));
+  const double d = std::sin(0.5 * tip.tip_angle_rad) *
+                   std::sin(std::min(load.phi0, load.gap) + 0.5 * tip.tip_angle_rad);
+  solution.u0 = std::atan2(load.s0, std::sqrt(std::max(d, 0.0)));
+}
+
+void SolveElliptic(const Loading& load, ElasticaSolution& solution) {
+  const double alpha = solution.alpha;
+  const RootResult root = SolveAmplitude(load, alpha);
+  solution.iterations = root.iterations;
+  if (root.straight) return;
+  const Trial& tr = root.trial;
+  const double sqrt_alpha = std::sqrt(alpha);
+  const double c0 = load.c0;
+  const double r_sq = tr.r * tr.r;
+  const double k_sq = tr.k * tr.k;
+  const double d_scaled = tr.d / (c0 * c0);
+  ElasticaTip& tip = solution.tip;
+  tip.tip_angle_rad = tr.t;
+  tip.root_curvature = 2.0 * sqrt_alpha * std::sqrt(tr.d);
+  tip.energy = (2.0 / 3.0) * sqrt_alpha * k_sq * r_sq * c0 * c0 * d_scaled * std::sqrt(d_scaled) *
+               Rd(r_sq * load.s0 * load.s0, k_sq, r_sq * k_sq);
+  if (alpha <= kQuadratureMaxAlpha) {
+    TipDisplacementByQuadrature(load, tr, sqrt_alpha, tip.deflection, tip.shortening);
+  } else {
+    // Tip displacement from the straight rod along the load, from the energy identity
+    // U = alpha (sin(theta(1) + psi) - r(1).e_F), and across it, from the root moment
+    // theta'(0) = alpha r(1).e_P with e_F = (cos psi, sin psi), e_P = (-sin psi, cos psi).
+    const double along = 2.0 * tr.d - tip.energy / alpha;
+    const double across = 2.0 * c0 * (1.0 - load.s0 * tr.rf) / tr.rf;
+    tip.deflection = along * load.cos_psi - across * load.sin_psi;
+    tip.shortening = -(along * load.sin_psi + across * load.cos_psi);
+  }
+  solution.modulus_k = tr.k;
+  solution.modulus_kc = tr.kc;
+  solution.u0 = std::atan2(load.s0, std::sqrt(tr.d));
+}
+
+// ---- Shape -----------------------------------------------------------------------------------
+
+// Position of the tip relative to the point at arc length s, in the load frame (along e_F,
+// across e_P), and theta(s), from the Jacobi functions at w = sqrt(alpha) (1 - s) measured from
+// the tip.
+struct FromTip {
+  double along = 0.0;
+  double across = 0.0;
+  double theta = 0.0;
+};
+
+FromTip ShapeFromTip(const ElasticaSolution& solution, double sqrt_alpha, double tau0, double s) {
+  const double k = solution.modulus_k;
+  const double kc = solution.modulus_kc;
+  const double w = sqrt_alpha * (1.0 - s);
+  const double tau = tau0 + sqrt_alpha * s;  // = K - w
+  Jacobi tipside;                            // sn, cn, dn at w
+  if (w <= tau) {
+    tipside = JacobiFunctions(w, k, kc);
+  } else {
+    // Reflection about K/2: sn(K - tau) = cd(tau), cn(K - tau) = k' sd(tau), dn = k' nd(tau).
+    const Jacobi rootside = JacobiFunctions(tau, k, kc);
+    tipside.sn = rootside.cn / rootside.dn;
+    tipside.cn = kc * rootside.sn / rootside.dn;
+    tipside.dn = kc / rootside.dn;
+  }
+  const double sn = tipside.sn;
+  const double cn = tipside.cn;
+  const double dn = tipside.dn;
+  FromTip out;
+  // int_s^1 sin(phi) = 2 k k' sd(w) / sqrt(alpha);
+  // int_s^1 -cos(phi) = (2 int_0^w k^2 cd^2 - w) / sqrt(alpha) with
+  // int_0^w k^2 cd^2 = (k^2/3) sn^3 R_D(cn^2, dn^2, 1) + k^2 sn cd.
+  out.across = 2.0 * k * kc * sn / (dn * sqrt_alpha);
+  const double cd_integral =
+      k * k * (sn * sn * sn * Rd(cn * cn, dn * dn, 1.0) / 3.0 + sn * cn / dn);
+  out.along = 2.0 * cd_integral / sqrt_alpha - (1.0 - s);
+  // A/2 - phi/2 = atan(k k' (1 - cn) / (k'^2 + k^2 cn)) with 1 - cn = sn^2 / (1 + cn).
+  const double half_gap = std::atan2(k * kc * sn * sn / (1.0 + cn), kc * kc + k * k * cn);
+  out.theta = solution.tip.tip_angle_rad - 2.0 * half_gap;
+  return out;
+}
+
+}  // namespace
+
+ElasticaSolution SolveElastica(double alpha, double psi_rad) {
+  if (!std::isfinite(alpha)) ThrowBad("alpha", alpha, "not finite");
+  if (!std::isfinite(psi_rad)) ThrowBad("psi_rad", psi_rad, "not finite");
+  if (alpha < 0.0 || alpha > kMaxAlpha) ThrowBad("alpha", alpha, "outside [0, 1e4]");
+  if (psi_rad < -kHalfPi || psi_rad > kHalfPi) {
+    ThrowBad("psi_rad", psi_rad, "outside [-pi/2, pi/2]");
+  }
+  ElasticaSolution solution;
+  solution.alpha = alpha;
+  solution.psi_rad = psi_rad;
+  const Loading load = MakeLoading(psi_rad);
+  // Straight answers: no load, pure tension, and pure compression up to and including Euler's
+  // load (the double nearest pi^2/4 counts as "not yet buckled").
+  if (alpha == 0.0 || load.gap == 0.0) return solution;
+  if (load.phi0 == 0.0 && alpha <= kEulerAlpha) return solution;
+  if (alpha <= kSeriesMaxAlpha) {
+    SolveSeries(load, solution);
+  } else {
+    SolveElliptic(load, solution);
+  }
+  return solution;
+}
+
+void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double> s,
+                        std::span<Eigen::Vector2d> xz_out, std::span<double> theta_out) {
+  if (xz_out.size() != s.size() || theta_out.size() != s.size()) {
+    throw std::invalid_argument("ElasticaCentreline: s, xz_out and theta_out differ in size");
+  }
+  for (const double si : s) {
+    if (!(si >= 0.0 && si <= 1.0)) {
+      char buffer[120];
+      std::snprintf(buffer, sizeof(buffer), "ElasticaCentreline: s = %.17g is outside [0, 1]", si);
+      throw std::invalid_argument(buffer);
+    }
+  }
+  const ElasticaTip& tip = solution.tip;
+  if (tip.tip_angle_rad == 0.0 && tip.deflection == 0.0) {
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      xz_out[i] = Eigen::Vector2d(0.0, s[i]);
+      theta_out[i] = 0.0;
+    }
+    return;
+  }
+  const Loading load = MakeLoading(solution.psi_rad);
+  if (solution.series) {
+    const SeriesShape shape = BuildSeries(solution.alpha, load);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+      xz_out[i] =
+          Eigen::Vector2d(EvalPolynomial(shape.x, s[i]), s[i] - EvalPolynomial(shape.h, s[i]));
+      theta_out[i] = EvalPolynomial(shape.theta, s[i]);
+    }
+    return;
+  }
+  const double sqrt_alpha = std::sqrt(solution.alpha);
+  // tau0 = F(u0|k) with sin u0 = s0/k, cos u0 = sqrt(D)/k and Delta(u0) = c0.
+  const double sin_u0 = std::sin(solution.u0);
+  const double cos_u0 = std::cos(solution.u0);
+  const double tau0 = sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
+  // The closed forms give the whole tip position relative to the root too; its tiny difference
+  // from the tip figures (rounding) is spread linearly so that s = 0 and s = 1 are both exact.
+  const FromTip root = ShapeFromTip(solution, sqrt_alpha, tau0, 0.0);
+  const double root_x = root.along * load.cos_psi - root.across * load.sin_psi;
+  const double root_z = root.along * load.sin_psi + root.across * load.cos_psi;
+  const double error_x = tip.deflection - root_x;
+  const double error_z = (1.0 - tip.shortening) - root_z;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const FromTip here = ShapeFromTip(solution, sqrt_alpha, tau0, s[i]);
+    const double along = root.along - here.along;
+    const double across = root.across - here.across;
+    xz_out[i] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s[i] * error_x,
+                                along * load.sin_psi + across * load.cos_psi + s[i] * error_z);
+    theta_out[i] = (s[i] == 0.0) ? 0.0 : here.theta;
+  }
+}
+
+}  // namespace tubeplan::model
