@@ -1,0 +1,31 @@
+#pragma once
+// Named surface elements of the rigid parts: a box has 6 faces, 12 edges and 8 vertices. A face
+// is "part.face"; an edge joins its two faces' names with '_' and a vertex its three, in the
+// order of BoxFace (top/bottom, then x faces, then y faces): "left.top", "left.top_xpos",
+// "left.top_xpos_ypos" — or, with the scene's face names, "left.top_inner".
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::scene {
+
+enum class ElementKind : unsigned char { kFace, kEdge, kVertex };
+
+struct PartElement {
+  std::uint32_t part_index = 0;
+  ElementKind kind = ElementKind::kFace;
+  std::uint8_t face_mask = 0;  ///< bit i set: the element lies on face BoxFace(i)
+  std::string name;            ///< "part.element"
+};
+
+/// Every element of every part, in part order, then faces, edges, vertices.
+std::vector<PartElement> EnumerateElements(const Scene& scene);
+
+/// Index into `elements` of the element named `name`, or -1.
+int FindElement(const std::vector<PartElement>& elements, std::string_view name);
+
+}  // namespace tubeplan::scene

@@ -1,0 +1,97 @@
+#pragma once
+// A scene: one task of inserting the tube into rigid parts. Plain data in SI units, built by the
+// loader (io/scene_yaml.hpp) or in code (tests); defaults in member initialisers.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/model/tip_response.hpp>
+#include <tubeplan/model/tube.hpp>
+#include <tubeplan/states/contact_formation.hpp>
+
+namespace tubeplan::scene {
+
+/// Coulomb friction with the load exponent of physics.md:
+/// f_max = static_coefficient * reference_load_N * (N / reference_load_N)^exponent.
+struct Friction {
+  double static_coefficient = 0.0;   ///< mu_s [-], >= 0
+  double kinetic_coefficient = 0.0;  ///< mu_k (the paper's mu_D) [-], 0 <= mu_k <= mu_s
+  double exponent = 1.0;             ///< beta [-], in [2/3, 1]
+  double reference_load_N = 1.0;     ///< N0 [N], > 0
+  bool IsFrictionless() const { return static_coefficient == 0.0 && kinetic_coefficient == 0.0; }
+};
+
+/// Penalty contact (paper eq. 4) and the threshold that decides "the tube bends".
+struct Contact {
+  double stiffness_N_per_m = 1.0e4;  ///< K [N/m]
+  double threshold_m = 1.0e-3;       ///< epsilon [m]: a PC is active when d < epsilon
+  double bend_threshold_m = 1.0e-4;  ///< tip deflection above which the tube "bends" [m]
+};
+
+/// Faces of a box in its own frame; the order is the order used to name edges and vertices.
+enum class BoxFace : int { kTop = 0, kBottom, kXPos, kXNeg, kYPos, kYNeg };
+inline constexpr std::array<const char*, 6> kBoxFaceIds = {"top",  "bottom", "xpos",
+                                                           "xneg", "ypos",   "yneg"};
+
+struct BoxPart {
+  std::string name;                                  ///< [A-Za-z][A-Za-z0-9_]*
+  Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  ///< full extents along the box's x, y, z [m]
+  Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();  ///< box centre frame P in world W
+  std::optional<Friction> friction;                  ///< overrides the scene's friction if set
+  /// Name of each face, indexed by BoxFace: the ids of kBoxFaceIds unless the scene renames them.
+  std::array<std::string, 6> face_names = {"top", "bottom", "xpos", "xneg", "ypos", "yneg"};
+};
+
+using model::BeamModel;
+enum class MultiContactRule { kSegmented, kCoupled };
+enum class SlipRule { kReturnMapping, kPaper };
+
+struct ModelOptions {
+  BeamModel beam = BeamModel::kLinear;
+  MultiContactRule multi_contact = MultiContactRule::kSegmented;
+  SlipRule slip = SlipRule::kReturnMapping;
+  double time_step_s = 1.0e-3;  ///< the core's fixed step [s]
+};
+
+/// The haptic device and the virtual coupling of the hand to the held end (physics.md).
+struct Device {
+  double max_force_N = 8.5;               ///< PHANToM Premium 1.5/6DOF
+  double max_torque_Nm = 0.188;
+  double max_stiffness_N_per_m = 800.0;
+  double damping_Ns_per_m = 5.0;          ///< the device's own physical damping b
+  std::optional<double> coupling_stiffness_N_per_m;  ///< K_c; unset: a passive default
+  std::optional<double> coupling_damping_Ns_per_m;   ///< unset: a default from the device
+};
+
+/// Axis-aligned box in world the hand may move in.
+struct Workspace {
+  Eigen::Vector3d min_W_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max_W_m = Eigen::Vector3d::Zero();
+};
+
+struct Scene {
+  std::string name;
+  model::TubeSpec tube;
+  Contact contact;
+  Friction friction;
+  std::vector<BoxPart> parts;
+  Eigen::Isometry3d X_WH_start = Eigen::Isometry3d::Identity();  ///< held end at the start
+  states::ContactFormation goal;
+  Device device;
+  ModelOptions model;
+  std::optional<Workspace> workspace;  ///< unset: the parts' bounding box grown by the tube length
+};
+
+/// Friction that applies at a part: its own if set, the scene's otherwise.
+const Friction& FrictionAt(const Scene& scene, std::size_t part_index);
+
+/// Rotation from roll-pitch-yaw [rad], applied as R = Rz(yaw) Ry(pitch) Rx(roll) (extrinsic
+/// x-y-z, the ROS/URDF convention).
+Eigen::Matrix3d RotationFromRpy(const Eigen::Vector3d& rpy_rad);
+
+}  // namespace tubeplan::scene

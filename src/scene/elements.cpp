@@ -1,0 +1,56 @@
+#include <tubeplan/scene/elements.hpp>
+
+#include <bit>
+
+namespace tubeplan::scene {
+namespace {
+
+// Faces on the same axis (top/bottom, xpos/xneg, ypos/yneg) are parallel and never meet.
+constexpr int AxisOf(int face) { return face / 2; }
+
+std::string JoinFaceNames(const BoxPart& part, std::uint8_t mask) {
+  std::string name = part.name + ".";
+  bool first = true;
+  for (int face = 0; face < 6; ++face) {
+    if ((mask & (1u << face)) == 0) continue;
+    if (!first) name += '_';
+    name += part.face_names[static_cast<std::size_t>(face)];
+    first = false;
+  }
+  return name;
+}
+
+}  // namespace
+
+std::vector<PartElement> EnumerateElements(const Scene& scene) {
+  std::vector<PartElement> elements;
+  elements.reserve(scene.parts.size() * 26);
+  for (std::uint32_t p = 0; p < scene.parts.size(); ++p) {
+    const BoxPart& part = scene.parts[p];
+    // Faces, then edges (two faces on different axes), then vertices (one face per axis): every
+    // subset of faces with at most one face per axis is an element, named by its faces.
+    for (int count = 1; count <= 3; ++count) {
+      for (unsigned mask = 1; mask < 64; ++mask) {
+        if (std::popcount(mask) != count) continue;
+        bool one_per_axis = true;
+        for (int a = 0; a < 6 && one_per_axis; ++a)
+          for (int b = a + 1; b < 6; ++b)
+            if ((mask & (1u << a)) && (mask & (1u << b)) && AxisOf(a) == AxisOf(b))
+              one_per_axis = false;
+        if (!one_per_axis) continue;
+        const auto kind = static_cast<ElementKind>(count - 1);
+        const auto face_mask = static_cast<std::uint8_t>(mask);
+        elements.push_back({p, kind, face_mask, JoinFaceNames(part, face_mask)});
+      }
+    }
+  }
+  return elements;
+}
+
+int FindElement(const std::vector<PartElement>& elements, std::string_view name) {
+  for (std::size_t i = 0; i < elements.size(); ++i)
+    if (elements[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace tubeplan::scene

@@ -1,0 +1,17 @@
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::scene {
+
+const Friction& FrictionAt(const Scene& scene, std::size_t part_index) {
+  const auto& own = scene.parts.at(part_index).friction;
+  return own ? *own : scene.friction;
+}
+
+Eigen::Matrix3d RotationFromRpy(const Eigen::Vector3d& rpy_rad) {
+  return (Eigen::AngleAxisd(rpy_rad.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(rpy_rad.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(rpy_rad.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+}  // namespace tubeplan::scene
