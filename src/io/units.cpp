@@ -1,0 +1,306 @@
+// The unit table and the quantity parser. Kept small on purpose: the symbols a scene, plan or
+// command line needs, every one tested (tests/io/units_test.cpp). README says why not udunits2.
+//
+// Grammar:  quantity := ws number [ws unit-expression] ws
+//           unit-expression := factor { ('*' | '·' | ' '+ | '/') factor }
+//           factor := [prefix] symbol ['^' integer]
+// A '/' divides only the factor right after it: "N/mm" = N mm^-1, "N s/m" = N s m^-1,
+// "kg/m/s" = kg m^-1 s^-1.
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+
+#include <tubeplan/io/units.hpp>
+
+namespace tubeplan::io {
+namespace {
+
+struct Symbol {
+  std::string_view text;
+  double factor;  // to SI
+  Dimension dimension;
+  bool prefixable;
+};
+
+// Exact symbols are matched before prefix + symbol, so "m" is the metre, "min" the minute and
+// "mm" the millimetre.
+constexpr std::array<Symbol, 12> kSymbols = {{
+    {"m", 1.0, dim::kLength, true},
+    {"g", 1e-3, dim::kMass, true},
+    {"s", 1.0, dim::kTime, true},
+    {"min", 60.0, dim::kTime, false},
+    {"N", 1.0, dim::kForce, true},
+    {"Pa", 1.0, dim::kPressure, true},
+    {"J", 1.0, dim::kTorque, true},
+    {"W", 1.0, Dimension{2, 1, -3, 0}, true},
+    {"Hz", 1.0, dim::kFrequency, true},
+    {"rad", 1.0, dim::kAngle, true},
+    {"deg", std::numbers::pi / 180.0, dim::kAngle, false},
+    {"\u00B0", std::numbers::pi / 180.0, dim::kAngle, false},
+}};
+
+struct Prefix {
+  std::string_view text;
+  double factor;
+};
+
+constexpr std::array<Prefix, 10> kPrefixes = {{
+    {"G", 1e9},
+    {"M", 1e6},
+    {"k", 1e3},
+    {"c", 1e-2},
+    {"m", 1e-3},
+    {"u", 1e-6},
+    {"\u00B5", 1e-6},  // micro sign
+    {"\u03BC", 1e-6},  // Greek mu
+    {"n", 1e-9},
+    {"d", 1e-1},
+}};
+
+constexpr std::string_view kKnownUnits =
+    "m, g, s, min, N, Pa, J, W, Hz, rad, deg with an optional prefix G M k c d m u \u00B5 n";
+
+Dimension Add(Dimension a, Dimension b, int power) {
+  return {a.length + power * b.length, a.mass + power * b.mass, a.time + power * b.time,
+          a.angle + power * b.angle};
+}
+
+bool IsSpace(char c) { return c == ' ' || c == '\t'; }
+
+// A symbol is a run of letters (ASCII or the multi-byte µ, μ, °) not containing an operator.
+bool IsSymbolByte(unsigned char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c >= 0x80;
+}
+
+bool StartsWith(std::string_view text, std::string_view prefix) {
+  return text.substr(0, prefix.size()) == prefix;
+}
+
+// "·" is two bytes in UTF-8; it is an operator, not part of a symbol.
+constexpr std::string_view kMiddleDot = "\u00B7";
+
+const Symbol* FindSymbol(std::string_view word, double& factor) {
+  for (const Symbol& s : kSymbols) {
+    if (word == s.text) {
+      factor = s.factor;
+      return &s;
+    }
+  }
+  for (const Prefix& p : kPrefixes) {
+    if (!StartsWith(word, p.text)) continue;
+    const std::string_view rest = word.substr(p.text.size());
+    for (const Symbol& s : kSymbols) {
+      if (rest == s.text && s.prefixable) {
+        factor = p.factor * s.factor;
+        return &s;
+      }
+    }
+  }
+  return nullptr;
+}
+
+std::string ExampleUnit(Dimension d) {
+  struct Example {
+    Dimension dimension;
+    const char* text;
+  };
+  static constexpr std::array<Example, 12> kExamples = {{
+      {dim::kNone, "0.5 (no unit)"},
+      {dim::kLength, "\"5 mm\""},
+      {dim::kMass, "\"1 kg\""},
+      {dim::kTime, "\"1 ms\""},
+      {dim::kAngle, "\"90 deg\""},
+      {dim::kForce, "\"2 N\""},
+      {dim::kPressure, "\"3 MPa\""},
+      {dim::kStiffness, "\"10 N/mm\""},
+      {dim::kDamping, "\"5 N s/m\""},
+      {dim::kTorque, "\"0.188 N m\""},
+      {dim::kFrequency, "\"1 kHz\""},
+      {dim::kVelocity, "\"10 mm/s\""},
+  }};
+  for (const Example& e : kExamples)
+    if (e.dimension == d) return e.text;
+  return "a plain SI number";
+}
+
+QuantityResult Fail(std::size_t offset, std::string message) {
+  return {std::nullopt, UnitError{offset, std::move(message)}};
+}
+
+}  // namespace
+
+std::string Describe(Dimension d) {
+  struct Named {
+    Dimension dimension;
+    const char* name;
+  };
+  static constexpr std::array<Named, 12> kNamed = {{
+      {dim::kNone, "dimensionless number"},
+      {dim::kLength, "length"},
+      {dim::kMass, "mass"},
+      {dim::kTime, "time"},
+      {dim::kAngle, "angle"},
+      {dim::kForce, "force"},
+      {dim::kPressure, "pressure"},
+      {dim::kStiffness, "force/length"},
+      {dim::kDamping, "force*time/length"},
+      {dim::kTorque, "torque or energy"},
+      {dim::kFrequency, "frequency"},
+      {dim::kVelocity, "velocity"},
+  }};
+  for (const Named& n : kNamed)
+    if (n.dimension == d) return n.name;
+  std::string text;
+  auto term = [&text](const char* symbol, int power) {
+    if (power == 0) return;
+    if (!text.empty()) text += ' ';
+    text += symbol;
+    if (power != 1) text += '^' + std::to_string(power);
+  };
+  term("m", d.length);
+  term("kg", d.mass);
+  term("s", d.time);
+  term("rad", d.angle);
+  return text;
+}
+
+namespace {
+
+// ParseQuantity, also telling where the unit expression starts (text.size() when there is none).
+QuantityResult Parse(std::string_view text, std::size_t& unit_offset) {
+  unit_offset = text.size();
+  std::size_t i = 0;
+  const std::size_t n = text.size();
+  while (i < n && IsSpace(text[i])) ++i;
+  std::size_t end = n;
+  while (end > i && IsSpace(text[end - 1])) --end;
+  if (i == end) return Fail(i, "expected a number, found nothing");
+
+  // from_chars does not take a leading '+' (it does take ".5"): the '+' is skipped here.
+  std::size_t number_start = i;
+  if (text[i] == '+') {
+    ++i;
+    if (i < end && text[i] == '-') return Fail(i, "expected a number, found '+-'");
+  }
+  double value = 0.0;
+  const char* first = text.data() + i;
+  const char* last = text.data() + end;
+  const auto [ptr, ec] = std::from_chars(first, last, value);
+  if (ec == std::errc::invalid_argument || ptr == first) {
+    std::size_t word_end = i;
+    while (word_end < end && !IsSpace(text[word_end])) ++word_end;
+    return Fail(number_start, "expected a number, found '" +
+                                  std::string(text.substr(number_start, word_end - number_start)) +
+                                  "'");
+  }
+  if (ec == std::errc::result_out_of_range) {
+    // from_chars says out of range for both overflow and underflow and leaves value unset. A
+    // number that underflows (its exponent is negative) is zero for every purpose here; one that
+    // overflows is an error.
+    const std::string_view digits(first, static_cast<std::size_t>(ptr - first));
+    const std::size_t e = digits.find_first_of("eE");
+    const bool underflow =
+        e != std::string_view::npos && e + 1 < digits.size() && digits[e + 1] == '-';
+    if (!underflow) return Fail(number_start, "the number is too large, expected a finite number");
+    value = digits.front() == '-' ? -0.0 : 0.0;
+  } else if (!std::isfinite(value)) {
+    return Fail(number_start, "the number is not finite, expected a finite number");
+  }
+  i = static_cast<std::size_t>(ptr - text.data());
+
+  Quantity q;
+  q.value_si = value;
+  if (i == end) return {q, std::nullopt};
+
+  // A unit expression follows, after optional spaces.
+  while (i < end && IsSpace(text[i])) ++i;
+  unit_offset = i;
+  bool expect_factor = true;
+  int power_sign = 1;
+  while (i < end) {
+    if (!expect_factor) {
+      // Between factors: '*', '·', '/', or spaces (a space alone multiplies).
+      std::size_t j = i;
+      while (j < end && IsSpace(text[j])) ++j;
+      if (j < end && (text[j] == '*' || text[j] == '/' || StartsWith(text.substr(j), kMiddleDot))) {
+        power_sign = text[j] == '/' ? -1 : 1;
+        j += text[j] == '*' || text[j] == '/' ? 1 : kMiddleDot.size();
+        while (j < end && IsSpace(text[j])) ++j;
+      } else if (j == i) {
+        return Fail(i, "unexpected '" + std::string(1, text[i]) +
+                           "' in the unit, expected '*', '/', '^' or a space");
+      } else {
+        power_sign = 1;
+      }
+      i = j;
+      expect_factor = true;
+      continue;
+    }
+    const std::size_t word_start = i;
+    while (i < end && IsSymbolByte(static_cast<unsigned char>(text[i])) &&
+           !StartsWith(text.substr(i), kMiddleDot))
+      ++i;
+    const std::string_view word = text.substr(word_start, i - word_start);
+    if (word.empty()) {
+      return Fail(word_start, i < end ? "unexpected '" + std::string(1, text[i]) +
+                                            "', expected a unit such as mm or N"
+                                      : std::string("expected a unit after the operator"));
+    }
+    double factor = 1.0;
+    const Symbol* symbol = FindSymbol(word, factor);
+    if (symbol == nullptr) {
+      return Fail(word_start, "unknown unit '" + std::string(word) + "', expected one of " +
+                                  std::string(kKnownUnits));
+    }
+    int power = 1;
+    if (i < end && text[i] == '^') {
+      const std::size_t power_start = ++i;
+      const auto [p_end, p_ec] = std::from_chars(text.data() + i, text.data() + end, power);
+      if (p_ec != std::errc() || p_end == text.data() + i) {
+        return Fail(power_start, "expected an integer power after '^', such as m^2 or s^-1");
+      }
+      if (power < -9 || power > 9 || power == 0) {
+        return Fail(power_start, "power " + std::to_string(power) +
+                                     " out of range, expected a non-zero integer from -9 to 9");
+      }
+      i = static_cast<std::size_t>(p_end - text.data());
+    }
+    const int signed_power = power_sign * power;
+    q.value_si *= std::pow(factor, signed_power);
+    q.dimension = Add(q.dimension, symbol->dimension, signed_power);
+    q.has_unit = true;
+    expect_factor = false;
+  }
+  if (expect_factor) return Fail(end, "expected a unit after the operator");
+  if (!std::isfinite(q.value_si)) {
+    return Fail(number_start, "the quantity overflows in SI units, expected a finite number");
+  }
+  return {q, std::nullopt};
+}
+
+}  // namespace
+
+QuantityResult ParseQuantity(std::string_view text) {
+  std::size_t unit_offset = 0;
+  return Parse(text, unit_offset);
+}
+
+QuantityResult ParseQuantityAs(std::string_view text, Dimension expected) {
+  std::size_t unit_offset = 0;
+  QuantityResult result = Parse(text, unit_offset);
+  if (!result.quantity) return result;
+  Quantity& q = *result.quantity;
+  if (!q.has_unit) {
+    q.dimension = expected;  // a plain number is SI for whatever it sets
+    return result;
+  }
+  if (q.dimension == expected) return result;
+  std::string_view unit = text.substr(unit_offset);
+  while (!unit.empty() && IsSpace(unit.back())) unit.remove_suffix(1);
+  return Fail(unit_offset, "has a unit of " + Describe(q.dimension) + " (" + std::string(unit) +
+                               "), expected a " + Describe(expected) + " such as " +
+                               ExampleUnit(expected));
+}
+
+}  // namespace tubeplan::io
