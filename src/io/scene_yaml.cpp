@@ -1,0 +1,634 @@
+// Scene files: YAML in, a validated Scene (SI) out, or every problem at once. The format is
+// documented for users in docs/scene-format.md; keep the two in step.
+//
+// The checker never stops at the first problem: each section is read as far as it can be, a bad
+// value is reported and replaced by its default so that later checks still run, and checks that
+// need a good value (geometry, the goal's elements) run only when their inputs were read cleanly.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/units.hpp>
+#include <tubeplan/scene/elements.hpp>
+
+namespace tubeplan::io {
+namespace {
+
+std::size_t EditDistance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0u : 1u)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+/// ", did you mean 'x'?" for the closest candidate within a third of the word's length (at least
+/// two edits), or "" when nothing is close: a far-fetched suggestion is worse than none.
+std::string Suggestion(std::string_view word, const std::vector<std::string>& candidates) {
+  const std::size_t limit = std::max<std::size_t>(2, word.size() / 3);
+  std::size_t best = limit + 1;
+  std::string best_name;
+  for (const std::string& c : candidates) {
+    const std::size_t d = EditDistance(word, c);
+    if (d < best) {
+      best = d;
+      best_name = c;
+    }
+  }
+  return best_name.empty() ? std::string() : ", did you mean '" + best_name + "'?";
+}
+
+std::string Join(const std::vector<std::string>& words) {
+  std::string text;
+  for (const std::string& w : words) text += (text.empty() ? "" : ", ") + w;
+  return text;
+}
+
+const char* KindName(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map:
+      return "a map";
+    case YAML::NodeType::Sequence:
+      return "a sequence";
+    case YAML::NodeType::Scalar:
+      return "a scalar";
+    case YAML::NodeType::Null:
+      return "nothing";
+    default:
+      return "an undefined node";
+  }
+}
+
+class Reader {
+ public:
+  Reader(const std::string& file, Diagnostics& diagnostics) : file_(file), diag_(diagnostics) {}
+
+  void Error(const YAML::Mark& mark, const std::string& message, std::size_t column_offset = 0) {
+    // yaml-cpp marks are 0-based; a null mark (-1) means "no position": report the file.
+    if (mark.line < 0) {
+      diag_.Error(file_, 0, 0, message);
+    } else {
+      diag_.Error(file_, mark.line + 1, mark.column + 1 + static_cast<int>(column_offset), message);
+    }
+  }
+  void Error(const YAML::Node& node, const std::string& message, std::size_t column_offset = 0) {
+    Error(node.Mark(), message, column_offset);
+  }
+  std::size_t error_count() const { return diag_.all().size(); }
+
+  /// Checks that `node` is a map whose keys are all in `allowed` (each once); reports unknown and
+  /// duplicate keys. Returns false (after reporting) when the node is not a map.
+  bool ExpectMap(const YAML::Node& node, const std::string& where,
+                 const std::vector<std::string>& allowed) {
+    if (!node.IsMap()) {
+      Error(node, "'" + where + "' must be a map, found " + KindName(node) +
+                      ", expected keys such as " + Join(allowed));
+      return false;
+    }
+    std::set<std::string> seen;
+    for (const auto& entry : node) {
+      if (!entry.first.IsScalar()) {
+        Error(entry.first,
+              "a key in '" + where + "' is " + KindName(entry.first) + ", expected a plain name");
+        continue;
+      }
+      const std::string key = entry.first.Scalar();
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        Error(entry.first, "unknown key '" + key + "' in '" + where + "'" +
+                               Suggestion(key, allowed) + " (expected one of: " + Join(allowed) +
+                               ")");
+      } else if (!seen.insert(key).second) {
+        Error(entry.first,
+              "duplicate key '" + key + "' in '" + where + "', expected each key once");
+      }
+    }
+    return true;
+  }
+
+  /// The value of `key` in map `node`, or an undefined node (missing keys reported if required).
+  YAML::Node Get(const YAML::Node& node, const std::string& key, const std::string& where,
+                 bool required) {
+    if (node.IsMap()) {
+      for (const auto& entry : node) {
+        if (entry.first.IsScalar() && entry.first.Scalar() == key) return entry.second;
+      }
+      if (required) Error(node, "missing key '" + key + "' in '" + where + "'");
+    }
+    return YAML::Node(YAML::NodeType::Undefined);
+  }
+
+  /// A quantity of `dimension`; reports and returns nullopt on any problem.
+  std::optional<double> Quantity(const YAML::Node& node, const std::string& what,
+                                 Dimension dimension) {
+    if (!node.IsScalar()) {
+      Error(node, what + " must be a quantity (a number or a string such as \"5 mm\"), found " +
+                      KindName(node));
+      return std::nullopt;
+    }
+    const QuantityResult parsed = ParseQuantityAs(node.Scalar(), dimension);
+    if (!parsed.quantity) {
+      // Quoted scalars start one column after their quote (yaml-cpp tags them "!").
+      const std::size_t quote = node.Tag() == "!" ? 1 : 0;
+      Error(node, what + ": " + parsed.error->message, quote + parsed.error->offset);
+      return std::nullopt;
+    }
+    return parsed.quantity->value_si;
+  }
+
+  /// Reads map[key] as a quantity into `target` (kept when absent or bad).
+  bool Field(const YAML::Node& map, const std::string& key, const std::string& where,
+             Dimension dimension, bool required, double& target) {
+    const YAML::Node node = Get(map, key, where, required);
+    if (!node.IsDefined()) return !required;
+    const auto value = Quantity(node, where + "." + key, dimension);
+    if (value) target = *value;
+    return value.has_value();
+  }
+
+  std::optional<Eigen::Vector3d> Vector(const YAML::Node& node, const std::string& what,
+                                        Dimension dimension) {
+    if (!node.IsSequence() || node.size() != 3) {
+      Error(node, what + " must be a sequence of 3 quantities such as [0, 5 mm, 10 mm], found " +
+                      (node.IsSequence() ? std::to_string(node.size()) + " items"
+                                         : std::string(KindName(node))));
+      return std::nullopt;
+    }
+    Eigen::Vector3d v;
+    bool ok = true;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto value = Quantity(node[i], what + "[" + std::to_string(i) + "]", dimension);
+      if (value) v[static_cast<Eigen::Index>(i)] = *value;
+      ok = ok && value.has_value();
+    }
+    return ok ? std::optional(v) : std::nullopt;
+  }
+
+  std::optional<std::string> String(const YAML::Node& node, const std::string& what) {
+    if (!node.IsScalar()) {
+      Error(node, what + " must be a string, found " + KindName(node));
+      return std::nullopt;
+    }
+    return node.Scalar();
+  }
+
+  template <typename Enum>
+  std::optional<Enum> Choice(const YAML::Node& node, const std::string& what,
+                             const std::vector<std::pair<std::string, Enum>>& choices) {
+    const auto text = String(node, what);
+    if (!text) return std::nullopt;
+    std::vector<std::string> names;
+    for (const auto& [name, value] : choices) {
+      if (name == *text) return value;
+      names.push_back(name);
+    }
+    Error(node, what + " '" + *text + "' is not known" + Suggestion(*text, names) +
+                    " (expected one of: " + Join(names) + ")");
+    return std::nullopt;
+  }
+
+ private:
+  const std::string& file_;
+  Diagnostics& diag_;
+};
+
+bool IsName(std::string_view text, bool allow_underscore) {
+  if (text.empty() || !std::isalpha(static_cast<unsigned char>(text[0]))) return false;
+  return std::all_of(text.begin(), text.end(), [allow_underscore](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || (allow_underscore && c == '_');
+  });
+}
+
+Eigen::Isometry3d Pose(const Eigen::Vector3d& position_m, const Eigen::Vector3d& rpy_rad) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = scene::RotationFromRpy(rpy_rad);
+  X.translation() = position_m;
+  return X;
+}
+
+// The exponent of the friction law is physics.md's [2/3, 1]; files write 2/3 as 0.6667 or 0.667,
+// so values down to 2/3 - 1e-3 are accepted (and kept as written: the law is smooth in beta).
+constexpr double kExponentMin = 2.0 / 3.0 - 1e-3;
+
+std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
+                                            const std::string& where) {
+  if (!r.ExpectMap(node, where, {"static", "kinetic", "exponent", "reference_load"}))
+    return std::nullopt;
+  const std::size_t errors = r.error_count();
+  scene::Friction f;
+  r.Field(node, "static", where, dim::kNone, true, f.static_coefficient);
+  r.Field(node, "kinetic", where, dim::kNone, true, f.kinetic_coefficient);
+  r.Field(node, "exponent", where, dim::kNone, false, f.exponent);
+  r.Field(node, "reference_load", where, dim::kForce, false, f.reference_load_N);
+  if (r.error_count() != errors) return std::nullopt;
+  bool ok = true;
+  auto fail = [&](const std::string& key, const std::string& message) {
+    r.Error(r.Get(node, key, where, false), where + "." + key + " " + message);
+    ok = false;
+  };
+  if (f.static_coefficient < 0.0) fail("static", "must be zero or more");
+  if (f.kinetic_coefficient < 0.0) {
+    fail("kinetic", "must be zero or more");
+  } else if (f.kinetic_coefficient > f.static_coefficient) {
+    std::ostringstream m;
+    m << "(" << f.kinetic_coefficient << ") must not exceed static (" << f.static_coefficient
+      << "): sliding friction is at most the friction that holds";
+    fail("kinetic", m.str());
+  }
+  if (f.exponent < kExponentMin || f.exponent > 1.0) {
+    std::ostringstream m;
+    m << "(" << f.exponent << ") must be in [2/3, 1] (0.6667 for rubber, 1 for Coulomb)";
+    if (r.Get(node, "exponent", where, false).IsDefined()) fail("exponent", m.str());
+  }
+  if (f.reference_load_N <= 0.0 && r.Get(node, "reference_load", where, false).IsDefined())
+    fail("reference_load", "must be greater than zero");
+  return ok ? std::optional(f) : std::nullopt;
+}
+
+// Separating-axis test of two oriented boxes: true when they share a volume thicker than
+// `tolerance_m` along every axis (boxes that only touch do not overlap).
+bool BoxesOverlap(const scene::BoxPart& a, const scene::BoxPart& b, double tolerance_m) {
+  const Eigen::Matrix3d& Ra = a.X_WP.linear();
+  const Eigen::Matrix3d& Rb = b.X_WP.linear();
+  const Eigen::Vector3d ha = a.size_m / 2.0;
+  const Eigen::Vector3d hb = b.size_m / 2.0;
+  const Eigen::Vector3d d_W = b.X_WP.translation() - a.X_WP.translation();
+  std::vector<Eigen::Vector3d> axes;
+  for (int i = 0; i < 3; ++i) {
+    axes.push_back(Ra.col(i));
+    axes.push_back(Rb.col(i));
+    for (int j = 0; j < 3; ++j) {
+      const Eigen::Vector3d c = Ra.col(i).cross(Rb.col(j));
+      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges give no new axis
+    }
+  }
+  for (const Eigen::Vector3d& n : axes) {
+    const double ra = (Ra.transpose() * n).cwiseAbs().dot(ha);
+    const double rb = (Rb.transpose() * n).cwiseAbs().dot(hb);
+    if (std::abs(d_W.dot(n)) >= ra + rb - tolerance_m) return false;  // a separating axis
+  }
+  return true;
+}
+
+bool PointInside(const scene::BoxPart& box, const Eigen::Vector3d& p_W, double tolerance_m) {
+  const Eigen::Vector3d p_P = box.X_WP.inverse() * p_W;
+  return ((box.size_m / 2.0).array() - p_P.cwiseAbs().array() > tolerance_m).all();
+}
+
+constexpr double kGeometryTolerance_m = 1e-9;
+
+void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok) {
+  if (!node.IsSequence() || node.size() == 0) {
+    r.Error(node, std::string("'parts' must be a non-empty sequence of parts, found ") +
+                      (node.IsSequence() ? "an empty sequence" : KindName(node)));
+    parts_ok = false;
+    return;
+  }
+  std::vector<YAML::Node> position_nodes;
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    const YAML::Node part_node = node[i];
+    const std::string where = "parts[" + std::to_string(i) + "]";
+    const std::size_t errors = r.error_count();
+    if (!r.ExpectMap(part_node, where, {"name", "box", "faces", "friction"})) {
+      parts_ok = false;
+      continue;
+    }
+    scene::BoxPart part;
+    if (const YAML::Node n = r.Get(part_node, "name", where, true); n.IsDefined()) {
+      if (const auto name = r.String(n, where + ".name")) {
+        part.name = *name;
+        if (!IsName(part.name, true)) {
+          r.Error(n, where + ".name '" + part.name +
+                         "' must start with a letter and hold only letters, digits and '_'");
+        }
+        for (const scene::BoxPart& other : s.parts) {
+          if (other.name == part.name)
+            r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
+        }
+      }
+    }
+    YAML::Node position_node(YAML::NodeType::Undefined);
+    if (const YAML::Node box = r.Get(part_node, "box", where, true); box.IsDefined()) {
+      const std::string bw = where + ".box";
+      if (r.ExpectMap(box, bw, {"size", "position", "rpy"})) {
+        if (const YAML::Node n = r.Get(box, "size", bw, true); n.IsDefined()) {
+          if (const auto size = r.Vector(n, bw + ".size", dim::kLength)) {
+            part.size_m = *size;
+            if ((part.size_m.array() <= 0.0).any())
+              r.Error(n, bw + ".size must be greater than zero along every axis");
+          }
+        }
+        Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+        position_node = r.Get(box, "position", bw, false);
+        if (position_node.IsDefined()) {
+          if (const auto p = r.Vector(position_node, bw + ".position", dim::kLength)) position = *p;
+        } else {
+          position_node = box;
+        }
+        if (const YAML::Node n = r.Get(box, "rpy", bw, false); n.IsDefined())
+          if (const auto a = r.Vector(n, bw + ".rpy", dim::kAngle)) rpy = *a;
+        part.X_WP = Pose(position, rpy);
+      }
+    }
+    if (const YAML::Node faces = r.Get(part_node, "faces", where, false); faces.IsDefined()) {
+      const std::string fw = where + ".faces";
+      const std::vector<std::string> ids(scene::kBoxFaceIds.begin(), scene::kBoxFaceIds.end());
+      if (r.ExpectMap(faces, fw, ids)) {
+        for (const auto& entry : faces) {
+          const auto it = std::find(ids.begin(), ids.end(), entry.first.Scalar());
+          if (it == ids.end()) continue;  // reported by ExpectMap
+          const auto name = r.String(entry.second, fw + "." + *it);
+          if (!name) continue;
+          // '_' joins face names into edge and vertex names, so a face name cannot hold one.
+          if (!IsName(*name, false)) {
+            r.Error(entry.second, fw + "." + *it + " '" + *name +
+                                      "' must start with a letter and hold only letters and "
+                                      "digits ('_' joins face names into edge names)");
+            continue;
+          }
+          part.face_names[static_cast<std::size_t>(it - ids.begin())] = *name;
+        }
+        for (std::size_t a = 0; a < 6; ++a)
+          for (std::size_t b = a + 1; b < 6; ++b)
+            if (part.face_names[a] == part.face_names[b])
+              r.Error(faces, fw + ": two faces are named '" + part.face_names[a] +
+                                 "', expected a distinct name for each face");
+      }
+    }
+    if (const YAML::Node f = r.Get(part_node, "friction", where, false); f.IsDefined())
+      part.friction = ReadFriction(r, f, where + ".friction");
+    if (r.error_count() != errors) parts_ok = false;
+    s.parts.push_back(part);
+    position_nodes.push_back(position_node);
+  }
+  if (!parts_ok) return;
+  for (std::size_t i = 0; i < s.parts.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (BoxesOverlap(s.parts[j], s.parts[i], kGeometryTolerance_m)) {
+        r.Error(position_nodes[i], "part '" + s.parts[i].name + "' overlaps part '" +
+                                       s.parts[j].name + "', expected parts that at most touch");
+        parts_ok = false;
+      }
+    }
+  }
+}
+
+void ReadGoal(Reader& r, const YAML::Node& node, scene::Scene& s, bool parts_ok) {
+  const auto text = r.String(node, "goal");
+  if (!text) return;
+  const std::size_t quote = node.Tag() == "!" ? 1 : 0;
+  const states::ParseResult parsed = states::ParseContactFormation(*text);
+  if (!parsed.cf) {
+    r.Error(node, "goal: " + parsed.error->message, quote + parsed.error->offset);
+    return;
+  }
+  s.goal = *parsed.cf;
+  if (!parts_ok) return;
+  const std::vector<scene::PartElement> elements = scene::EnumerateElements(s);
+  std::vector<std::string> names;
+  for (const scene::PartElement& e : elements) names.push_back(e.name);
+  for (const states::PrincipalContact& pc : s.goal.contacts) {
+    if (scene::FindElement(elements, pc.part_element) >= 0) continue;
+    const std::size_t at = text->find(pc.part_element);
+    r.Error(node,
+            "goal: no element '" + pc.part_element + "' in this scene" +
+                Suggestion(pc.part_element, names) +
+                " (expected part.face, part.face_face or part.face_face_face)",
+            quote + (at == std::string::npos ? 0 : at));
+  }
+}
+
+void ReadDevice(Reader& r, const YAML::Node& node, scene::Device& d) {
+  const std::string w = "device";
+  if (!r.ExpectMap(node, w, {"max_force", "max_torque", "max_stiffness", "damping", "coupling"}))
+    return;
+  auto positive = [&](const std::string& key, Dimension dimension, double& target, bool zero_ok) {
+    if (!r.Field(node, key, w, dimension, false, target)) return;
+    if (target < 0.0 || (!zero_ok && target == 0.0))
+      r.Error(r.Get(node, key, w, false),
+              w + "." + key + (zero_ok ? " must be zero or more" : " must be greater than zero"));
+  };
+  positive("max_force", dim::kForce, d.max_force_N, false);
+  positive("max_torque", dim::kTorque, d.max_torque_Nm, false);
+  positive("max_stiffness", dim::kStiffness, d.max_stiffness_N_per_m, false);
+  positive("damping", dim::kDamping, d.damping_Ns_per_m, true);
+  const YAML::Node coupling = r.Get(node, "coupling", w, false);
+  if (!coupling.IsDefined()) return;
+  const std::string cw = "device.coupling";
+  if (!r.ExpectMap(coupling, cw, {"stiffness", "damping"})) return;
+  double k = 0.0, b = 0.0;
+  if (const YAML::Node n = r.Get(coupling, "stiffness", cw, false); n.IsDefined()) {
+    if (const auto v = r.Quantity(n, cw + ".stiffness", dim::kStiffness)) {
+      if (*v <= 0.0) {
+        r.Error(n, cw + ".stiffness must be greater than zero");
+      } else if (*v > d.max_stiffness_N_per_m) {
+        std::ostringstream m;
+        m << cw << ".stiffness (" << *v << " N/m) exceeds device.max_stiffness ("
+          << d.max_stiffness_N_per_m << " N/m), expected at most the device's limit";
+        r.Error(n, m.str());
+      } else {
+        k = *v;
+        d.coupling_stiffness_N_per_m = k;
+      }
+    }
+  }
+  if (const YAML::Node n = r.Get(coupling, "damping", cw, false); n.IsDefined()) {
+    if (const auto v = r.Quantity(n, cw + ".damping", dim::kDamping)) {
+      if (*v < 0.0) {
+        r.Error(n, cw + ".damping must be zero or more");
+      } else {
+        b = *v;
+        d.coupling_damping_Ns_per_m = b;
+      }
+    }
+  }
+}
+
+void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
+  const std::string w = "model";
+  if (!r.ExpectMap(node, w, {"beam", "multi_contact", "slip", "time_step"})) return;
+  if (const YAML::Node n = r.Get(node, "beam", w, false); n.IsDefined())
+    if (const auto v = r.Choice<model::BeamModel>(
+            n, "model.beam",
+            {{"linear", model::BeamModel::kLinear}, {"elastica", model::BeamModel::kElastica}}))
+      m.beam = *v;
+  if (const YAML::Node n = r.Get(node, "multi_contact", w, false); n.IsDefined())
+    if (const auto v =
+            r.Choice<scene::MultiContactRule>(n, "model.multi_contact",
+                                              {{"segmented", scene::MultiContactRule::kSegmented},
+                                               {"coupled", scene::MultiContactRule::kCoupled}}))
+      m.multi_contact = *v;
+  if (const YAML::Node n = r.Get(node, "slip", w, false); n.IsDefined())
+    if (const auto v =
+            r.Choice<scene::SlipRule>(n, "model.slip",
+                                      {{"return-mapping", scene::SlipRule::kReturnMapping},
+                                       {"paper", scene::SlipRule::kPaper}}))
+      m.slip = *v;
+  // Up to 10 ms: slower than 100 Hz is not haptics, and the contact spring needs small steps.
+  if (r.Field(node, "time_step", w, dim::kTime, false, m.time_step_s) &&
+      (m.time_step_s <= 0.0 || m.time_step_s > 0.010))
+    r.Error(r.Get(node, "time_step", w, false),
+            "model.time_step must be in (0, 10 ms], expected e.g. \"1 ms\" (1 kHz)");
+}
+
+void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
+  const std::vector<std::string> top = {"tubeplan", "name",  "tube",     "contact",
+                                        "friction", "parts", "start",    "goal",
+                                        "device",   "model", "workspace"};
+  if (!root.IsMap()) {
+    r.Error(root, std::string("a scene file must be a map, found ") + KindName(root) +
+                      ", expected keys such as tubeplan, name, tube, parts");
+    return;
+  }
+  r.ExpectMap(root, "scene", top);
+  if (const YAML::Node n = r.Get(root, "tubeplan", "scene", true); n.IsDefined()) {
+    if (!n.IsScalar() || n.Scalar() != "1") {
+      r.Error(n, "unsupported format version " + (n.IsScalar() ? n.Scalar() : KindName(n)) +
+                     ", expected 1");
+    }
+  }
+  if (const YAML::Node n = r.Get(root, "name", "scene", true); n.IsDefined()) {
+    if (const auto name = r.String(n, "name")) {
+      s.name = *name;
+      if (s.name.empty()) r.Error(n, "name must not be empty");
+    }
+  }
+  if (const YAML::Node t = r.Get(root, "tube", "scene", true); t.IsDefined()) {
+    const std::string w = "tube";
+    if (r.ExpectMap(
+            t, w, {"outer_radius", "inner_radius", "length", "youngs_modulus", "poisson_ratio"})) {
+      model::TubeSpec& spec = s.tube;
+      // Keys read cleanly; the model's rules are checked only on those, so that a value that
+      // failed to parse is not reported a second time as "must be greater than zero".
+      std::set<std::string> read;
+      auto field = [&](const char* key, Dimension dimension, double& target) {
+        if (r.Field(t, key, w, dimension, true, target) && r.Get(t, key, w, false).IsDefined())
+          read.insert(key);
+      };
+      field("outer_radius", dim::kLength, spec.outer_radius_m);
+      field("inner_radius", dim::kLength, spec.inner_radius_m);
+      field("length", dim::kLength, spec.length_m);
+      field("youngs_modulus", dim::kPressure, spec.youngs_modulus_Pa);
+      field("poisson_ratio", dim::kNone, spec.poisson_ratio);
+      // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
+      for (const std::string& problem : model::ValidateTubeSpec(spec)) {
+        const std::string key = problem.substr(0, problem.find(' '));
+        if (read.count(key) == 0) continue;
+        // r2 >= r1 is only meaningful when r1 itself was read.
+        if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
+        r.Error(r.Get(t, key, w, false), "tube." + problem);
+      }
+    }
+  }
+  if (const YAML::Node c = r.Get(root, "contact", "scene", false); c.IsDefined()) {
+    const std::string w = "contact";
+    if (r.ExpectMap(c, w, {"stiffness", "threshold", "bend_threshold"})) {
+      auto positive = [&](const std::string& key, Dimension dimension, double& target) {
+        if (r.Field(c, key, w, dimension, false, target) && target <= 0.0)
+          r.Error(r.Get(c, key, w, false), w + "." + key + " must be greater than zero");
+      };
+      positive("stiffness", dim::kStiffness, s.contact.stiffness_N_per_m);
+      positive("threshold", dim::kLength, s.contact.threshold_m);
+      positive("bend_threshold", dim::kLength, s.contact.bend_threshold_m);
+    }
+  }
+  if (const YAML::Node f = r.Get(root, "friction", "scene", false); f.IsDefined()) {
+    if (const auto friction = ReadFriction(r, f, "friction")) s.friction = *friction;
+  }
+  bool parts_ok = true;
+  if (const YAML::Node p = r.Get(root, "parts", "scene", true); p.IsDefined()) {
+    ReadParts(r, p, s, parts_ok);
+  } else {
+    parts_ok = false;
+  }
+  if (const YAML::Node st = r.Get(root, "start", "scene", true); st.IsDefined()) {
+    const std::string w = "start";
+    if (r.ExpectMap(st, w, {"position", "rpy"})) {
+      Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
+      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined())
+        if (const auto a = r.Vector(n, "start.rpy", dim::kAngle)) rpy = *a;
+      if (const YAML::Node n = r.Get(st, "position", w, true); n.IsDefined()) {
+        if (const auto p = r.Vector(n, "start.position", dim::kLength)) {
+          s.X_WH_start = Pose(*p, rpy);
+          if (parts_ok) {
+            for (const scene::BoxPart& part : s.parts)
+              if (PointInside(part, *p, kGeometryTolerance_m))
+                r.Error(n, "start.position is inside part '" + part.name +
+                               "', expected the held end outside every part");
+          }
+        }
+      }
+    }
+  }
+  if (const YAML::Node g = r.Get(root, "goal", "scene", true); g.IsDefined())
+    ReadGoal(r, g, s, parts_ok);
+  if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsDefined())
+    ReadDevice(r, d, s.device);
+  if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
+    ReadModel(r, m, s.model);
+  if (const YAML::Node ws = r.Get(root, "workspace", "scene", false); ws.IsDefined()) {
+    if (r.ExpectMap(ws, "workspace", {"min", "max"})) {
+      const YAML::Node lo = r.Get(ws, "min", "workspace", true);
+      const YAML::Node hi = r.Get(ws, "max", "workspace", true);
+      std::optional<Eigen::Vector3d> min, max;
+      if (lo.IsDefined()) min = r.Vector(lo, "workspace.min", dim::kLength);
+      if (hi.IsDefined()) max = r.Vector(hi, "workspace.max", dim::kLength);
+      if (min && max) {
+        if (((*max - *min).array() <= 0.0).any()) {
+          r.Error(hi, "workspace.max must exceed workspace.min along every axis");
+        } else {
+          s.workspace = scene::Workspace{*min, *max};
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+
+SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& display_name) {
+  SceneLoadResult result;
+  Reader reader(display_name, result.diagnostics);
+  scene::Scene s;
+  try {
+    const YAML::Node root = YAML::Load(std::string(yaml_text));
+    ReadScene(reader, root, s);
+  } catch (const YAML::Exception& e) {
+    reader.Error(e.mark, e.msg + ", expected valid YAML");
+  } catch (const std::exception& e) {
+    // Not expected: the reader checks every node's type before converting it. Still a file
+    // problem for the user, never a crash.
+    result.diagnostics.Error(display_name, 0, 0,
+                             std::string("could not read the scene: ") + e.what());
+  }
+  if (!result.diagnostics.HasErrors()) result.scene = std::move(s);
+  return result;
+}
+
+SceneLoadResult LoadSceneFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  if (in) text << in.rdbuf();
+  if (!in || std::filesystem::is_directory(path)) {
+    SceneLoadResult result;
+    result.diagnostics.Error(path.string(), 0, 0,
+                             "cannot read file, expected a readable YAML scene file");
+    return result;
+  }
+  return LoadSceneText(text.str(), path.string());
+}
+
+}  // namespace tubeplan::io

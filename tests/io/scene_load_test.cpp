@@ -1,0 +1,250 @@
+// Scene loading: the shipped scenes load, a good file gives exactly its SI values, and broken
+// files give exactly the diagnostics a user should read (all of them, at the right line:col).
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/scene/scene.hpp>
+
+namespace {
+
+using tubeplan::io::LoadSceneFile;
+using tubeplan::io::LoadSceneText;
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A minimal valid scene; the broken cases below edit one line of it, so the line numbers in the
+// expected messages are this text's (line 1 is "tubeplan: 1").
+const std::string kMinimal =
+    "tubeplan: 1\n"
+    "name: t\n"
+    "tube: {outer_radius: 5 mm, inner_radius: 4 mm, length: 150 mm, youngs_modulus: 3 MPa, "
+    "poisson_ratio: 0.5}\n"
+    "friction: {static: 0.7, kinetic: 0.08}\n"
+    "parts:\n"
+    "  - name: floor\n"
+    "    box: {size: [60 mm, 200 mm, 10 mm], position: [0, 0, -5 mm]}\n"
+    "  - name: wall\n"
+    "    box: {size: [10 mm, 200 mm, 20 mm], position: [15 mm, 0, 10 mm]}\n"
+    "start: {position: [0, -90 mm, 40 mm]}\n"
+    "goal: \"{Fs - floor.top}\"\n";
+
+// kMinimal with its line `line` (1-based) replaced.
+std::string WithLine(int line, const std::string& replacement) {
+  std::istringstream in(kMinimal);
+  std::string out, l;
+  for (int i = 1; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Every shipped scene loads without a diagnostic", "[scene]") {
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(SourcePath("scenes"))) {
+    if (entry.path().extension() != ".yaml") continue;
+    CAPTURE(entry.path().string());
+    const auto loaded = LoadSceneFile(entry.path());
+    CHECK(loaded.diagnostics.FormatAll() == "");
+    CHECK(loaded.scene.has_value());
+    ++count;
+  }
+  CHECK(count >= 2);
+}
+
+TEST_CASE("The minimal scene of these tests is valid", "[scene]") {
+  const auto loaded = LoadSceneText(kMinimal, "t.yaml");
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.scene);
+  // No device or model section: the documented defaults.
+  CHECK(loaded.scene->device.max_force_N == 8.5);
+  CHECK_FALSE(loaded.scene->device.coupling_stiffness_N_per_m.has_value());
+  CHECK(loaded.scene->model.beam == tubeplan::model::BeamModel::kLinear);
+  CHECK(loaded.scene->friction.exponent == 1.0);
+}
+
+TEST_CASE("A good scene gives exactly its SI values", "[scene]") {
+  const auto loaded = LoadSceneFile(SourcePath("tests/data/scenes/good.yaml"));
+  REQUIRE(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.scene);
+  const tubeplan::scene::Scene& s = *loaded.scene;
+  // Each value is one conversion of a short decimal: equal to the double literal, or within an
+  // ulp or two where the conversion multiplies by 1e-3 (Approx with 1e-15 relative).
+  const auto mm = [](double v) { return Approx(v * 1e-3).epsilon(1e-15); };
+  CHECK(s.name == "good");
+  CHECK(s.tube.outer_radius_m == mm(5));
+  CHECK(s.tube.inner_radius_m == mm(4));
+  CHECK(s.tube.length_m == mm(150));
+  CHECK(s.tube.youngs_modulus_Pa == 3e6);
+  CHECK(s.tube.poisson_ratio == 0.5);
+  CHECK(s.contact.stiffness_N_per_m == Approx(1e4).epsilon(1e-15));
+  CHECK(s.contact.threshold_m == mm(1));
+  CHECK(s.friction.static_coefficient == 0.7);
+  CHECK(s.friction.kinetic_coefficient == 0.08);
+  CHECK(s.friction.exponent == 0.6667);
+  CHECK(s.friction.reference_load_N == 1.0);
+  REQUIRE(s.parts.size() == 2);
+  CHECK(s.parts[1].name == "wall");
+  CHECK(s.parts[1].face_names[3] == "inner");  // xneg renamed
+  REQUIRE(s.parts[1].friction);
+  CHECK(s.parts[1].friction->static_coefficient == 0.5);
+  CHECK_FALSE(s.parts[0].friction);
+  // rpy [0, 0, 90 deg]: the wall's x axis along world y, its y axis along world -x.
+  const Eigen::Matrix3d R = s.parts[1].X_WP.linear();
+  CHECK((R.col(0) - Eigen::Vector3d::UnitY()).norm() < 1e-15);
+  CHECK((R.col(1) + Eigen::Vector3d::UnitX()).norm() < 1e-15);
+  CHECK(s.parts[1].X_WP.translation().x() == mm(15));
+  // Start: roll -90 deg turns the tube's axis (z) onto world +y.
+  CHECK((s.X_WH_start.linear().col(2) - Eigen::Vector3d::UnitY()).norm() < 1e-15);
+  CHECK(s.X_WH_start.translation().y() == mm(-90));
+  CHECK(tubeplan::states::ToString(s.goal) == "{Fs - floor.top, Fs u wall.top_inner}");
+  CHECK(s.device.coupling_stiffness_N_per_m == 400.0);
+  CHECK(s.device.coupling_damping_Ns_per_m == 2.0);
+  CHECK(s.model.beam == tubeplan::model::BeamModel::kElastica);
+  CHECK(s.model.time_step_s == 1e-3);
+}
+
+TEST_CASE("Broken scenes get exactly the right diagnostics", "[scene]") {
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"YAML syntax",
+       WithLine(7, "    box: {size: [60 mm, 200 mm, 10 mm], position: [0, 0, -5 mm]"),
+       "t.yaml:8:3: error: illegal block entry, expected valid YAML\n"},
+      {"unsupported version", WithLine(1, "tubeplan: 2"),
+       "t.yaml:1:11: error: unsupported format version 2, expected 1\n"},
+      {"unknown key with a suggestion", WithLine(4, "frction: {static: 0.7, kinetic: 0.08}"),
+       "t.yaml:4:1: error: unknown key 'frction' in 'scene', did you mean 'friction'? (expected "
+       "one of: tubeplan, name, tube, contact, friction, parts, start, goal, device, model, "
+       "workspace)\n"},
+      {"missing key",
+       WithLine(3,
+                "tube: {outer_radius: 5 mm, inner_radius: 4 mm, youngs_modulus: 3 MPa, "
+                "poisson_ratio: 0.5}"),
+       "t.yaml:3:7: error: missing key 'length' in 'tube'\n"},
+      {"wrong dimension",
+       WithLine(3,
+                "tube: {outer_radius: 5 N, inner_radius: 4 mm, length: 150 mm, "
+                "youngs_modulus: 3 MPa, poisson_ratio: 0.5}"),
+       "t.yaml:3:24: error: tube.outer_radius: has a unit of force (N), expected a length such "
+       "as \"5 mm\"\n"},
+      {"wrong type",
+       WithLine(3,
+                "tube: {outer_radius: [5 mm], inner_radius: 4 mm, length: 150 mm, "
+                "youngs_modulus: 3 MPa, poisson_ratio: 0.5}"),
+       "t.yaml:3:22: error: tube.outer_radius must be a quantity (a number or a string such as "
+       "\"5 mm\"), found a sequence\n"},
+      {"inner radius not below the outer",
+       WithLine(3,
+                "tube: {outer_radius: 5 mm, inner_radius: 5 mm, length: 150 mm, "
+                "youngs_modulus: 3 MPa, poisson_ratio: 0.5}"),
+       "t.yaml:3:42: error: tube.inner_radius (5 mm) must be smaller than outer_radius (5 mm)\n"},
+      {"Poisson's ratio out of range",
+       WithLine(3,
+                "tube: {outer_radius: 5 mm, inner_radius: 4 mm, length: 150 mm, "
+                "youngs_modulus: 3 MPa, poisson_ratio: 0.7}"),
+       "t.yaml:3:102: error: tube.poisson_ratio (0.7) must be in [0, 0.5]\n"},
+      {"NaN", WithLine(4, "friction: {static: nan, kinetic: 0.08}"),
+       "t.yaml:4:20: error: friction.static: the number is not finite, expected a finite "
+       "number\n"},
+      {"kinetic above static", WithLine(4, "friction: {static: 0.3, kinetic: 0.5}"),
+       "t.yaml:4:34: error: friction.kinetic (0.5) must not exceed static (0.3): sliding "
+       "friction is at most the friction that holds\n"},
+      {"overlapping parts",
+       WithLine(9, "    box: {size: [10 mm, 200 mm, 20 mm], position: [15 mm, 0, 9 mm]}"),
+       "t.yaml:9:51: error: part 'wall' overlaps part 'floor', expected parts that at most "
+       "touch\n"},
+      {"start inside a part", WithLine(10, "start: {position: [15 mm, 0, 10 mm]}"),
+       "t.yaml:10:19: error: start.position is inside part 'wall', expected the held end "
+       "outside every part\n"},
+      {"goal names an unknown element", WithLine(11, "goal: \"{Fs - floor.topp}\""),
+       "t.yaml:11:14: error: goal: no element 'floor.topp' in this scene, did you mean "
+       "'floor.top'? (expected part.face, part.face_face or part.face_face_face)\n"},
+      {"goal with a marker an end face cannot take", WithLine(11, "goal: \"{Fe u floor.top}\""),
+       "t.yaml:11:"},  // column and message from the CF parser: checked by prefix below
+      {"coupling stiffer than the device",
+       kMinimal + "device: {max_stiffness: 800 N/m, coupling: {stiffness: 1 kN/m}}\n",
+       "t.yaml:12:56: error: device.coupling.stiffness (1000 N/m) exceeds device.max_stiffness "
+       "(800 N/m), expected at most the device's limit\n"},
+      {"unknown model", kMinimal + "model: {beam: timoshenko}\n",
+       "t.yaml:12:15: error: model.beam 'timoshenko' is not known (expected one of: linear, "
+       "elastica)\n"},
+      {"top level not a map", "- 1\n- 2\n",
+       "t.yaml:1:1: error: a scene file must be a map, found a sequence, expected keys such as "
+       "tubeplan, name, tube, parts\n"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.what, c.text);
+    const auto loaded = LoadSceneText(c.text, "t.yaml");
+    CHECK_FALSE(loaded.scene);
+    const std::string got = loaded.diagnostics.FormatAll();
+    if (c.expected.back() == '\n') {
+      CHECK(got == c.expected);
+    } else {
+      CHECK_THAT(got, Catch::StartsWith(c.expected));
+      CHECK(std::count(got.begin(), got.end(), '\n') == 1);
+    }
+  }
+}
+
+TEST_CASE("Every problem in a file is reported at once", "[scene]") {
+  std::string text = WithLine(3,
+                              "tube: {outer_radius: 5 mm, inner_radius: 6 mm, length: 5 N, "
+                              "youngs_modulus: -3 MPa, poisson_ratio: 0.5}");
+  text = text + "colour: red\n";
+  const auto loaded = LoadSceneText(text, "t.yaml");
+  CHECK_FALSE(loaded.scene);
+  // r2 >= r1, length with a force unit, negative E, unknown key: four, in file order.
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:3:42: error: tube.inner_radius (6 mm) must be smaller than outer_radius (5 mm)\n"
+        "t.yaml:3:58: error: tube.length: has a unit of force (N), expected a length such as "
+        "\"5 mm\"\n"
+        "t.yaml:3:77: error: tube.youngs_modulus (-3e+06) must be a finite number greater than "
+        "zero\n"
+        "t.yaml:12:1: error: unknown key 'colour' in 'scene' (expected one of: tubeplan, name, "
+        "tube, contact, friction, parts, start, goal, device, model, workspace)\n");
+}
+
+TEST_CASE("An unreadable file is one error for the whole file", "[scene]") {
+  const auto loaded = LoadSceneFile("no/such/scene.yaml");
+  CHECK_FALSE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "no/such/scene.yaml: error: cannot read file, expected a readable YAML scene file\n");
+}
+
+TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
+  // Every one-byte deletion and duplication of a good file: the loader must return either a
+  // scene with no error or at least one error, and never throw or crash (ASan build included).
+  const std::string good = ReadText(SourcePath("tests/data/scenes/good.yaml"));
+  REQUIRE(good.size() > 100);
+  int loaded_count = 0, rejected = 0;
+  for (std::size_t i = 0; i < good.size(); ++i) {
+    for (const std::string& text :
+         {good.substr(0, i) + good.substr(i + 1), good.substr(0, i + 1) + good.substr(i)}) {
+      tubeplan::io::SceneLoadResult result;
+      REQUIRE_NOTHROW(result = LoadSceneText(text, "fuzz.yaml"));
+      CHECK(result.scene.has_value() != result.diagnostics.HasErrors());
+      (result.scene ? loaded_count : rejected) += 1;
+    }
+  }
+  // Most damage must be caught (comments and spaces are harmless, most other bytes are not).
+  CHECK(rejected > loaded_count);
+}
