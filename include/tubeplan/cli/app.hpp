@@ -1,0 +1,19 @@
+#pragma once
+// The tubeplan command line. Exit codes (documented in README): 0 success, 1 the job ran and
+// found a negative answer (e.g. an infeasible plan), 2 bad input or bad usage, 3 internal error.
+
+#include <ostream>
+#include <span>
+#include <string>
+
+namespace tubeplan::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitNegative = 1;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitInternal = 3;
+
+/// Runs the command with `args` (without the program name); output to `out`, logs to `err`.
+int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err);
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,73 @@
+#include <tubeplan/cli/app.hpp>
+
+#include <exception>
+
+#include "commands.hpp"
+
+namespace tubeplan::cli {
+
+std::optional<std::vector<double>> ParseQuantityList(std::string_view option, std::string_view text,
+                                                     std::size_t min_count, std::size_t max_count,
+                                                     io::Dimension dimension, std::string& error) {
+  std::vector<double> values;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string_view item =
+        text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    const io::QuantityResult parsed = io::ParseQuantityAs(item, dimension);
+    if (!parsed.quantity) {
+      error = std::string(option) + ": \"" + std::string(item) + "\": " + parsed.error->message;
+      return std::nullopt;
+    }
+    values.push_back(parsed.quantity->value_si);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  if (values.size() < min_count || values.size() > max_count) {
+    error = std::string(option) + ": expected " +
+            (min_count == max_count ? std::to_string(min_count)
+                                    : std::to_string(min_count) + " to " + std::to_string(max_count)) +
+            " comma-separated values, got " + std::to_string(values.size());
+    return std::nullopt;
+  }
+  return values;
+}
+
+int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
+  CLI::App app{
+      "tubeplan: feasibility of assembly motion plans for an elastic tube going into a rigid "
+      "groove.",
+      "tubeplan"};
+  app.set_version_flag("--version", "tubeplan 0.1.0");
+  app.require_subcommand(1);
+  const Streams streams{out, err};
+  const std::vector<Command> commands = {AddCheckCommand(app, streams),
+                                         AddBeamCommand(app, streams),
+                                         AddBenchCommand(app, streams)};
+
+  // CLI11 wants argv order reversed when given a vector.
+  std::vector<std::string> reversed(args.rbegin(), args.rend());
+  try {
+    app.parse(reversed);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e, out, err);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e, out, err);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e, out, err);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e, out, err);
+    return kExitBadInput;
+  }
+  try {
+    for (const Command& command : commands)
+      if (command.app->parsed()) return command.run();
+  } catch (const std::exception& e) {
+    err << "tubeplan: internal error: " << e.what() << "\n";
+    return kExitInternal;
+  }
+  return kExitBadInput;
+}
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,40 @@
+#pragma once
+// Private to the cli library: each subcommand registers itself on the app and hands back the
+// action to run when it was the one parsed.
+
+#include <functional>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include <tubeplan/io/units.hpp>
+
+namespace tubeplan::cli {
+
+struct Streams {
+  std::ostream& out;  ///< results (one JSON document with --json)
+  std::ostream& err;  ///< diagnostics, logs
+};
+
+/// A registered subcommand and what to run when it is the one parsed (returns the exit code).
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+
+Command AddCheckCommand(CLI::App& app, Streams streams);
+Command AddBeamCommand(CLI::App& app, Streams streams);
+Command AddBenchCommand(CLI::App& app, Streams streams);
+
+/// Parses "a,b,c" of quantities of one dimension (each a plain SI number or with a unit) with
+/// between min_count and max_count items. On failure returns nullopt and sets `error` to a
+/// sentence naming the option.
+std::optional<std::vector<double>> ParseQuantityList(std::string_view option, std::string_view text,
+                                                     std::size_t min_count, std::size_t max_count,
+                                                     io::Dimension dimension, std::string& error);
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,180 @@
+// The command line as a user drives it: argument strings in, exit code and text out.
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+
+namespace {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+Outcome RunTool(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  const int code = tubeplan::cli::Run(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+// A steel tube well inside the linear range: r1 3 mm, r2 2.5 mm, l 300 mm, E 200 GPa.
+const std::vector<std::string> kSteelTube = {
+    "--outer-radius",   "3 mm",    "--inner-radius",  "2.5mm", "--length", "0.3",
+    "--youngs-modulus", "200 GPa", "--poisson-ratio", "0.3"};
+
+std::vector<std::string> Beam(std::vector<std::string> extra) {
+  std::vector<std::string> args = {"beam"};
+  args.insert(args.end(), kSteelTube.begin(), kSteelTube.end());
+  args.insert(args.end(), extra.begin(), extra.end());
+  return args;
+}
+
+}  // namespace
+
+TEST_CASE("beam --json reports the cantilever's analytic tip figures", "[cli]") {
+  const Outcome r = RunTool(Beam({"--tip-force", "0.5 N", "--json", "--at", "0,0,300 mm"}));
+  REQUIRE(r.exit_code == 0);
+  const auto doc = nlohmann::json::parse(r.out);
+  // Independent of the library: I = pi (r1^4 - r2^4) / 4, delta = F l^3 / (3 E I).
+  const double r1 = 3e-3, r2 = 2.5e-3, l = 0.3, E = 200e9, F = 0.5;
+  const double I = std::numbers::pi * (std::pow(r1, 4) - std::pow(r2, 4)) / 4.0;
+  const double EI = E * I;
+  // The CLI prints what the library computed from parsed text: exact to a few ulps.
+  const double kRel = 1e-12;
+  CHECK(doc["tip_deflection"].get<double>() == Approx(F * l * l * l / (3 * EI)).epsilon(kRel));
+  CHECK(doc["tip_angle"].get<double>() == Approx(F * l * l / (2 * EI)).epsilon(kRel));
+  CHECK(doc["energy"].get<double>() == Approx(F * F * l * l * l / (6 * EI)).epsilon(kRel));
+  CHECK(doc["strain"].get<double>() == Approx(r1 * F * l / EI).epsilon(kRel));
+  CHECK(doc["alpha"].get<double>() == Approx(F * l * l / EI).epsilon(kRel));
+  // The linear model does not shorten the tube.
+  CHECK(doc["tip_shortening"].get<double>() == 0.0);
+  // The displacement of the tip centre is the tip deflection along the force (x).
+  REQUIRE(doc["points"].size() == 1);
+  const auto& u = doc["points"][0]["displacement"];
+  CHECK(u[0].get<double>() == Approx(F * l * l * l / (3 * EI)).epsilon(kRel));
+  CHECK(u[1].get<double>() == 0.0);
+}
+
+TEST_CASE("beam: the elastica and the linear model agree for a small load", "[cli]") {
+  // alpha ~ 1e-4 here: the elastica's deflection is below the linear one by ~ (2/7)... at order
+  // alpha^2, i.e. ~1e-8 relative; 1e-6 leaves room and still fails for any real mismatch.
+  const Outcome linear = RunTool(Beam({"--tip-force", "0.001", "--json"}));
+  const Outcome elastica = RunTool(Beam({"--tip-force", "0.001", "--json", "--model", "elastica"}));
+  REQUIRE(linear.exit_code == 0);
+  REQUIRE(elastica.exit_code == 0);
+  const auto a = nlohmann::json::parse(linear.out);
+  const auto b = nlohmann::json::parse(elastica.out);
+  CHECK(b["tip_deflection"].get<double>() ==
+        Approx(a["tip_deflection"].get<double>()).epsilon(1e-6));
+  CHECK(b["tip_shortening"].get<double>() > 0.0);
+}
+
+TEST_CASE("beam: a quantity with a unit equals the same quantity in SI", "[cli]") {
+  const Outcome mm = RunTool(Beam({"--tip-force", "1000 mN", "--json"}));
+  const Outcome si = RunTool(Beam({"--tip-force", "1", "--json"}));
+  REQUIRE(mm.exit_code == 0);
+  REQUIRE(si.exit_code == 0);
+  CHECK(nlohmann::json::parse(mm.out)["tip_deflection"] ==
+        nlohmann::json::parse(si.out)["tip_deflection"]);
+}
+
+TEST_CASE("beam: bad input is exit code 2 with a message naming the problem", "[cli]") {
+  SECTION("a unit of the wrong dimension") {
+    const Outcome r = RunTool(Beam({"--tip-force", "5 mm"}));
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--tip-force") && Catch::Contains("length") &&
+                          Catch::Contains("force"));
+  }
+  SECTION("an inner radius not below the outer one") {
+    const Outcome r = RunTool({"beam", "--outer-radius", "3mm", "--inner-radius", "3mm", "--length",
+                               "1", "--youngs-modulus", "1GPa", "--poisson-ratio", "0.3"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("inner_radius"));
+  }
+  SECTION("no tube at all") {
+    const Outcome r = RunTool({"beam", "--tip-force", "1"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--scene"));
+  }
+  SECTION("an unknown option") {
+    const Outcome r = RunTool(Beam({"--bogus"}));
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("--bogus"));
+  }
+  SECTION("an unknown model") {
+    const Outcome r = RunTool(Beam({"--model", "timoshenko"}));
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("timoshenko"));
+  }
+  SECTION("a scene file that does not exist") {
+    const Outcome r = RunTool({"beam", "--scene", "no/such/scene.yaml"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::StartsWith("no/such/scene.yaml: error:"));
+  }
+}
+
+TEST_CASE("check: every shipped scene is valid and summarised in one line", "[cli]") {
+  std::vector<std::string> args = {"check"};
+  for (const auto& entry : std::filesystem::directory_iterator(SourcePath("scenes")))
+    if (entry.path().extension() == ".yaml") args.push_back(entry.path().string());
+  REQUIRE(args.size() >= 3);  // groove.yaml and groove-steel.yaml at least
+  const Outcome r = RunTool(args);
+  CHECK(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(static_cast<std::size_t>(std::count(r.out.begin(), r.out.end(), '\n')) == args.size() - 1);
+}
+
+TEST_CASE("check: a broken scene is exit code 2 with file:line:col diagnostics", "[cli]") {
+  const std::string broken = SourcePath("tests/data/scenes/cli-several-errors.yaml");
+  const std::string good = SourcePath("scenes/groove.yaml");
+  const Outcome r = RunTool({"check", good, broken});
+  CHECK(r.exit_code == 2);
+  // The good file is still summarised; every diagnostic line is about the broken one.
+  CHECK_THAT(r.out, Catch::Contains(good + ": ok:"));
+  std::istringstream lines(r.err);
+  int count = 0;
+  for (std::string line; std::getline(lines, line); ++count)
+    CHECK_THAT(line, Catch::StartsWith(broken + ":") && Catch::Contains(": error: "));
+  CHECK(count >= 2);
+
+  const Outcome json = RunTool({"check", "--json", broken});
+  CHECK(json.exit_code == 2);
+  const auto doc = nlohmann::json::parse(json.out);
+  CHECK(doc["files"][0]["valid"] == false);
+  CHECK(doc["files"][0]["diagnostics"].size() == static_cast<std::size_t>(count));
+}
+
+TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
+  // Only the shape of the report is tested: speed is measured by running `tubeplan bench`,
+  // never asserted in a test.
+  const Outcome r = RunTool({"bench", "--samples", "10", "--json"});
+  REQUIRE(r.exit_code == 0);
+  const auto doc = nlohmann::json::parse(r.out);
+  REQUIRE(doc["scenarios"].size() == 4);
+  for (const auto& s : doc["scenarios"]) {
+    const double median = s["median_us"].get<double>();
+    CHECK(std::isfinite(median));
+    CHECK(median > 0.0);
+    CHECK(s["p99_us"].get<double>() >= median);
+    CHECK(s["max_us"].get<double>() >= s["p99_us"].get<double>());
+  }
+}
+
+TEST_CASE("usage: no subcommand and --version", "[cli]") {
+  CHECK(RunTool({}).exit_code == 2);
+  const Outcome v = RunTool({"--version"});
+  CHECK(v.exit_code == 0);
+  CHECK_THAT(v.out, Catch::Contains("tubeplan"));
+}
