@@ -73,13 +73,13 @@ std::vector<TubeSpec> StressTubes() {
 // d = r1 - r2 (exact in double when r2 >= r1 / 2, Sterbenz), r1^4 - r2^4 = 4 r1^3 d - 6 r1^2 d^2 +
 // 4 r1 d^3 - d^4 has no cancellation for thin walls; thick walls use the plain difference.
 long double SecondMomentLongDouble(double r1, double r2) {
-  const long double a = r1;
+  const long double a = static_cast<long double>(r1);
   long double difference = 0.0L;
   if (2.0 * r2 >= r1) {
-    const long double d = r1 - r2;
+    const long double d = static_cast<long double>(r1 - r2);
     difference = 4.0L * a * a * a * d - 6.0L * a * a * d * d + 4.0L * a * d * d * d - d * d * d * d;
   } else {
-    const long double b = r2;
+    const long double b = static_cast<long double>(r2);
     difference = a * a * a * a - b * b * b * b;
   }
   return std::numbers::pi_v<long double> * difference / 4.0L;
@@ -279,8 +279,10 @@ TEST_CASE("Tip deflection of the corrected field is F l^3 / (3 E I)", "[linear]"
     const double l = spec.length_m;
     CAPTURE(spec.outer_radius_m, spec.inner_radius_m, spec.poisson_ratio);
     const long double I = SecondMomentLongDouble(spec.outer_radius_m, spec.inner_radius_m);
-    const double expected = static_cast<double>(static_cast<long double>(F) * l * l * l /
-                                                (3.0L * spec.youngs_modulus_Pa * I));
+    const long double l_ld = static_cast<long double>(l);
+    const double expected =
+        static_cast<double>(static_cast<long double>(F) * l_ld * l_ld * l_ld /
+                            (3.0L * static_cast<long double>(spec.youngs_modulus_Pa) * I));
     const Eigen::Vector3d tip = beam.DisplacementInBendingFrame({0.0, 0.0, l}, F);
     // About a dozen roundings of 1/2 ulp in I, E I, 1 / (E I) and the cubic; 1e-14 is ~45 ulps.
     CHECK(std::abs(tip.x() - expected) <= 1e-14 * expected);
