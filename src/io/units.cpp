@@ -100,28 +100,36 @@ const Symbol* FindSymbol(std::string_view word, double& factor) {
   return nullptr;
 }
 
+// The dimensions with a name of their own, and a unit to suggest when one is expected.
+struct NamedDimension {
+  Dimension dimension;
+  const char* name;
+  const char* example;
+};
+constexpr std::array<NamedDimension, 12> kNamedDimensions = {{
+    {dim::kNone, "dimensionless number", "0.5 (no unit)"},
+    {dim::kLength, "length", "\"5 mm\""},
+    {dim::kMass, "mass", "\"1 kg\""},
+    {dim::kTime, "time", "\"1 ms\""},
+    {dim::kAngle, "angle", "\"90 deg\""},
+    {dim::kForce, "force", "\"2 N\""},
+    {dim::kPressure, "pressure", "\"3 MPa\""},
+    {dim::kStiffness, "force/length", "\"10 N/mm\""},
+    {dim::kDamping, "force*time/length", "\"5 N s/m\""},
+    {dim::kTorque, "torque or energy", "\"0.188 N m\""},
+    {dim::kFrequency, "frequency", "\"1 kHz\""},
+    {dim::kVelocity, "velocity", "\"10 mm/s\""},
+}};
+
+const NamedDimension* FindNamed(Dimension d) {
+  for (const NamedDimension& n : kNamedDimensions)
+    if (n.dimension == d) return &n;
+  return nullptr;
+}
+
 std::string ExampleUnit(Dimension d) {
-  struct Example {
-    Dimension dimension;
-    const char* text;
-  };
-  static constexpr std::array<Example, 12> kExamples = {{
-      {dim::kNone, "0.5 (no unit)"},
-      {dim::kLength, "\"5 mm\""},
-      {dim::kMass, "\"1 kg\""},
-      {dim::kTime, "\"1 ms\""},
-      {dim::kAngle, "\"90 deg\""},
-      {dim::kForce, "\"2 N\""},
-      {dim::kPressure, "\"3 MPa\""},
-      {dim::kStiffness, "\"10 N/mm\""},
-      {dim::kDamping, "\"5 N s/m\""},
-      {dim::kTorque, "\"0.188 N m\""},
-      {dim::kFrequency, "\"1 kHz\""},
-      {dim::kVelocity, "\"10 mm/s\""},
-  }};
-  for (const Example& e : kExamples)
-    if (e.dimension == d) return e.text;
-  return "a plain SI number";
+  const NamedDimension* named = FindNamed(d);
+  return named != nullptr ? named->example : "a plain SI number";
 }
 
 QuantityResult Fail(std::size_t offset, std::string message) {
@@ -131,26 +139,7 @@ QuantityResult Fail(std::size_t offset, std::string message) {
 }  // namespace
 
 std::string Describe(Dimension d) {
-  struct Named {
-    Dimension dimension;
-    const char* name;
-  };
-  static constexpr std::array<Named, 12> kNamed = {{
-      {dim::kNone, "dimensionless number"},
-      {dim::kLength, "length"},
-      {dim::kMass, "mass"},
-      {dim::kTime, "time"},
-      {dim::kAngle, "angle"},
-      {dim::kForce, "force"},
-      {dim::kPressure, "pressure"},
-      {dim::kStiffness, "force/length"},
-      {dim::kDamping, "force*time/length"},
-      {dim::kTorque, "torque or energy"},
-      {dim::kFrequency, "frequency"},
-      {dim::kVelocity, "velocity"},
-  }};
-  for (const Named& n : kNamed)
-    if (n.dimension == d) return n.name;
+  if (const NamedDimension* named = FindNamed(d)) return named->name;
   std::string text;
   auto term = [&text](const char* symbol, int power) {
     if (power == 0) return;
