@@ -1,0 +1,169 @@
+// Hand trajectories: resampling onto the core's step, and the CSV loader's values and messages.
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/trajectory.hpp>
+
+namespace {
+
+using tubeplan::io::LoadTrajectoryFile;
+using tubeplan::io::LoadTrajectoryText;
+using tubeplan::plan::HandSample;
+using tubeplan::plan::Trajectory;
+
+Eigen::Quaterniond AboutZ(double angle_rad) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitZ()));
+}
+
+// Rotation angle between two orientations (either sign of a quaternion is the same rotation).
+double AngleBetween(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
+  return a.angularDistance(b);
+}
+
+}  // namespace
+
+TEST_CASE("Resampling a constant-velocity line gives the analytic position every tick",
+          "[trajectory]") {
+  // 250 Hz samples of p(t) = p0 + v t; every 1 ms tick must lie on the line.
+  const Eigen::Vector3d p0(0.01, -0.09, 0.04), v(0.05, 0.2, -0.1);  // m, m/s
+  Trajectory trajectory;
+  for (int i = 0; i <= 250; ++i) {
+    const double t = i / 250.0;
+    trajectory.samples.push_back({t, p0 + v * t, Eigen::Quaterniond::Identity()});
+  }
+  const std::vector<HandSample> ticks = tubeplan::plan::Resample(trajectory, 1e-3);
+  REQUIRE(ticks.size() == 1001);  // 0 .. 1 s inclusive
+  for (std::size_t k = 0; k < ticks.size(); ++k) {
+    const double t = static_cast<double>(k) * 1e-3;
+    CAPTURE(k);
+    CHECK(ticks[k].t_s == Approx(t).margin(1e-15));
+    // A few roundings of numbers ~0.1 m: 1e-15 m is ~10 ulps.
+    CHECK((ticks[k].p_WH_m - (p0 + v * t)).norm() < 1e-15);
+  }
+  // A tick whose time equals a sample's returns that sample bit for bit (t = 0 here).
+  CHECK(ticks.front().p_WH_m == trajectory.samples.front().p_WH_m);
+}
+
+TEST_CASE("Orientation is interpolated on the shorter arc", "[trajectory]") {
+  Trajectory trajectory;
+  trajectory.samples.push_back({0.0, Eigen::Vector3d::Zero(), AboutZ(0.0)});
+  trajectory.samples.push_back({0.002, Eigen::Vector3d::Zero(), AboutZ(std::numbers::pi / 2)});
+  const auto ticks = tubeplan::plan::Resample(trajectory, 1e-3);
+  REQUIRE(ticks.size() == 3);
+  // Halfway through a 90 degree turn about z is a 45 degree turn (SLERP is uniform in angle).
+  CHECK(AngleBetween(ticks[1].q_WH, AboutZ(std::numbers::pi / 4)) < 1e-12);
+
+  // The same end orientation written as -q: still the 90 degree way, not the 270 degree way.
+  trajectory.samples[1].q_WH.coeffs() = -trajectory.samples[1].q_WH.coeffs();
+  const auto flipped = tubeplan::plan::Resample(trajectory, 1e-3);
+  CHECK(AngleBetween(flipped[1].q_WH, AboutZ(std::numbers::pi / 4)) < 1e-12);
+}
+
+TEST_CASE("PoseAt holds the ends and moves its cursor forward", "[trajectory]") {
+  Trajectory trajectory;
+  for (int i = 0; i < 5; ++i)
+    trajectory.samples.push_back(
+        {0.01 * i, Eigen::Vector3d(i, 0, 0), Eigen::Quaterniond::Identity()});
+  std::size_t cursor = 0;
+  CHECK(tubeplan::plan::PoseAt(trajectory, -1.0, cursor).p_WH_m.x() == 0.0);
+  CHECK(tubeplan::plan::PoseAt(trajectory, 0.025, cursor).p_WH_m.x() == Approx(2.5));
+  CHECK(cursor == 2);
+  // Going back in time still answers correctly.
+  CHECK(tubeplan::plan::PoseAt(trajectory, 0.005, cursor).p_WH_m.x() == Approx(0.5));
+  CHECK(tubeplan::plan::PoseAt(trajectory, 9.0, cursor).p_WH_m.x() == 4.0);
+}
+
+TEST_CASE("A good trajectory file loads with exact values and metadata", "[trajectory]") {
+  const auto loaded =
+      LoadTrajectoryFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/trajectories/good.csv");
+  REQUIRE(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.trajectory);
+  const Trajectory& t = *loaded.trajectory;
+  CHECK(t.device == "PHANToM Premium 1.5/6DOF");
+  CHECK(t.nominal_rate_Hz == 250.0);
+  REQUIRE(t.samples.size() == 3);
+  CHECK(t.samples[1].t_s == 0.004);
+  // "# units: mm": positions are scaled to metres (one multiplication by 1e-3).
+  CHECK(t.samples[1].p_WH_m.x() == Approx(1e-3).epsilon(1e-15));
+  CHECK(t.samples[2].p_WH_m.y() == Approx(-0.089).epsilon(1e-15));
+  // The third quaternion is off unit length by ~5e-7 (rounded digits): normalised, kept.
+  CHECK(std::abs(t.samples[2].q_WH.norm() - 1.0) < 1e-15);
+  REQUIRE(t.extra_columns == std::vector<std::string>{"button"});
+  CHECK(t.extra_values[1][0] == 1.0);
+}
+
+TEST_CASE("Broken trajectory files get exactly the right diagnostics", "[trajectory]") {
+  const std::string header = "t,px,py,pz,qw,qx,qy,qz\n";
+  const std::string row0 = "0.000,0,0,0,1,0,0,0\n";
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"not a number", header + row0 + "0.001,0,abc,0,1,0,0,0\n",
+       "t.csv:3:9: error: 'abc' is not a number, expected a decimal number\n"},
+      {"nan", header + row0 + "0.001,nan,0,0,1,0,0,0\n",
+       "t.csv:3:7: error: the number is not finite, expected a finite number\n"},
+      {"time not increasing", header + row0 + "0.000,0,0,0,1,0,0,0\n",
+       "t.csv:3:1: error: time 0 s is not after the previous sample's 0 s, expected strictly "
+       "increasing times\n"},
+      {"gap", header + row0 + "0.2,0,0,0,1,0,0,0\n",
+       "t.csv:3:1: error: gap of 0.2 s before this sample, more than 0.05 s (a dropped "
+       "recording?)\n"},
+      {"quaternion not unit", header + row0 + "0.001,0,0,0,0.5,0,0,0\n",
+       "t.csv:3:13: error: quaternion (qw, qx, qy, qz) has norm 0.5, expected a unit quaternion "
+       "(within 0.001)\n"},
+      {"missing columns", "t,px,py,pz,qx,qy\n" + row0,
+       "t.csv:1:1: error: the header lacks column(s) qw, qz, expected t,px,py,pz,qw,qx,qy,qz (in "
+       "any order, more allowed)\n"},
+      {"duplicate column", "t,px,py,pz,qw,qx,qy,qz,px\n",
+       "t.csv:1:24: error: column 'px' appears twice, expected each column once\n"},
+      {"wrong field count", header + row0 + "0.001,0,0,0,1,0,0\n",
+       "t.csv:3:1: error: row has 7 fields, expected 8 as in the header\n"},
+      {"one sample", header + row0,
+       "t.csv: error: the file has 1 sample(s), expected at least 2\n"},
+      {"empty", "# only a comment\n",
+       "t.csv: error: no header line, expected t,px,py,pz,qw,qx,qy,qz\n"},
+      {"bad units", "# units: inch\n" + header + row0 + "0.001,0,0,0,1,0,0,0\n",
+       "t.csv:1:10: error: units 'inch' not supported, expected m or mm (for px, py, pz; t is in "
+       "s)\n"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.what, c.text);
+    const auto loaded = LoadTrajectoryText(c.text, "t.csv");
+    CHECK_FALSE(loaded.trajectory);
+    CHECK(loaded.diagnostics.FormatAll() == c.expected);
+  }
+}
+
+TEST_CASE("Trajectory errors are all reported, then capped", "[trajectory]") {
+  std::string text = "t,px,py,pz,qw,qx,qy,qz\r\n0,0,0,0,1,0,0,0\r\n";  // CRLF is fine
+  for (int i = 1; i <= 60; ++i) text += std::to_string(i * 1e-3) + ",x,0,0,1,0,0,0\r\n";
+  const auto loaded = LoadTrajectoryText(text, "t.csv");
+  CHECK_FALSE(loaded.trajectory);
+  // 60 bad rows: the first 50 are listed, then one line says how many more.
+  REQUIRE(loaded.diagnostics.all().size() == 51);
+  CHECK(loaded.diagnostics.all()[0].line == 3);
+  CHECK(loaded.diagnostics.all()[0].column == 10);
+  CHECK(loaded.diagnostics.all()[50].message == "... and 10 more errors");
+}
+
+TEST_CASE("Damaged trajectory files never throw", "[trajectory]") {
+  const std::string good =
+      "# rate: 1 kHz\nt,px,py,pz,qw,qx,qy,qz\n0,0.1,0.2,0.3,1,0,0,0\n0.001,0.1,0.2,0.3,1,0,0,0\n";
+  REQUIRE(LoadTrajectoryText(good, "g.csv").trajectory);
+  for (std::size_t i = 0; i < good.size(); ++i) {
+    for (const std::string& text :
+         {good.substr(0, i) + good.substr(i + 1), good.substr(0, i + 1) + good.substr(i)}) {
+      tubeplan::io::TrajectoryLoadResult r;
+      REQUIRE_NOTHROW(r = LoadTrajectoryText(text, "f.csv"));
+      CHECK(r.trajectory.has_value() != r.diagnostics.HasErrors());
+    }
+  }
+}
