@@ -1,12 +1,15 @@
-// `tubeplan check FILE...`: validates files and prints a one-line summary of each valid one.
-// Every problem in every file is reported before the exit code says so.
+// `tubeplan check FILE...`: validates scene and trajectory files and prints a one-line summary of
+// each valid one. Every problem in every file is reported before the exit code says so.
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/scene/elements.hpp>
 
 #include "commands.hpp"
@@ -37,28 +40,63 @@ std::string Summary(const scene::Scene& s) {
   return out.str();
 }
 
+std::string Summary(const plan::Trajectory& t) {
+  const double duration_s = t.samples.back().t_s - t.samples.front().t_s;
+  std::ostringstream out;
+  out << "trajectory: " << t.samples.size() << " samples over " << duration_s << " s (mean rate "
+      << static_cast<double>(t.samples.size() - 1) / duration_s << " Hz";
+  if (t.nominal_rate_Hz > 0.0) out << ", nominal " << t.nominal_rate_Hz << " Hz";
+  out << ")";
+  if (!t.device.empty()) out << "; device " << t.device;
+  if (!t.extra_columns.empty()) {
+    out << "; extra columns";
+    for (const std::string& c : t.extra_columns) out << " " << c;
+  }
+  return out.str();
+}
+
+// What a file is, by its extension: .csv is a trajectory, anything else a scene.
+struct Checked {
+  const char* kind;
+  io::Diagnostics diagnostics;
+  std::optional<std::string> summary;  // set when valid
+};
+
+Checked CheckFile(const std::string& file) {
+  if (std::filesystem::path(file).extension() == ".csv") {
+    io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(file);
+    Checked c{"trajectory", std::move(loaded.diagnostics), std::nullopt};
+    if (loaded.trajectory) c.summary = Summary(*loaded.trajectory);
+    return c;
+  }
+  io::SceneLoadResult loaded = io::LoadSceneFile(file);
+  Checked c{"scene", std::move(loaded.diagnostics), std::nullopt};
+  if (loaded.scene) c.summary = Summary(*loaded.scene);
+  return c;
+}
+
 int RunCheck(const CheckOptions& o, Streams io) {
   bool all_valid = true;
   nlohmann::json files = nlohmann::json::array();
   for (const std::string& file : o.files) {
-    const io::SceneLoadResult loaded = io::LoadSceneFile(file);
-    io.err << loaded.diagnostics.FormatAll();
-    const bool valid = loaded.scene.has_value();
+    const Checked checked = CheckFile(file);
+    io.err << checked.diagnostics.FormatAll();
+    const bool valid = checked.summary.has_value();
     all_valid = all_valid && valid;
     if (o.json) {
       nlohmann::json diagnostics = nlohmann::json::array();
-      for (const io::Diagnostic& d : loaded.diagnostics.all())
+      for (const io::Diagnostic& d : checked.diagnostics.all())
         diagnostics.push_back(
             {{"line", d.line},
              {"column", d.column},
              {"severity", d.severity == io::Severity::kError ? "error" : "warning"},
              {"message", d.message}});
       nlohmann::json entry = {
-          {"file", file}, {"kind", "scene"}, {"valid", valid}, {"diagnostics", diagnostics}};
-      if (valid) entry["summary"] = Summary(*loaded.scene);
+          {"file", file}, {"kind", checked.kind}, {"valid", valid}, {"diagnostics", diagnostics}};
+      if (valid) entry["summary"] = *checked.summary;
       files.push_back(entry);
     } else if (valid) {
-      io.out << file << ": ok: " << Summary(*loaded.scene) << "\n";
+      io.out << file << ": ok: " << *checked.summary << "\n";
     }
   }
   if (o.json) io.out << nlohmann::json{{"files", files}}.dump(2) << "\n";
@@ -71,9 +109,10 @@ Command AddCheckCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<CheckOptions>();
   CLI::App* sub = app.add_subcommand(
       "check",
-      "Validate scene files: every problem is reported as file:line:col (exit 2), and "
-      "each valid file gets a one-line summary.");
-  sub->add_option("files", options->files, "scene files (YAML)")->required();
+      "Validate scene files (.yaml) and trajectories (.csv): every problem is reported as "
+      "file:line:col (exit 2), and each valid file gets a one-line summary.");
+  sub->add_option("files", options->files, "scene files (.yaml) and trajectory files (.csv)")
+      ->required();
   sub->add_flag("--json", options->json, "print one JSON document");
   return {sub, [options, streams] { return RunCheck(*options, streams); }};
 }

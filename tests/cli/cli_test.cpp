@@ -178,3 +178,15 @@ TEST_CASE("usage: no subcommand and --version", "[cli]") {
   CHECK(v.exit_code == 0);
   CHECK_THAT(v.out, Catch::Contains("tubeplan"));
 }
+
+TEST_CASE("check: trajectories are checked by their .csv extension", "[cli]") {
+  const std::string good = SourcePath("tests/data/trajectories/good.csv");
+  const Outcome r = RunTool({"check", good});
+  CHECK(r.exit_code == 0);
+  // 3 samples 4 ms apart: 0.008 s at a mean rate of 250 Hz.
+  CHECK_THAT(r.out, Catch::Contains("3 samples over 0.008 s (mean rate 250 Hz"));
+  const Outcome missing = RunTool({"check", "no/such.csv"});
+  CHECK(missing.exit_code == 2);
+  CHECK(missing.err ==
+        "no/such.csv: error: cannot read file, expected a readable CSV trajectory\n");
+}
