@@ -1,0 +1,37 @@
+#pragma once
+// The friction law of one principal contact (physics.md, "Contact force", steps 3-4): the load-
+// dependent limit of static friction and the stick/slip decision with a return mapping. Part of
+// the core: no I/O, no allocation, never NaN for finite inputs.
+
+#include <Eigen/Core>
+
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::core {
+
+/// f_max = coefficient * N0 * (N / N0)^beta [N] for a normal load normal_N >= 0 [N]. Zero for
+/// N <= 0 (a contact that does not press holds nothing); exactly coefficient * N when beta = 1.
+/// For beta < 1 the limit has an infinite slope at N = 0 but its value tends to 0: no special
+/// case is needed beyond N <= 0, and denormal loads give denormal limits, never NaN.
+double FrictionLimit(const scene::Friction& friction, double coefficient, double normal_N);
+
+struct FrictionResult {
+  Eigen::Vector3d force_N = Eigen::Vector3d::Zero();  ///< friction force on the tube [N]
+  /// How far the stuck point must move along the contact plane so that the spring that produced
+  /// the trial force carries exactly the kinetic limit [m]; zero when stuck.
+  Eigen::Vector3d slip_m = Eigen::Vector3d::Zero();
+  bool sliding = false;
+};
+
+/// Stick first, then slide (return mapping). `trial_force_N` is the tangential force the contact
+/// would carry if the contact point stayed stuck, produced by a tangential spring of stiffness
+/// `tangential_stiffness_N_per_m` (> 0) stretched by trial_force / stiffness. If
+/// |trial| <= f_max(mu_s) the point sticks and the friction is the trial force. Otherwise it
+/// slides: the friction is the kinetic limit f_max(mu_k) along the trial force, and the point
+/// slips by (|trial| - f_k) / stiffness along it, after which the spring carries exactly f_k.
+/// Either way |force| <= f_max(mu_s). A frictionless contact returns zero force and full slip
+/// without evaluating the law (no friction work without friction).
+FrictionResult ReturnMap(const scene::Friction& friction, const Eigen::Vector3d& trial_force_N,
+                         double normal_N, double tangential_stiffness_N_per_m);
+
+}  // namespace tubeplan::core
