@@ -14,6 +14,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <tubeplan/core/coupling.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
@@ -579,6 +580,23 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
     ReadDevice(r, d, s.device);
   if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
     ReadModel(r, m, s.model);
+  // The coupling a scene asks for must be passive on its device at its step (physics.md): an
+  // active coupling makes the device oscillate in the operator's hand.
+  if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsMap()) {
+    const YAML::Node coupling = r.Get(d, "coupling", "device", false);
+    const core::Coupling c = core::ResolveCoupling(s.device, s.model.time_step_s);
+    if (coupling.IsDefined() && c.stiffness_N_per_m > 0.0 &&
+        !core::IsPassive(s.device.damping_Ns_per_m, c, s.model.time_step_s)) {
+      std::ostringstream m;
+      m << "device.coupling (" << c.stiffness_N_per_m << " N/m, " << c.damping_Ns_per_m
+        << " N s/m) is not passive at a " << s.model.time_step_s * 1e3
+        << " ms step: the device's damping " << s.device.damping_Ns_per_m
+        << " N s/m must exceed K T / 2 + |B| = "
+        << c.stiffness_N_per_m * s.model.time_step_s / 2.0 + std::abs(c.damping_Ns_per_m)
+        << " N s/m, expected a softer spring or less coupling damping";
+      r.Error(coupling, m.str());
+    }
+  }
   if (const YAML::Node ws = r.Get(root, "workspace", "scene", false); ws.IsDefined()) {
     if (r.ExpectMap(ws, "workspace", {"min", "max"})) {
       const YAML::Node lo = r.Get(ws, "min", "workspace", true);

@@ -184,6 +184,12 @@ TEST_CASE("Broken scenes get exactly the right diagnostics", "[scene]") {
        kMinimal + "device: {max_stiffness: 800 N/m, coupling: {stiffness: 1 kN/m}}\n",
        "t.yaml:12:56: error: device.coupling.stiffness (1000 N/m) exceeds device.max_stiffness "
        "(800 N/m), expected at most the device's limit\n"},
+      {"coupling that is not passive",
+       kMinimal +
+           "device: {damping: 1 N s/m, coupling: {stiffness: 500 N/m, damping: 0.9 N s/m}}\n",
+       "t.yaml:12:38: error: device.coupling (500 N/m, 0.9 N s/m) is not passive at a 1 ms step: "
+       "the device's damping 1 N s/m must exceed K T / 2 + |B| = 1.15 N s/m, expected a softer "
+       "spring or less coupling damping\n"},
       {"unknown model", kMinimal + "model: {beam: timoshenko}\n",
        "t.yaml:12:15: error: model.beam 'timoshenko' is not known (expected one of: linear, "
        "elastica)\n"},
