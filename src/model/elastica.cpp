@@ -41,7 +41,7 @@ namespace {
 constexpr double kHalfPi = 1.5707963267948966;
 // Euler's load pi^2/4 of the cantilever.
 constexpr double kEulerAlpha = 2.4674011002723395;
-constexpr double kMaxAlpha = 1e4;
+constexpr double kMaxAlpha = kMaxElasticaAlpha;
 // Below this the perturbation series (order kSeriesOrder) replaces the elliptic solution. Both
 // agree to the elliptic forms' rounding (<= 1e-14) for 1e-5 <= alpha <= 3e-3 over all psi; the
 // truncation error ~(alpha / 2.5)^6 of the series grows past that above ~3e-3.

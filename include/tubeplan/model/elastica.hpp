@@ -30,22 +30,25 @@ struct ElasticaTip {
 
 /// Everything needed to evaluate the solved shape anywhere; plain data, no heap.
 struct ElasticaSolution {
-  double alpha = 0.0;           ///< load parameter, >= 0
-  double psi_rad = 0.0;         ///< load direction, in [-pi/2, pi/2]
+  double alpha = 0.0;    ///< load parameter, >= 0
+  double psi_rad = 0.0;  ///< load direction, in [-pi/2, pi/2]
   ElasticaTip tip;
   // Solver internals a shape evaluation needs (meaning documented in elastica.cpp).
-  double modulus_k = 0.0;       ///< elliptic modulus k = sin(A/2) of the pendulum amplitude A
-  double modulus_kc = 1.0;      ///< complementary modulus k' = cos(A/2), kept separately for k -> 1
-  double u0 = 0.0;              ///< amplitude-parameter at the root
-  int iterations = 0;           ///< root-finding iterations used
-  bool series = false;          ///< true when the small-alpha series produced the answer
+  double modulus_k = 0.0;   ///< elliptic modulus k = sin(A/2) of the pendulum amplitude A
+  double modulus_kc = 1.0;  ///< complementary modulus k' = cos(A/2), kept separately for k -> 1
+  double u0 = 0.0;          ///< amplitude-parameter at the root
+  int iterations = 0;       ///< root-finding iterations used
+  bool series = false;      ///< true when the small-alpha series produced the answer
 };
 
-/// Solves the elastica for alpha in [0, 1e4] and psi in [-pi/2, pi/2]. Never returns NaN or Inf;
-/// throws std::invalid_argument for arguments outside those ranges or not finite.
-/// psi = +-std::numbers::pi / 2 (the double nearest pi/2) is exactly axial: tension is straight,
-/// and compression is straight up to and including alpha = std::numbers::pi^2 / 4 (the double
-/// nearest Euler's load), buckled towards +x above it.
+/// The largest load parameter SolveElastica accepts.
+inline constexpr double kMaxElasticaAlpha = 1e4;
+
+/// Solves the elastica for alpha in [0, kMaxElasticaAlpha = 1e4] and psi in [-pi/2, pi/2]. Never
+/// returns NaN or Inf; throws std::invalid_argument for arguments outside those ranges or not
+/// finite. psi = +-std::numbers::pi / 2 (the double nearest pi/2) is exactly axial: tension is
+/// straight, and compression is straight up to and including alpha = std::numbers::pi^2 / 4 (the
+/// double nearest Euler's load), buckled towards +x above it.
 ElasticaSolution SolveElastica(double alpha, double psi_rad);
 
 /// Centreline of the solved shape at the arc positions s (each in [0, 1]): out[i] = (x, z) / l and
