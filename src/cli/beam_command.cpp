@@ -9,6 +9,7 @@
 
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/model/elastica.hpp>
 #include <tubeplan/model/tip_response.hpp>
 
 #include "commands.hpp"
@@ -78,9 +79,9 @@ int RunBeam(const BeamOptions& o, Streams io) {
       errors.push_back(error);
     }
   }
-  if (o.scene_path.empty() && (o.outer_radius.empty() || o.inner_radius.empty() ||
-                               o.length.empty() || o.youngs_modulus.empty() ||
-                               o.poisson_ratio.empty())) {
+  if (o.scene_path.empty() &&
+      (o.outer_radius.empty() || o.inner_radius.empty() || o.length.empty() ||
+       o.youngs_modulus.empty() || o.poisson_ratio.empty())) {
     errors.push_back(
         "the tube: give --scene FILE, or all of --outer-radius --inner-radius --length "
         "--youngs-modulus --poisson-ratio");
@@ -94,10 +95,29 @@ int RunBeam(const BeamOptions& o, Streams io) {
   }
 
   const model::TubeSection section = model::ComputeSection(spec);
+  // Loads the models cannot answer are bad input, not internal errors: say which limit.
+  const double alpha = model::LoadParameter(spec, f_tip_O_N.norm());
+  if (beam_model == model::BeamModel::kElastica && !(alpha <= model::kMaxElasticaAlpha)) {
+    io.err << "tubeplan beam: error: --tip-force: the load parameter alpha = F l^2 / (E I) = "
+           << alpha << " is beyond the elastica's range (at most " << model::kMaxElasticaAlpha
+           << "), expected a smaller force or a stiffer tube\n";
+    return kExitBadInput;
+  }
   const model::TipLoadResponse r = model::TipResponse(beam_model, spec, f_tip_O_N);
   std::vector<Eigen::Vector3d> displacements;
-  for (const Eigen::Vector3d& p : points)
+  bool finite = std::isfinite(r.alpha) && r.tip_displacement_O_m.allFinite() &&
+                std::isfinite(r.tip_angle_rad) && std::isfinite(r.energy_J) &&
+                std::isfinite(r.root_strain);
+  for (const Eigen::Vector3d& p : points) {
     displacements.push_back(model::PointDisplacement(beam_model, spec, f_tip_O_N, p));
+    finite = finite && displacements.back().allFinite();
+  }
+  if (!finite) {
+    io.err << "tubeplan beam: error: --tip-force: the results overflow a double for this load "
+              "(alpha = "
+           << alpha << "), expected a smaller force\n";
+    return kExitBadInput;
+  }
 
   if (o.json) {
     nlohmann::json doc;
@@ -142,8 +162,8 @@ int RunBeam(const BeamOptions& o, Streams io) {
   out << "alpha:           " << r.alpha << "  (F l^2 / EI)\n";
   out << "tip deflection:  " << r.tip_deflection_m << " m\n";
   out << "tip shortening:  " << r.tip_shortening_m << " m\n";
-  out << "tip angle:       " << r.tip_angle_rad << " rad (" << r.tip_angle_rad * 180.0 / std::numbers::pi
-      << " deg)\n";
+  out << "tip angle:       " << r.tip_angle_rad << " rad ("
+      << r.tip_angle_rad * 180.0 / std::numbers::pi << " deg)\n";
   out << "bending energy:  " << r.energy_J << " J\n";
   out << "root strain:     " << r.root_strain << "\n";
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -160,8 +180,9 @@ int RunBeam(const BeamOptions& o, Streams io) {
 Command AddBeamCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<BeamOptions>();
   CLI::App* sub = app.add_subcommand(
-      "beam", "Bending of the tube under a tip load: tip deflection, shortening, angle, energy, "
-              "root strain, and the displacement of material points.");
+      "beam",
+      "Bending of the tube under a tip load: tip deflection, shortening, angle, energy, "
+      "root strain, and the displacement of material points.");
   // No CLI::ExistingFile check: the loader reports a missing file as "file: error: ..." like
   // every other file problem.
   sub->add_option("--scene", options->scene_path, "take the tube (and model) from a scene file");
@@ -173,8 +194,8 @@ Command AddBeamCommand(CLI::App& app, Streams streams) {
   sub->add_option("--tip-force", options->tip_force,
                   "FX[,FY[,FZ]] in the tube frame (z along the axis), N or with a unit")
       ->capture_default_str();
-  const std::map<std::string, model::BeamModel> models = {{"linear", model::BeamModel::kLinear},
-                                                          {"elastica", model::BeamModel::kElastica}};
+  const std::map<std::string, model::BeamModel> models = {
+      {"linear", model::BeamModel::kLinear}, {"elastica", model::BeamModel::kElastica}};
   sub->add_option("--model", options->model, "linear (the paper's) or elastica (large deflection)")
       ->transform(CLI::CheckedTransformer(models, CLI::ignore_case));
   sub->add_option("--at", options->at,

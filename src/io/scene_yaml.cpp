@@ -527,10 +527,15 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
       for (const std::string& problem : model::ValidateTubeSpec(spec)) {
         const std::string key = problem.substr(0, problem.find(' '));
-        if (read.count(key) == 0) continue;
-        // r2 >= r1 is only meaningful when r1 itself was read.
-        if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
-        r.Error(r.Get(t, key, w, false), "tube." + problem);
+        const YAML::Node at = r.Get(t, key, w, false);
+        if (at.IsDefined()) {
+          if (read.count(key) == 0) continue;
+          // r2 >= r1 is only meaningful when r1 itself was read.
+          if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
+          r.Error(at, "tube." + problem);
+        } else if (read.size() == 5) {
+          r.Error(t, "tube " + problem);  // about the section as a whole
+        }
       }
     }
   }

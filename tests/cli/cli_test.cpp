@@ -118,6 +118,23 @@ TEST_CASE("beam: bad input is exit code 2 with a message naming the problem", "[
     CHECK(r.exit_code == 2);
     CHECK_THAT(r.err, Catch::Contains("timoshenko"));
   }
+  SECTION("a load beyond the elastica's range") {
+    // alpha = 1e6 * 0.09 / 6.59 ~ 1.4e4 > 1e4.
+    const Outcome r = RunTool(Beam({"--tip-force", "1e6", "--model", "elastica"}));
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("beyond the elastica's range"));
+  }
+  SECTION("a load whose results overflow") {
+    const Outcome r = RunTool(Beam({"--tip-force", "1e300"}));
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("overflow"));
+  }
+  SECTION("a tube whose section underflows") {
+    const Outcome r = RunTool({"beam", "--outer-radius", "1e-90", "--inner-radius", "0", "--length",
+                               "1", "--youngs-modulus", "1e-100", "--poisson-ratio", "0.3"});
+    CHECK(r.exit_code == 2);
+    CHECK_THAT(r.err, Catch::Contains("bending stiffness"));
+  }
   SECTION("a scene file that does not exist") {
     const Outcome r = RunTool({"beam", "--scene", "no/such/scene.yaml"});
     CHECK(r.exit_code == 2);
