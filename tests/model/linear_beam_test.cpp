@@ -702,8 +702,8 @@ TEST_CASE("ValidateTubeSpec names each problem in plain text", "[linear]") {
         Messages{"poisson_ratio (nan) must be in [0, 0.5]"});
 
   // Every field in range, the product not: I = pi r1^4 / 4 underflows to 0 for r1 = 1e-90 m;
-  // E I overflows for E = 1e300 Pa with a 1 m radius.
-  for (const TubeSpec& spec : {Tube(1e-90, 0.0, 1.0, 3e6, 0.3), Tube(1.0, 0.0, 1.0, 1e300, 0.3)}) {
+  // E I overflows for E = 1e300 Pa with a 1 km radius.
+  for (const TubeSpec& spec : {Tube(1e-90, 0.0, 1.0, 3e6, 0.3), Tube(1e3, 0.0, 1.0, 1e300, 0.3)}) {
     const Messages problems = ValidateTubeSpec(spec);
     REQUIRE(problems.size() == 1);
     CHECK(problems[0].rfind("section: the bending stiffness E I", 0) == 0);
