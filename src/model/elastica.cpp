@@ -32,6 +32,7 @@
 #include <boost/math/special_functions/ellint_rf.hpp>
 
 #include <tubeplan/model/elastica.hpp>
+#include <tubeplan/model/gauss_legendre.hpp>
 
 namespace tubeplan::model {
 namespace {
@@ -305,7 +306,6 @@ Jacobi JacobiFunctions(double z, double k, double kc) {
 // alpha <= kQuadratureMaxAlpha: 8 points already reach rounding level there, 6 lose 1e-11 at
 // alpha = 0.4 (measured); 10 leave a margin.
 constexpr int kGaussPoints = 10;
-static_assert(kGaussPoints % 2 == 0, "the rule is built in symmetric pairs");
 
 struct GaussRule {
   std::array<double, kGaussPoints> node{};
@@ -314,30 +314,12 @@ struct GaussRule {
 
 const GaussRule& Gauss() {
   static const GaussRule rule = [] {
+    // Mapped from [-1, 1] to [0, 1]: nodes (1 + x) / 2, weights halved.
+    const auto legendre = MakeGaussLegendreRule<kGaussPoints>();
     GaussRule r;
-    constexpr int n = kGaussPoints;
-    for (int i = 0; i < n / 2; ++i) {
-      // Newton on the Legendre polynomial P_n from the usual asymptotic start.
-      double x = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5));
-      double derivative = 1.0;
-      for (int iteration = 0; iteration < 50; ++iteration) {
-        double p_prev = 1.0;
-        double p = x;
-        for (int j = 2; j <= n; ++j) {
-          const double p_next = ((2.0 * j - 1.0) * x * p - (j - 1.0) * p_prev) / j;
-          p_prev = p;
-          p = p_next;
-        }
-        derivative = n * (x * p - p_prev) / (x * x - 1.0);
-        const double dx = p / derivative;
-        x -= dx;
-        if (std::abs(dx) < 1e-16) break;
-      }
-      const double w = 1.0 / ((1.0 - x * x) * derivative * derivative);  // half of 2/(...)
-      r.node[i] = 0.5 * (1.0 - x);
-      r.weight[i] = w;
-      r.node[n - 1 - i] = 0.5 * (1.0 + x);
-      r.weight[n - 1 - i] = w;
+    for (std::size_t i = 0; i < kGaussPoints; ++i) {
+      r.node[i] = 0.5 * (1.0 + legendre.nodes[i]);
+      r.weight[i] = 0.5 * legendre.weights[i];
     }
     return r;
   }();

@@ -21,6 +21,7 @@
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
+#include <tubeplan/model/gauss_legendre.hpp>
 #include <tubeplan/model/linear_beam.hpp>
 #include <tubeplan/model/tube.hpp>
 
@@ -183,36 +184,6 @@ std::vector<Eigen::Vector3d> InteriorPoints(const TubeSpec& spec, int count, uns
   return points;
 }
 
-// Gauss-Legendre nodes and weights on [-1, 1], by Newton's method on P_n.
-struct GaussLegendre {
-  std::vector<double> nodes;
-  std::vector<double> weights;
-};
-
-GaussLegendre MakeGaussLegendre(int n) {
-  GaussLegendre rule;
-  for (int i = 1; i <= n; ++i) {
-    double t = std::cos(kPi * (i - 0.25) / (n + 0.5));
-    double derivative = 1.0;
-    for (int iteration = 0; iteration < 100; ++iteration) {
-      double p_previous = 1.0;
-      double p_current = t;
-      for (int k = 1; k < n; ++k) {
-        const double p_next = ((2.0 * k + 1.0) * t * p_current - k * p_previous) / (k + 1.0);
-        p_previous = p_current;
-        p_current = p_next;
-      }
-      derivative = n * (t * p_current - p_previous) / (t * t - 1.0);
-      const double correction = p_current / derivative;
-      t -= correction;
-      if (std::abs(correction) < 1e-16) break;
-    }
-    rule.nodes.push_back(t);
-    rule.weights.push_back(2.0 / ((1.0 - t * t) * derivative * derivative));
-  }
-  return rule;
-}
-
 // Integral of f over the annular section r2 <= rho <= r1 at height z, in polar coordinates:
 // 12-point Gauss-Legendre in rho (exact for the polynomial-in-rho parts of eq. (1)'s stresses,
 // degree <= 4 with the Jacobian rho) and the uniform 32-point rule in theta (exact for
@@ -220,7 +191,7 @@ GaussLegendre MakeGaussLegendre(int n) {
 template <typename Integrand>
 auto IntegrateOverSection(const TubeSpec& spec, double z, const Integrand& f) {
   using Value = std::decay_t<decltype(f(Eigen::Vector3d()))>;
-  static const GaussLegendre rule = MakeGaussLegendre(12);
+  static const auto rule = tubeplan::model::MakeGaussLegendreRule<12>();
   constexpr int kAngles = 32;
   const double r1 = spec.outer_radius_m;
   const double r2 = spec.inner_radius_m;
