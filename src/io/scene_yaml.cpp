@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -16,6 +15,7 @@
 
 #include <tubeplan/core/coupling.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
 
@@ -642,16 +642,14 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
 }
 
 SceneLoadResult LoadSceneFile(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  if (in) text << in.rdbuf();
-  if (!in || std::filesystem::is_directory(path)) {
+  const std::optional<std::string> text = ReadTextFile(path);
+  if (!text) {
     SceneLoadResult result;
     result.diagnostics.Error(path.string(), 0, 0,
                              "cannot read file, expected a readable YAML scene file");
     return result;
   }
-  return LoadSceneText(text.str(), path.string());
+  return LoadSceneText(*text, path.string());
 }
 
 }  // namespace tubeplan::io

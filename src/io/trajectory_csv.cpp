@@ -1,9 +1,9 @@
 #include <array>
 #include <charconv>
 #include <cmath>
-#include <fstream>
 #include <sstream>
 
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/io/units.hpp>
 
@@ -258,16 +258,14 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
 
 TrajectoryLoadResult LoadTrajectoryFile(const std::filesystem::path& path,
                                         const TrajectoryLoadOptions& options) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  if (in) text << in.rdbuf();
-  if (!in || std::filesystem::is_directory(path)) {
+  const std::optional<std::string> text = ReadTextFile(path);
+  if (!text) {
     TrajectoryLoadResult result;
     result.diagnostics.Error(path.string(), 0, 0,
                              "cannot read file, expected a readable CSV trajectory");
     return result;
   }
-  return LoadTrajectoryText(text.str(), path.string(), options);
+  return LoadTrajectoryText(*text, path.string(), options);
 }
 
 }  // namespace tubeplan::io

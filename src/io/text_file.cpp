@@ -1,0 +1,49 @@
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <system_error>
+#include <unistd.h>
+
+#include <tubeplan/io/text_file.hpp>
+
+namespace tubeplan::io {
+
+std::optional<std::string> ReadTextFile(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return std::nullopt;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::ostringstream text;
+  text << in.rdbuf();  // an empty file sets failbit on `text`, which is fine: it is ""
+  if (in.bad()) return std::nullopt;
+  return text.str();
+}
+
+std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text) {
+  // Same directory, so the rename is atomic (same file system); the pid keeps two concurrent
+  // writers of one path from sharing a temporary file.
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    if (!out) return "cannot create " + temporary.string() + ": " + std::strerror(errno);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.flush();
+    if (!out) {
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      return "cannot write " + temporary.string() + ": " + std::strerror(errno);
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    return "cannot rename " + temporary.string() + " to " + path.string() + ": " + ec.message();
+  }
+  return {};
+}
+
+}  // namespace tubeplan::io
