@@ -1,8 +1,8 @@
-#include <tubeplan/io/diagnostics.hpp>
-
 #include <algorithm>
 #include <tuple>
 #include <utility>
+
+#include <tubeplan/io/diagnostics.hpp>
 
 namespace tubeplan::io {
 
