@@ -1,0 +1,143 @@
+#pragma once
+// The one force-and-deformation core (architecture.md): a fixed-step function from the pose of
+// the operator's hand to the wrench the operator feels, the tube's state and its contact
+// formation. Everything that moves the tube goes through Core::Step: replay, graph exploration,
+// live haptics, the studies and the benchmarks. No I/O, no heap allocation per tick after
+// construction, never NaN or Inf in what it returns.
+//
+// Model, in the order of one tick (docs/core.md has the derivations and every choice):
+//  1. The held end H is a proxy coupled to the hand by the scene's spring K_c and damper B. Its
+//     orientation is the hand's (the rotational coupling is rigid); its position is where the
+//     coupling force balances the contact forces on the massless tube.
+//  2. The deformed tube is a chain of FCL capsules along its centreline, ending in an FCL
+//     cylinder so that the free end has a flat end face and a rim; parts are FCL boxes. A broad
+//     phase in each box's frame passes only the pairs that can be closer than epsilon to FCL's
+//     GJK, which gives the distance, the nearest points and so the normal.
+//  3. Each pair closer than epsilon is classified into a PC (tube element, part element) and PCs
+//     of the same element pair merge into one load point on the centreline.
+//  4. Normal force K (eps - d) and a tangential spring of the same stiffness to a stuck anchor
+//     give each contact's force; the beam's compliance (the paper's segmented rule or the
+//     coupled influence coefficients), the coupling and the contacts are solved together as one
+//     small linear system (linearised in d); friction is decided per PC by the return mapping.
+//  5. The bending shape under the solved loads (linear model or elastica) gives energy, strain,
+//     markers and the next tick's capsules.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/scene/elements.hpp>
+#include <tubeplan/scene/scene.hpp>
+#include <tubeplan/states/contact_formation.hpp>
+
+namespace tubeplan::core {
+
+/// Most load points (merged PCs) the core resolves at once; further PCs, the shallowest, are
+/// dropped for that tick and flagged kContactsTruncated.
+inline constexpr int kMaxContacts = 6;
+/// Most capsules in the tube's chain (the count is chosen per scene, see ChainCapsuleCount).
+inline constexpr int kMaxCapsules = 48;
+
+/// Bits of StepOutput::flags.
+enum StepFlag : std::uint32_t {
+  kForceClamped = 1u << 0,       ///< the coupling force reached the device's maximum
+  kPenetration = 1u << 1,        ///< a tube and a part overlap (d <= 0)
+  kProxySeparated = 1u << 2,     ///< the held end is more than epsilon from the hand
+  kContactsTruncated = 1u << 3,  ///< more than kMaxContacts PCs; the shallowest were dropped
+  kLinearFallback = 1u << 4,     ///< elastica asked for, but the loading is not one it covers
+  kSolverFault = 1u << 5,        ///< the tick's system was singular or not finite: held still
+};
+
+/// One principal contact in a tick, in the core's compact form.
+struct ContactState {
+  states::TubeElement tube = states::TubeElement::kSide;
+  states::Marker marker = states::Marker::kNone;
+  int part_element = -1;  ///< index into Core::elements()
+  double s_m = 0.0;       ///< arc position of the load point on the centreline [m]
+  double distance_m = 0.0;  ///< smallest distance d between the two elements [m]
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< unit, from the part into the tube
+  Eigen::Vector3d p_WC_m = Eigen::Vector3d::Zero();     ///< load point (centreline) in W [m]
+  Eigen::Vector3d anchor_W_m = Eigen::Vector3d::Zero(); ///< where the stuck load point is held
+  double normal_force_N = 0.0;                          ///< >= 0
+  Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< tangential force on the tube
+  Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();     ///< total force on the tube
+  double friction_limit_N = 0.0;  ///< f_max = mu_s N0 (N/N0)^beta at this normal force
+  bool sliding = false;
+};
+
+/// What one tick returns. Plain data; valid until the next Step.
+struct StepOutput {
+  double t_s = 0.0;
+  Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();  ///< hand pose given
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();      ///< held end (proxy)
+  Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();    ///< on the operator, at the held end
+  Eigen::Vector3d torque_W_Nm = Eigen::Vector3d::Zero();  ///< on the operator, about H
+  std::array<ContactState, kMaxContacts> contacts{};      ///< sorted by (tube, part element)
+  int contact_count = 0;
+  double energy_J = 0.0;     ///< bending energy
+  double max_strain = 0.0;   ///< largest bending strain (outer fibre at a clamp) [-]
+  double tip_deflection_m = 0.0;  ///< lateral deflection of the free end from the straight tube
+  std::uint32_t flags = 0;   ///< StepFlag bits
+  std::span<const ContactState> Contacts() const {
+    return {contacts.data(), static_cast<std::size_t>(contact_count)};
+  }
+};
+
+/// Capsule count of the chain: the chord of a segment of length l/N on an arc of curvature
+/// kappa lies inside the arc by kappa (l/N)^2 / 8; the largest curvature the core can produce is
+/// at the root under the device's largest force, kappa = F_max l / (E I). N is the smallest count
+/// that keeps that error below epsilon / 10, clamped to [8, kMaxCapsules].
+int ChainCapsuleCount(const scene::Scene& scene);
+
+class Core {
+ public:
+  /// Set-up (allocates): elements, reachable parts, FCL shapes, the coupling. The scene must be
+  /// valid (the loader checks it); the held end starts at scene.X_WH_start with the hand there.
+  explicit Core(const scene::Scene& scene);
+  ~Core();
+  Core(const Core&) = delete;
+  Core& operator=(const Core&) = delete;
+
+  /// Starts over at the held-end pose X_WH: no contacts, no anchors, hand at the same pose.
+  void Reset(const Eigen::Isometry3d& X_WH);
+
+  /// One tick of scene.model.time_step at time t_s with the hand at X_W_hand. No allocation.
+  const StepOutput& Step(double t_s, const Eigen::Isometry3d& X_W_hand);
+
+  /// The deformed centreline at `count` points equally spaced in arc length, in W. Computed only
+  /// when asked (the "shape only when a consumer asks" rule); no allocation.
+  void Centreline(std::span<Eigen::Vector3d> p_W_m) const;
+
+  /// The contact formation of the last tick (cold path: allocates its strings).
+  states::ContactFormation Formation() const;
+  std::string FormationText() const;
+
+  const StepOutput& last() const { return out_; }
+  const scene::Scene& scene() const { return scene_; }
+  /// The elements the tube can reach (unreachable parts and elements are left out).
+  const std::vector<scene::PartElement>& elements() const { return elements_; }
+  const std::vector<std::uint32_t>& reachable_parts() const { return reachable_parts_; }
+  int capsule_count() const { return capsule_count_; }
+  double coupling_stiffness_N_per_m() const { return coupling_stiffness_; }
+  double coupling_damping_Ns_per_m() const { return coupling_damping_; }
+
+  struct Impl;  // collision and beam internals (src/core)
+
+ private:
+  scene::Scene scene_;
+  std::vector<scene::PartElement> elements_;
+  std::vector<std::uint32_t> reachable_parts_;
+  int capsule_count_ = 0;
+  double coupling_stiffness_ = 0.0;
+  double coupling_damping_ = 0.0;
+  std::unique_ptr<Impl> impl_;
+  StepOutput out_;
+};
+
+}  // namespace tubeplan::core

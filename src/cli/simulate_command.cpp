@@ -1,0 +1,196 @@
+// `tubeplan simulate SCENE TRAJECTORY [--out FILE] [--json] [--mesh]`: runs the core over a
+// recorded hand trajectory (resampled onto the core's step) and reports what happened. The
+// per-tick series (columns in docs/simulate-output.md) goes to --out, CSV or JSON Lines by the
+// file's extension, written to a temporary file and renamed.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+
+#include "commands.hpp"
+#include "series_format.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+struct SimulateOptions {
+  std::string scene_path;
+  std::string trajectory_path;
+  std::string out_path;
+  bool json = false;
+  bool mesh = false;
+};
+
+struct Visit {
+  double t_s = 0.0;
+  std::string cf;
+};
+
+int RunSimulate(const SimulateOptions& o, Streams io) {
+  io::SceneLoadResult scene = io::LoadSceneFile(o.scene_path);
+  io::TrajectoryLoadResult trajectory = io::LoadTrajectoryFile(o.trajectory_path);
+  io.err << scene.diagnostics.FormatAll() << trajectory.diagnostics.FormatAll();
+  SeriesFormat format = SeriesFormat::kNone;
+  if (!o.out_path.empty()) {
+    const std::string ext = std::filesystem::path(o.out_path).extension().string();
+    if (ext == ".csv") {
+      format = SeriesFormat::kCsv;
+    } else if (ext == ".jsonl") {
+      format = SeriesFormat::kJsonLines;
+    } else {
+      io.err << o.out_path << ": error: unknown output format \"" << ext
+             << "\", and expected a file name ending in .csv or .jsonl\n";
+      return kExitBadInput;
+    }
+  }
+  if (!scene.scene || !trajectory.trajectory) return kExitBadInput;
+
+  const scene::Scene& s = *scene.scene;
+  const std::vector<plan::HandSample> ticks =
+      plan::Resample(*trajectory.trajectory, s.model.time_step_s);
+  core::Core core(s);
+  const plan::HandSample& first = ticks.front();
+  Eigen::Isometry3d X_W_hand0 = Eigen::Isometry3d::Identity();
+  X_W_hand0.linear() = first.q_WH.toRotationMatrix();
+  X_W_hand0.translation() = first.p_WH_m;
+  // The core starts with the held end at the hand's first pose. A trajectory that starts away
+  // from the scene's start is allowed (a plan may begin mid-task) but said.
+  const double start_offset_m = (first.p_WH_m - s.X_WH_start.translation()).norm();
+  const double start_turn_rad =
+      Eigen::AngleAxisd(s.X_WH_start.linear().transpose() * X_W_hand0.linear()).angle();
+  if (start_offset_m > 1e-3 || start_turn_rad > 1e-2) {
+    io.err << o.trajectory_path << ": warning: the trajectory starts " << start_offset_m * 1e3
+           << " mm and " << start_turn_rad * 180.0 / M_PI
+           << " deg away from the scene's start pose; the held end starts at the trajectory's\n";
+  }
+  core.Reset(X_W_hand0);
+
+  SeriesWriter writer(format, o.mesh);
+  std::vector<Visit> visits;
+  std::string cf_text;
+  double peak_force_N = 0.0, peak_force_t = 0.0, peak_strain = 0.0, peak_strain_t = 0.0;
+  double peak_energy_J = 0.0, peak_torque_Nm = 0.0;
+  std::array<long, 6> flag_ticks{};
+  double core_s = 0.0, worst_tick_s = 0.0;
+  for (const plan::HandSample& sample : ticks) {
+    Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
+    X_W_hand.linear() = sample.q_WH.toRotationMatrix();
+    X_W_hand.translation() = sample.p_WH_m;
+    const auto start = std::chrono::steady_clock::now();
+    const core::StepOutput& out = core.Step(sample.t_s, X_W_hand);
+    const double tick_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    core_s += tick_s;
+    worst_tick_s = std::max(worst_tick_s, tick_s);
+    cf_text = core.FormationText();
+    if (visits.empty() || visits.back().cf != cf_text) visits.push_back({sample.t_s, cf_text});
+    const double force_N = out.force_W_N.norm();
+    if (force_N > peak_force_N) peak_force_N = force_N, peak_force_t = sample.t_s;
+    if (out.max_strain > peak_strain) peak_strain = out.max_strain, peak_strain_t = sample.t_s;
+    peak_energy_J = std::max(peak_energy_J, out.energy_J);
+    peak_torque_Nm = std::max(peak_torque_Nm, out.torque_W_Nm.norm());
+    for (int b = 0; b < 6; ++b)
+      if (out.flags & (1u << b)) ++flag_ticks[std::size_t(b)];
+    writer.Add(core, out, cf_text);
+  }
+  if (format != SeriesFormat::kNone) {
+    const std::string error = io::WriteTextFileAtomically(o.out_path, writer.text());
+    if (!error.empty()) {
+      io.err << o.out_path << ": error: " << error << "\n";
+      return kExitBadInput;
+    }
+  }
+
+  const double duration_s = ticks.back().t_s - ticks.front().t_s;
+  if (o.json) {
+    nlohmann::json j;
+    j["scene"] = o.scene_path;
+    j["trajectory"] = o.trajectory_path;
+    j["ticks"] = ticks.size();
+    j["time_step_s"] = s.model.time_step_s;
+    j["duration_s"] = duration_s;
+    j["capsules"] = core.capsule_count();
+    nlohmann::json v = nlohmann::json::array();
+    for (const Visit& visit : visits) v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
+    j["visits"] = v;
+    j["final_cf"] = cf_text;
+    j["goal"] = states::ToString(s.goal);
+    j["goal_reached"] = cf_text == states::ToString(s.goal);
+    j["peak_force_N"] = peak_force_N;
+    j["peak_force_t"] = peak_force_t;
+    j["peak_torque_Nm"] = peak_torque_Nm;
+    j["peak_strain"] = peak_strain;
+    j["peak_strain_t"] = peak_strain_t;
+    j["peak_energy_J"] = peak_energy_J;
+    nlohmann::json flags;
+    for (int b = 0; b < 6; ++b) flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
+    j["flag_ticks"] = flags;
+    j["run_time_s"] = core_s;
+    j["mean_tick_us"] = 1e6 * core_s / static_cast<double>(ticks.size());
+    j["worst_tick_us"] = 1e6 * worst_tick_s;
+    if (!o.out_path.empty()) j["out"] = o.out_path;
+    io.out << j.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::ostringstream text;
+  text << std::setprecision(4);
+  text << o.scene_path << " + " << o.trajectory_path << ": " << ticks.size() << " ticks of "
+       << s.model.time_step_s * 1e3 << " ms (" << duration_s << " s), " << core.capsule_count()
+       << " capsules\n";
+  text << "contact formations, in order (t = entry time):\n";
+  const std::size_t shown = std::min<std::size_t>(visits.size(), 40);
+  for (std::size_t i = 0; i < shown; ++i)
+    text << "  t = " << std::setw(7) << visits[i].t_s << " s  " << visits[i].cf << "\n";
+  if (visits.size() > shown)
+    text << "  ... " << visits.size() - shown << " more changes (the series in --out has all)\n";
+  text << "final: " << cf_text << (cf_text == states::ToString(s.goal) ? " (the goal)" : "")
+       << "\n";
+  text << "peak force " << peak_force_N << " N at t = " << peak_force_t << " s; peak torque "
+       << peak_torque_Nm << " N m; peak strain " << peak_strain << " at t = " << peak_strain_t
+       << " s; peak bending energy " << peak_energy_J << " J\n";
+  text << "ticks flagged:";
+  bool any = false;
+  for (int b = 0; b < 6; ++b)
+    if (flag_ticks[std::size_t(b)] > 0) {
+      text << " " << FlagName(1u << b) << " " << flag_ticks[std::size_t(b)];
+      any = true;
+    }
+  text << (any ? "" : " none") << "\n";
+  text << "core run time " << core_s * 1e3 << " ms: mean "
+       << 1e6 * core_s / static_cast<double>(ticks.size()) << " us per tick, worst "
+       << 1e6 * worst_tick_s << " us\n";
+  if (!o.out_path.empty()) text << "series written to " << o.out_path << "\n";
+  io.out << text.str();
+  return kExitOk;
+}
+
+}  // namespace
+
+Command AddSimulateCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<SimulateOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "simulate",
+      "Run the core over a recorded hand trajectory: prints the contact formations visited, "
+      "peaks and timing; --out writes the per-tick series (.csv or .jsonl).");
+  sub->add_option("scene", options->scene_path, "scene file (.yaml)")->required();
+  sub->add_option("trajectory", options->trajectory_path, "hand trajectory (.csv)")->required();
+  sub->add_option("--out", options->out_path,
+                  "write the per-tick series to FILE (.csv or .jsonl; see docs/simulate-output.md)");
+  sub->add_flag("--json", options->json, "print the summary as one JSON document");
+  sub->add_flag("--mesh", options->mesh,
+                "add the deformed centreline (21 points) to every tick of the series");
+  return {sub, [options, streams] { return RunSimulate(*options, streams); }};
+}
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,202 @@
+#include "beam_chain.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tubeplan/model/tube.hpp>
+
+namespace tubeplan::core {
+namespace {
+
+// The elastica's tip, in the segment's clamp frame, for a load with lateral part fx >= 0 along
+// the bending direction and axial part fz.
+Eigen::Vector2d ElasticaTipXZ(double fx, double fz, double length_m, double EI) {
+  const double f = std::hypot(fx, fz);
+  const double alpha = f * length_m * length_m / EI;
+  const double psi = f > 0.0 ? std::atan2(fz, fx) : 0.0;
+  const model::ElasticaSolution solution = model::SolveElastica(alpha, psi);
+  return {length_m * solution.tip.deflection, length_m * (1.0 - solution.tip.shortening)};
+}
+
+}  // namespace
+
+BeamChain::BeamChain(const scene::Scene& scene)
+    : EI_(model::ComputeSection(scene.tube).bending_stiffness_Nm2),
+      length_m_(scene.tube.length_m),
+      r1_(scene.tube.outer_radius_m),
+      // Loads closer than a tube radius act on the same cross-section as far as the tube's
+      // bending can tell: they share a cut (e.g. the end face and a wall at the tip's side).
+      group_tolerance_m_(scene.tube.outer_radius_m),
+      rule_(scene.model.multi_contact) {}
+
+int BeamChain::Assign(std::array<BeamLoad, kMaxContacts>& loads, int count,
+                      std::array<int, kMaxContacts>& order) const {
+  for (int i = 0; i < count; ++i) order[std::size_t(i)] = i;
+  std::sort(order.begin(), order.begin() + count, [&](int a, int b) {
+    const double sa = loads[std::size_t(a)].s_m, sb = loads[std::size_t(b)].s_m;
+    return sa < sb || (sa == sb && a < b);
+  });
+  int group = -1;
+  double group_start_m = -1.0, group_end_m = 0.0, clamp_m = 0.0;
+  for (int k = 0; k < count; ++k) {
+    BeamLoad& load = loads[std::size_t(order[std::size_t(k)])];
+    if (group < 0 || load.s_m - group_start_m > group_tolerance_m_) {
+      ++group;
+      clamp_m = group == 0 ? 0.0 : group_end_m;
+      group_start_m = load.s_m;
+    }
+    group_end_m = load.s_m;
+    load.group = group;
+    load.clamp_m = rule_ == scene::MultiContactRule::kCoupled ? 0.0 : clamp_m;
+  }
+  return group + 1;
+}
+
+double BeamChain::Influence(double s_m, const BeamLoad& load) const {
+  const double a = s_m - load.clamp_m, b = load.s_m - load.clamp_m;
+  if (a <= 0.0 || b <= 0.0) return 0.0;
+  return a <= b ? a * a * (3.0 * b - a) / (6.0 * EI_) : b * b * (3.0 * a - b) / (6.0 * EI_);
+}
+
+double BeamChain::InfluenceSlope(double s_m, const BeamLoad& load) const {
+  const double a = s_m - load.clamp_m, b = load.s_m - load.clamp_m;
+  if (a <= 0.0 || b <= 0.0) return 0.0;
+  return a <= b ? a * (2.0 * b - a) / (2.0 * EI_) : b * b / (2.0 * EI_);
+}
+
+bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxContacts>& loads, int count,
+                               int groups) const {
+  if (rule_ == scene::MultiContactRule::kCoupled && groups > 1) return false;
+  // Each segment's resultant must be within the solver's range (and finite).
+  std::array<Eigen::Vector3d, kMaxContacts> resultant;
+  std::array<double, kMaxContacts> length;
+  resultant.fill(Eigen::Vector3d::Zero());
+  length.fill(0.0);
+  for (int i = 0; i < count; ++i) {
+    const BeamLoad& load = loads[std::size_t(i)];
+    resultant[std::size_t(load.group)] += load.f_H_N;
+    length[std::size_t(load.group)] =
+        std::max(length[std::size_t(load.group)], load.s_m - load.clamp_m);
+  }
+  for (int g = 0; g < groups; ++g) {
+    const double L = length[std::size_t(g)];
+    const double alpha = resultant[std::size_t(g)].norm() * L * L / EI_;
+    if (!(alpha <= 0.5 * model::kMaxElasticaAlpha)) return false;
+  }
+  return true;
+}
+
+int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxContacts>& loads, int count,
+                                  const std::array<int, kMaxContacts>& order,
+                                  std::array<ElasticaSegment, kMaxContacts>& segments) const {
+  int segment_count = 0;
+  Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();
+  double clamp_m = 0.0;
+  for (int k = 0; k < count;) {
+    // One group: its loads are consecutive in `order`.
+    const int group = loads[std::size_t(order[std::size_t(k)])].group;
+    Eigen::Vector3d f_H = Eigen::Vector3d::Zero();
+    double end_m = clamp_m;
+    for (; k < count && loads[std::size_t(order[std::size_t(k)])].group == group; ++k) {
+      const BeamLoad& load = loads[std::size_t(order[std::size_t(k)])];
+      f_H += load.f_H_N;
+      end_m = std::max(end_m, load.s_m);
+    }
+    ElasticaSegment& seg = segments[std::size_t(segment_count++)];
+    seg.origin_H = origin_H;
+    seg.R_HS = R_HS;
+    seg.clamp_m = clamp_m;
+    seg.length_m = end_m - clamp_m;
+    const Eigen::Vector3d f_S = R_HS.transpose() * f_H;
+    const double fx = std::hypot(f_S.x(), f_S.y());
+    // The bending direction: along the lateral load; with none (axial load), the clamp's x.
+    seg.bend_x_S = fx > 0.0 ? Eigen::Vector3d(f_S.x() / fx, f_S.y() / fx, 0.0)
+                            : Eigen::Vector3d::UnitX();
+    const double f = std::hypot(fx, f_S.z());
+    const double L = seg.length_m;
+    if (L > 0.0) {
+      seg.solution = model::SolveElastica(f * L * L / EI_, f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0);
+    } else {
+      seg.solution = model::ElasticaSolution{};
+    }
+    // Carry the clamp to the segment's tip: there the next segment starts.
+    const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(seg.bend_x_S);
+    const model::ElasticaTip& tip = seg.solution.tip;
+    origin_H += R_HS * (L * tip.deflection * seg.bend_x_S +
+                        L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
+    R_HS = R_HS * Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
+    clamp_m = end_m;
+  }
+  return segment_count;
+}
+
+Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxContacts>& segments,
+                                         int segment_count, double s_m) const {
+  for (int g = 0; g < segment_count; ++g) {
+    const ElasticaSegment& seg = segments[std::size_t(g)];
+    if (s_m > seg.clamp_m + seg.length_m && g + 1 < segment_count) continue;
+    if (s_m > seg.clamp_m + seg.length_m) break;  // beyond the last load: straight, below
+    if (!(seg.length_m > 0.0)) return seg.origin_H;
+    const double s_unit = std::clamp((s_m - seg.clamp_m) / seg.length_m, 0.0, 1.0);
+    Eigen::Vector2d xz;
+    double theta = 0.0;
+    model::ElasticaCentreline(seg.solution, std::span<const double>(&s_unit, 1),
+                              std::span<Eigen::Vector2d>(&xz, 1), std::span<double>(&theta, 1));
+    return seg.origin_H +
+           seg.R_HS * (seg.length_m * (xz.x() * seg.bend_x_S + xz.y() * Eigen::Vector3d::UnitZ()));
+  }
+  // Beyond the last segment (or no segment): straight along the last tip's tangent.
+  if (segment_count == 0) return {0.0, 0.0, s_m};
+  const ElasticaSegment& last = segments[std::size_t(segment_count - 1)];
+  const double L = last.length_m;
+  const model::ElasticaTip& tip = last.solution.tip;
+  const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(last.bend_x_S);
+  const Eigen::Vector3d tip_H =
+      last.origin_H + last.R_HS * (L * tip.deflection * last.bend_x_S +
+                                   L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d tangent_H =
+      last.R_HS * (Eigen::AngleAxisd(tip.tip_angle_rad, y_S) * Eigen::Vector3d::UnitZ());
+  return tip_H + (s_m - last.clamp_m - L) * tangent_H;
+}
+
+Eigen::Vector3d BeamChain::ElasticaTipTangent(
+    const std::array<ElasticaSegment, kMaxContacts>& segments, int segment_count) const {
+  if (segment_count == 0) return Eigen::Vector3d::UnitZ();
+  const ElasticaSegment& last = segments[std::size_t(segment_count - 1)];
+  const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(last.bend_x_S);
+  return last.R_HS *
+         (Eigen::AngleAxisd(last.solution.tip.tip_angle_rad, y_S) * Eigen::Vector3d::UnitZ());
+}
+
+Eigen::Matrix3d BeamChain::ElasticaCompliance(const ElasticaSegment& segment,
+                                              const Eigen::Vector3d& f_H_N) const {
+  const double L = segment.length_m;
+  if (!(L > 0.0)) return Eigen::Matrix3d::Zero();
+  const Eigen::Vector3d f_S = segment.R_HS.transpose() * f_H_N;
+  const Eigen::Vector3d& x_S = segment.bend_x_S;
+  const double fx = std::max(0.0, f_S.dot(x_S));
+  const double fz = f_S.z();
+  // Forward differences with a step of 1e-6 of the load scale EI / L^2 (the force at alpha = 1)
+  // plus the load itself: the elastica's ~1e-13 relative accuracy leaves ~1e-7 in the slope.
+  const double scale = EI_ / (L * L);
+  const double h = 1e-6 * (scale + std::hypot(fx, fz));
+  const Eigen::Vector2d base = ElasticaTipXZ(fx, fz, L, EI_);
+  const Eigen::Vector2d dx = (ElasticaTipXZ(fx + h, fz, L, EI_) - base) / h;
+  const Eigen::Vector2d dz = (ElasticaTipXZ(fx, fz + h, L, EI_) - base) / h;
+  // Across the bending plane the response is the in-plane one turned about the axis: a small
+  // turn phi of the load turns the deflection X by the same phi, so the compliance is X / fx.
+  const double across = fx > 1e-9 * scale ? base.x() / fx : dx.x();
+  Eigen::Matrix3d J_local;  // in the basis (bend x, bend y, z) of S
+  J_local << dx.x(), 0.0, dz.x(),  //
+      0.0, across, 0.0,            //
+      dx.y(), 0.0, dz.y();
+  Eigen::Matrix3d B;
+  B.col(0) = x_S;
+  B.col(1) = Eigen::Vector3d::UnitZ().cross(x_S);
+  B.col(2) = Eigen::Vector3d::UnitZ();
+  const Eigen::Matrix3d basis_H = segment.R_HS * B;
+  return basis_H * J_local * basis_H.transpose();
+}
+
+}  // namespace tubeplan::core

@@ -1,0 +1,174 @@
+#include "collision.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tubeplan::core {
+namespace {
+
+// Bit of BoxFace for the positive / negative side of each box axis (x, y, z).
+constexpr std::array<int, 3> kPositiveFace = {2, 4, 0};
+constexpr std::array<int, 3> kNegativeFace = {3, 5, 1};
+
+Eigen::Isometry3d SegmentPose(const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = 0.5 * (a_W + b_W);
+  const Eigen::Vector3d axis = b_W - a_W;
+  // Pieces have the tube's length over N, far from zero; FromTwoVectors handles antiparallel.
+  X.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
+  return X;
+}
+
+// A capsule's round cap reaches r1 past its end node: the capsules stop at least r1 before the
+// free end, and a flat-ended cylinder of a whole number of node intervals covers the rest.
+int EndPieceCount(const scene::Scene& scene, int capsule_count) {
+  const double piece_m = scene.tube.length_m / capsule_count;
+  return std::clamp(static_cast<int>(std::ceil(scene.tube.outer_radius_m / piece_m - 1e-9)), 1,
+                    capsule_count);
+}
+double EndCylinderLength(const scene::Scene& scene, int capsule_count) {
+  return EndPieceCount(scene, capsule_count) * scene.tube.length_m / capsule_count;
+}
+
+}  // namespace
+
+Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> parts,
+                     int capsule_count, std::vector<std::array<int, 64>> element_of)
+    : element_of_(std::move(element_of)),
+      capsule_(scene.tube.outer_radius_m, scene.tube.length_m / capsule_count),
+      end_(scene.tube.outer_radius_m, EndCylinderLength(scene, capsule_count)),
+      radius_m_(scene.tube.outer_radius_m),
+      length_m_(scene.tube.length_m),
+      piece_m_(scene.tube.length_m / capsule_count),
+      end_pieces_(EndPieceCount(scene, capsule_count)),
+      end_m_(EndCylinderLength(scene, capsule_count)),
+      threshold_m_(scene.contact.threshold_m),
+      // A part point within 1 % of epsilon of a second face plane lies on their edge: far above
+      // GJK's error (gjk_tolerance below), far below any distance that changes a force.
+      part_tolerance_m_(0.01 * scene.contact.threshold_m),
+      // The end face counts as flat on a face, or the last piece's side as flat on it, when its
+      // far side is within a tenth of epsilon of its near side.
+      tube_tolerance_m_(0.1 * scene.contact.threshold_m) {
+  // FCL's default 1e-6 leaves micrometres of error in d, i.e. 1e-2 N at K = 1e4 N/m.
+  solver_.gjk_tolerance = 1e-12;
+  solver_.gjk_max_iterations = 128;
+  for (const std::uint32_t p : parts) {
+    const scene::BoxPart& box = scene.parts[p];
+    Part part{p, fcl::Boxd(box.size_m), box.X_WP, box.X_WP.inverse(), 0.5 * box.size_m};
+    parts_.push_back(part);
+  }
+}
+
+std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) const {
+  const Eigen::Vector3d q_P = part.X_PW * q_W;
+  std::uint8_t mask = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (q_P[a] >= part.half_m[a] - part_tolerance_m_) mask |= std::uint8_t(1u << kPositiveFace[a]);
+    if (q_P[a] <= -part.half_m[a] + part_tolerance_m_) mask |= std::uint8_t(1u << kNegativeFace[a]);
+  }
+  if (mask != 0) return mask;
+  // Not on the surface (only when the shapes overlap): the face nearest to the point.
+  int best = 0;
+  for (int a = 1; a < 3; ++a)
+    if (part.half_m[a] - std::abs(q_P[a]) < part.half_m[best] - std::abs(q_P[best])) best = a;
+  return std::uint8_t(1u << (q_P[best] >= 0.0 ? kPositiveFace[best] : kNegativeFace[best]));
+}
+
+bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W,
+                                 const Eigen::Vector3d& b_W) const {
+  // The piece's bounding box in the part's frame, grown by its radius and epsilon, against the
+  // part: exact for the box's own axes, so rotated parts cull as well as aligned ones.
+  const Eigen::Vector3d a_P = part.X_PW * a_W;
+  const Eigen::Vector3d b_P = part.X_PW * b_W;
+  const double grow = radius_m_ + threshold_m_;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = std::min(a_P[k], b_P[k]) - grow;
+    const double hi = std::max(a_P[k], b_P[k]) + grow;
+    if (lo > part.half_m[k] || hi < -part.half_m[k]) return false;
+  }
+  return true;
+}
+
+void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
+                            const Eigen::Vector3d& b_W, RawContact& c) const {
+  // GJK reports overlap without a depth. The contact is taken at the piece's midpoint, pushed out
+  // through the face of the part nearest to it, at distance 0: the largest penalty force, K eps,
+  // and a defined normal. The tick is flagged kPenetration by the caller.
+  const Eigen::Vector3d m_P = part.X_PW * (0.5 * (a_W + b_W));
+  int axis = 0;
+  for (int a = 1; a < 3; ++a)
+    if (part.half_m[a] - std::abs(m_P[a]) < part.half_m[axis] - std::abs(m_P[axis])) axis = a;
+  const double side = m_P[axis] >= 0.0 ? 1.0 : -1.0;
+  Eigen::Vector3d q_P = m_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
+  q_P[axis] = side * part.half_m[axis];
+  c.q_W_m = part.X_WP * q_P;
+  c.normal_W = part.X_WP.linear() * (side * Eigen::Vector3d::Unit(axis));
+  c.distance_m = 0.0;
+  c.overlap = true;
+}
+
+int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
+                     const Eigen::Vector3d& tip_tangent_W, std::span<RawContact> out) const {
+  // Capsules 0 .. pieces - 2, then the end cylinder as piece pieces - 1.
+  const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
+  int count = 0;
+  narrow_calls_ = 0;
+  const Eigen::Vector3d tip_W = nodes_W.back();
+  const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
+  for (const Part& part : parts_) {
+    for (int k = 0; k < pieces; ++k) {
+      const bool is_end = k == pieces - 1;
+      const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
+      const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];
+      if (!PassesBroadPhase(part, a_W, b_W)) continue;
+      if (count == static_cast<int>(out.size())) return count;
+
+      const Eigen::Isometry3d X_WS = SegmentPose(a_W, b_W);
+      double d = 0.0;
+      Eigen::Vector3d p_tube_W, q_part_W;
+      ++narrow_calls_;
+      const bool separated =
+          is_end ? solver_.shapeDistance(end_, X_WS, part.box, part.X_WP, &d, &p_tube_W, &q_part_W)
+                 : solver_.shapeDistance(capsule_, X_WS, part.box, part.X_WP, &d, &p_tube_W,
+                                         &q_part_W);
+      RawContact c;
+      c.part = part.index;
+      if (separated && d >= threshold_m_) continue;
+      const Eigen::Vector3d axis_W = X_WS.linear().col(2);
+      if (separated && d > 0.0) {
+        c.distance_m = d;
+        c.q_W_m = q_part_W;
+        c.normal_W = (p_tube_W - q_part_W) / d;
+      } else {
+        Overlapping(part, a_W, b_W, c);
+        p_tube_W = c.q_W_m;
+      }
+      c.face_mask = FaceMask(part, c.q_W_m);
+      c.part_element = element_of_[part.index][c.face_mask];
+
+      // The centreline point under the contact, and which element of the tube touches.
+      const Eigen::Vector3d centre_W = X_WS.translation();
+      const double half_m = 0.5 * (is_end ? end_m_ : piece_m_);
+      const double along = std::clamp((p_tube_W - centre_W).dot(axis_W), -half_m, half_m);
+      const double s0 = is_end ? length_m_ - end_m_ : piece_m_ * k;
+      c.s_m = std::max(0.0, s0 + half_m + along);
+      c.tube = states::TubeElement::kSide;
+      if (is_end && along >= half_m - tube_tolerance_m_) {
+        const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
+        const double tilt = axis_W.cross(c.normal_W).norm();  // sin of end face to contact plane
+        const bool side_flat = std::abs(axis_W.dot(c.normal_W)) * end_m_ < tube_tolerance_m_;
+        if (radial_W.norm() < radius_m_ - tube_tolerance_m_ ||
+            (!side_flat && 2.0 * radius_m_ * tilt < tube_tolerance_m_)) {
+          c.tube = states::TubeElement::kEndFace;
+        } else if (!side_flat) {
+          c.tube = states::TubeElement::kEndRim;
+        }
+        if (c.tube != states::TubeElement::kSide) c.s_m = length_m_;
+      }
+      out[std::size_t(count++)] = c;
+    }
+  }
+  return count;
+}
+
+}  // namespace tubeplan::core

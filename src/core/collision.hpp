@@ -1,0 +1,86 @@
+#pragma once
+// Private to the core: the tube as a chain of FCL capsules ending in an FCL cylinder, the parts
+// as FCL boxes, a broad phase in each box's frame, and the classification of each close pair into
+// a tube element and a part element (contact-states.md, "Surface elements").
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/capsule.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/narrowphase/detail/gjk_solver_indep.h>
+
+#include <tubeplan/core/core.hpp>
+
+namespace tubeplan::core {
+
+/// One close pair: a piece of the tube (capsule or end cylinder) and a part.
+struct RawContact {
+  states::TubeElement tube = states::TubeElement::kSide;
+  int part_element = -1;      ///< index into the core's element list
+  std::uint8_t face_mask = 0;
+  std::uint32_t part = 0;     ///< index into scene.parts
+  double s_m = 0.0;           ///< arc position of the centreline point under the contact
+  double distance_m = 0.0;    ///< >= 0; 0 when the shapes overlap (then `overlap` is set)
+  bool overlap = false;
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
+  Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
+};
+
+inline constexpr int kMaxRawContacts = 4 * kMaxCapsules;
+
+class Collision {
+ public:
+  /// `element_of[part][mask]` is the element index of a face mask of a part.
+  Collision(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsule_count,
+            std::vector<std::array<int, 64>> element_of);
+
+  /// Close pairs of the tube whose centreline nodes (capsule_count + 1 of them, equally spaced
+  /// in arc length from the held end) are `nodes_W`, with the free end's axis `tip_tangent_W`.
+  /// The last EndPieces() intervals are one straight cylinder along the tip tangent, so that no
+  /// capsule's round cap reaches past the flat end face.
+  /// Writes at most out.size() contacts and returns how many; no allocation.
+  int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
+            std::span<RawContact> out) const;
+
+  /// GJK calls of the last Query (for the benchmarks' leave-out figures).
+  int last_narrow_phase_calls() const { return narrow_calls_; }
+  int EndPieces() const { return end_pieces_; }
+
+ private:
+  struct Part {
+    std::uint32_t index = 0;
+    fcl::Boxd box;
+    Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d X_PW = Eigen::Isometry3d::Identity();
+    Eigen::Vector3d half_m = Eigen::Vector3d::Zero();
+  };
+  // Classifies the part point q (world) into a face mask of the box.
+  std::uint8_t FaceMask(const Part& part, const Eigen::Vector3d& q_W) const;
+  bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W,
+                        const Eigen::Vector3d& b_W) const;
+  void Overlapping(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                   RawContact& c) const;
+
+  std::vector<Part> parts_;
+  std::vector<std::array<int, 64>> element_of_;
+  fcl::Capsuled capsule_;
+  fcl::Cylinderd end_;
+  fcl::detail::GJKSolver_indep<double> solver_;
+  double radius_m_ = 0.0;
+  double length_m_ = 0.0;
+  double piece_m_ = 0.0;        // arc length of one capsule, l / N
+  int end_pieces_ = 1;          // node intervals the end cylinder covers
+  double end_m_ = 0.0;          // its length, end_pieces_ * piece_m_ >= r1
+  double threshold_m_ = 0.0;    // epsilon
+  double part_tolerance_m_ = 0.0;
+  double tube_tolerance_m_ = 0.0;
+  mutable int narrow_calls_ = 0;
+};
+
+}  // namespace tubeplan::core
