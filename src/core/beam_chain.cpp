@@ -29,9 +29,13 @@ BeamChain::BeamChain(const scene::Scene& scene)
       group_tolerance_m_(scene.tube.outer_radius_m),
       rule_(scene.model.multi_contact) {}
 
-int BeamChain::Assign(std::array<BeamLoad, kMaxContacts>& loads, int count,
-                      std::array<int, kMaxContacts>& order) const {
-  for (int i = 0; i < count; ++i) order[std::size_t(i)] = i;
+int BeamChain::Assign(std::array<BeamLoad, kMaxLoads>& loads, int total,
+                      const std::array<bool, kMaxLoads>& member,
+                      std::array<int, kMaxLoads>& order, int& members) const {
+  int count = 0;
+  for (int i = 0; i < total; ++i)
+    if (member[std::size_t(i)]) order[std::size_t(count++)] = i;
+  members = count;
   std::sort(order.begin(), order.begin() + count, [&](int a, int b) {
     const double sa = loads[std::size_t(a)].s_m, sb = loads[std::size_t(b)].s_m;
     return sa < sb || (sa == sb && a < b);
@@ -40,7 +44,14 @@ int BeamChain::Assign(std::array<BeamLoad, kMaxContacts>& loads, int count,
   double group_start_m = -1.0, group_end_m = 0.0, clamp_m = 0.0;
   for (int k = 0; k < count; ++k) {
     BeamLoad& load = loads[std::size_t(order[std::size_t(k)])];
-    if (group < 0 || load.s_m - group_start_m > group_tolerance_m_) {
+    // A new cut, unless within a tube radius of the group's first load or of the same PC as a
+    // load already in the group (a line contact is one PC, one load region).
+    bool same_pc = false;
+    for (int q = 0; q < k && load.pc >= 0; ++q) {
+      const BeamLoad& other = loads[std::size_t(order[std::size_t(q)])];
+      if (other.group == group && other.pc == load.pc) same_pc = true;
+    }
+    if (group < 0 || (load.s_m - group_start_m > group_tolerance_m_ && !same_pc)) {
       ++group;
       clamp_m = group == 0 ? 0.0 : group_end_m;
       group_start_m = load.s_m;
@@ -64,16 +75,66 @@ double BeamChain::InfluenceSlope(double s_m, const BeamLoad& load) const {
   return a <= b ? a * (2.0 * b - a) / (2.0 * EI_) : b * b / (2.0 * EI_);
 }
 
-bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxContacts>& loads, int count,
+namespace {
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+const Eigen::Matrix3d kLateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
+const Eigen::Matrix3d kZ = Skew(Eigen::Vector3d::UnitZ());
+
+struct Coefficients {
+  double uF = 0.0, thF = 0.0, uM = 0.0, thM = 0.0;
+};
+
+Coefficients Coeffs(double a, double b, double EI) {
+  Coefficients c;
+  if (a <= 0.0 || b <= 0.0) return c;
+  if (a <= b) {
+    c.uF = a * a * (3.0 * b - a) / (6.0 * EI);
+    c.thF = a * (2.0 * b - a) / (2.0 * EI);
+    c.uM = a * a / (2.0 * EI);
+    c.thM = a / EI;
+  } else {
+    c.uF = b * b * (3.0 * a - b) / (6.0 * EI);
+    c.thF = b * b / (2.0 * EI);
+    c.uM = b * (2.0 * a - b) / (2.0 * EI);
+    c.thM = b / EI;
+  }
+  return c;
+}
+}  // namespace
+
+Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j) const {
+  const Coefficients c = Coeffs(i.s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  const Eigen::Matrix3d Rj = Skew(j.r_H_m);
+  return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
+}
+
+Eigen::Vector3d BeamChain::CentreDisplacement(double s_m, const BeamLoad& j) const {
+  const Coefficients c = Coeffs(s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  const Eigen::Vector3d M = j.r_H_m.cross(j.f_H_N);
+  return c.uF * (kLateral * j.f_H_N) - c.uM * (kZ * M);
+}
+
+Eigen::Vector3d BeamChain::SectionRotation(double s_m, const BeamLoad& j) const {
+  const Coefficients c = Coeffs(s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  const Eigen::Vector3d M = j.r_H_m.cross(j.f_H_N);
+  return c.thF * (kZ * j.f_H_N) + c.thM * (kLateral * M);
+}
+
+bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxLoads>& loads,
+                               const std::array<int, kMaxLoads>& order, int count,
                                int groups) const {
   if (rule_ == scene::MultiContactRule::kCoupled && groups > 1) return false;
   // Each segment's resultant must be within the solver's range (and finite).
-  std::array<Eigen::Vector3d, kMaxContacts> resultant;
-  std::array<double, kMaxContacts> length;
+  std::array<Eigen::Vector3d, kMaxLoads> resultant;
+  std::array<double, kMaxLoads> length;
   resultant.fill(Eigen::Vector3d::Zero());
   length.fill(0.0);
-  for (int i = 0; i < count; ++i) {
-    const BeamLoad& load = loads[std::size_t(i)];
+  for (int k = 0; k < count; ++k) {
+    const BeamLoad& load = loads[std::size_t(order[std::size_t(k)])];
     resultant[std::size_t(load.group)] += load.f_H_N;
     length[std::size_t(load.group)] =
         std::max(length[std::size_t(load.group)], load.s_m - load.clamp_m);
@@ -86,9 +147,9 @@ bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxContacts>& loads, 
   return true;
 }
 
-int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxContacts>& loads, int count,
-                                  const std::array<int, kMaxContacts>& order,
-                                  std::array<ElasticaSegment, kMaxContacts>& segments) const {
+int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
+                                  const std::array<int, kMaxLoads>& order,
+                                  std::array<ElasticaSegment, kMaxLoads>& segments) const {
   int segment_count = 0;
   Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();
@@ -131,7 +192,7 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxContacts>& load
   return segment_count;
 }
 
-Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxContacts>& segments,
+Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxLoads>& segments,
                                          int segment_count, double s_m) const {
   for (int g = 0; g < segment_count; ++g) {
     const ElasticaSegment& seg = segments[std::size_t(g)];
@@ -161,7 +222,7 @@ Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxC
 }
 
 Eigen::Vector3d BeamChain::ElasticaTipTangent(
-    const std::array<ElasticaSegment, kMaxContacts>& segments, int segment_count) const {
+    const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count) const {
   if (segment_count == 0) return Eigen::Vector3d::UnitZ();
   const ElasticaSegment& last = segments[std::size_t(segment_count - 1)];
   const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(last.bend_x_S);

@@ -14,6 +14,19 @@
 // the cross-section where segment k - 1 ended, which carries it along rigidly (a point beyond a
 // cantilever's load moves by the load point's deflection plus its rotation times the distance,
 // which is the a >= b branch).
+//
+// A contact acts on the tube's surface, a distance r from the centreline (a rim contact: r = r1).
+// Its force F is carried to the centreline as F and the moment M = r x F, and the surface point
+// moves with the centre and with the section's rotation omega: dx = dc + omega x r. With
+// a = s - c, b = s_j - c, Z = [z]x and P the lateral projection, a load j moves the centre at s by
+//     uF(a, b) P F - uM(a, b) Z M,      uM = a^2 / (2 E I) (a <= b),  b (2a - b) / (2 E I) (a >= b)
+// and turns its section by
+//     omega = thF(a, b) Z F + thM(a, b) P M,   thF = d uF / da,  thM = min(a, b) / (E I),
+// so the compliance of surface point i to force j is (Maxwell-Betti: symmetric for one clamp)
+//     W_ij = uF P - uM Z [r_j]x - [r_i]x (thF Z + thM P [r_j]x).
+// Without the rotation term a rim contact's point would move as the centre does, while the end
+// face's rotation moves it by r1 times the tip angle: for the rubber tube of scenes/groove.yaml
+// 100 times the penalty spring's compliance, which made a lagged scheme oscillate.
 
 #include <array>
 
@@ -28,8 +41,10 @@ namespace tubeplan::core {
 struct BeamLoad {
   double s_m = 0.0;                                    ///< arc position of the load point
   Eigen::Vector3d f_H_N = Eigen::Vector3d::Zero();     ///< force on the tube, frame H
+  Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();     ///< surface point minus centre, frame H
   double clamp_m = 0.0;                                ///< c_j (set by BeamChain::Assign)
   int group = 0;                                       ///< cut group (set by Assign)
+  int pc = -1;  ///< loads of one PC (the two ends of a line contact) are never cut apart
 };
 
 /// The solved shape of one elastica segment (a group's cantilever).
@@ -45,33 +60,43 @@ class BeamChain {
  public:
   BeamChain(const scene::Scene& scene);
 
-  /// Sorts `order` (indices of loads) by arc position and sets each load's group and clamp.
-  /// Returns the number of groups.
-  int Assign(std::array<BeamLoad, kMaxContacts>& loads, int count,
-             std::array<int, kMaxContacts>& order) const;
+  /// Takes the loads whose `member` flag is set (the first `count`), writes their indices
+  /// sorted by arc position to `order` and sets their group and clamp; returns how many there
+  /// are in `members` and the number of groups.
+  int Assign(std::array<BeamLoad, kMaxLoads>& loads, int count,
+             const std::array<bool, kMaxLoads>& member, std::array<int, kMaxLoads>& order,
+             int& members) const;
 
   /// Lateral influence coefficient [m/N] of load j on the point at arc position s_m.
   double Influence(double s_m, const BeamLoad& load) const;
   /// d/ds of Influence [1/N]: the rotation of the tangent per newton.
   double InfluenceSlope(double s_m, const BeamLoad& load) const;
 
+  /// W_ij above [m/N], frame H: displacement of load i's surface point per force of load j.
+  Eigen::Matrix3d Compliance(const BeamLoad& i, const BeamLoad& j) const;
+  /// Displacement of the centre at s_m [m] and rotation of its section [rad], frame H, under
+  /// load j (force and the moment of its offset).
+  Eigen::Vector3d CentreDisplacement(double s_m, const BeamLoad& j) const;
+  Eigen::Vector3d SectionRotation(double s_m, const BeamLoad& j) const;
+
   /// Whether the elastica can carry these loads: one group per cantilever (segmented), or a
   /// single group (coupled), and every segment's load parameter within the solver's range.
-  bool ElasticaCovers(const std::array<BeamLoad, kMaxContacts>& loads, int count,
-                      int groups) const;
+  /// `order` and `count` as Assign left them.
+  bool ElasticaCovers(const std::array<BeamLoad, kMaxLoads>& loads,
+                      const std::array<int, kMaxLoads>& order, int count, int groups) const;
 
   /// Solves the elastica chain: one segment per group, each loaded by its group's resultant at
   /// the group's last load point, clamped where the previous one ended. Loads must be Assigned.
   /// Returns the number of segments.
-  int SolveElasticaChain(const std::array<BeamLoad, kMaxContacts>& loads, int count,
-                         const std::array<int, kMaxContacts>& order,
-                         std::array<ElasticaSegment, kMaxContacts>& segments) const;
+  int SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
+                         const std::array<int, kMaxLoads>& order,
+                         std::array<ElasticaSegment, kMaxLoads>& segments) const;
 
   /// Position in H of the centreline at s_m of a solved elastica chain.
-  Eigen::Vector3d ElasticaPoint(const std::array<ElasticaSegment, kMaxContacts>& segments,
+  Eigen::Vector3d ElasticaPoint(const std::array<ElasticaSegment, kMaxLoads>& segments,
                                 int segment_count, double s_m) const;
   /// Unit tangent in H at the free end of a solved elastica chain.
-  Eigen::Vector3d ElasticaTipTangent(const std::array<ElasticaSegment, kMaxContacts>& segments,
+  Eigen::Vector3d ElasticaTipTangent(const std::array<ElasticaSegment, kMaxLoads>& segments,
                                      int segment_count) const;
   /// 3x3 tangent compliance [m/N] of a segment's tip to its own load, frame H (finite
   /// differences of the elastica in the bending plane; rotational symmetry across it).

@@ -1,6 +1,7 @@
 #include "collision.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace tubeplan::core {
@@ -42,7 +43,6 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       piece_m_(scene.tube.length_m / capsule_count),
       end_pieces_(EndPieceCount(scene, capsule_count)),
       end_m_(EndCylinderLength(scene, capsule_count)),
-      threshold_m_(scene.contact.threshold_m),
       // A part point within 1 % of epsilon of a second face plane lies on their edge: far above
       // GJK's error (gjk_tolerance below), far below any distance that changes a force.
       part_tolerance_m_(0.01 * scene.contact.threshold_m),
@@ -75,12 +75,12 @@ std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) c
 }
 
 bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W,
-                                 const Eigen::Vector3d& b_W) const {
+                                 const Eigen::Vector3d& b_W, double band_m) const {
   // The piece's bounding box in the part's frame, grown by its radius and epsilon, against the
   // part: exact for the box's own axes, so rotated parts cull as well as aligned ones.
   const Eigen::Vector3d a_P = part.X_PW * a_W;
   const Eigen::Vector3d b_P = part.X_PW * b_W;
-  const double grow = radius_m_ + threshold_m_;
+  const double grow = radius_m_ + band_m;
   for (int k = 0; k < 3; ++k) {
     const double lo = std::min(a_P[k], b_P[k]) - grow;
     const double hi = std::max(a_P[k], b_P[k]) + grow;
@@ -108,7 +108,8 @@ void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
 }
 
 int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
-                     const Eigen::Vector3d& tip_tangent_W, std::span<RawContact> out) const {
+                     const Eigen::Vector3d& tip_tangent_W, double band_m,
+                     std::span<RawContact> out) const {
   // Capsules 0 .. pieces - 2, then the end cylinder as piece pieces - 1.
   const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
   int count = 0;
@@ -120,7 +121,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
       const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];
-      if (!PassesBroadPhase(part, a_W, b_W)) continue;
+      if (!PassesBroadPhase(part, a_W, b_W, band_m)) continue;
       if (count == static_cast<int>(out.size())) return count;
 
       const Eigen::Isometry3d X_WS = SegmentPose(a_W, b_W);
@@ -133,7 +134,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
                                          &q_part_W);
       RawContact c;
       c.part = part.index;
-      if (separated && d >= threshold_m_) continue;
+      if (separated && d >= band_m) continue;
       const Eigen::Vector3d axis_W = X_WS.linear().col(2);
       if (separated && d > 0.0) {
         c.distance_m = d;
@@ -143,6 +144,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
         Overlapping(part, a_W, b_W, c);
         p_tube_W = c.q_W_m;
       }
+      c.p_W_m = p_tube_W;
       c.face_mask = FaceMask(part, c.q_W_m);
       c.part_element = element_of_[part.index][c.face_mask];
 
@@ -164,6 +166,23 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
           c.tube = states::TubeElement::kEndRim;
         }
         if (c.tube != states::TubeElement::kSide) c.s_m = length_m_;
+      }
+      if (is_end && c.tube == states::TubeElement::kSide && !c.overlap &&
+          std::popcount(unsigned(c.face_mask)) == 1) {
+        // The end cylinder's side on a face is a line contact along its nearest generator: GJK
+        // returns one point of it, at either end depending on the sign of a tiny tilt, which
+        // would make the load jump by the cylinder's length from tick to tick. Both ends of the
+        // generator go out instead, each with its own distance to the face's plane.
+        const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
+        for (const double end : {-half_m, half_m}) {
+          if (count == static_cast<int>(out.size())) return count;
+          RawContact e = c;
+          e.p_W_m = centre_W + radial_W + end * axis_W;
+          e.distance_m = c.distance_m + c.normal_W.dot(e.p_W_m - p_tube_W);
+          e.s_m = std::max(0.0, s0 + half_m + end);
+          if (e.distance_m < band_m && e.distance_m > 0.0) out[std::size_t(count++)] = e;
+        }
+        continue;
       }
       out[std::size_t(count++)] = c;
     }

@@ -30,6 +30,7 @@ struct RawContact {
   bool overlap = false;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
+  Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the tube
 };
 
 inline constexpr int kMaxRawContacts = 4 * kMaxCapsules;
@@ -45,8 +46,10 @@ class Collision {
   /// The last EndPieces() intervals are one straight cylinder along the tip tangent, so that no
   /// capsule's round cap reaches past the flat end face.
   /// Writes at most out.size() contacts and returns how many; no allocation.
+  /// Pairs closer than `band_m` are returned (the core asks for more than epsilon so that a
+  /// contact about to close this tick is in its system, and one releasing leaves smoothly).
   int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
-            std::span<RawContact> out) const;
+            double band_m, std::span<RawContact> out) const;
 
   /// GJK calls of the last Query (for the benchmarks' leave-out figures).
   int last_narrow_phase_calls() const { return narrow_calls_; }
@@ -62,8 +65,8 @@ class Collision {
   };
   // Classifies the part point q (world) into a face mask of the box.
   std::uint8_t FaceMask(const Part& part, const Eigen::Vector3d& q_W) const;
-  bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W,
-                        const Eigen::Vector3d& b_W) const;
+  bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                        double band_m) const;
   void Overlapping(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
                    RawContact& c) const;
 
@@ -77,7 +80,6 @@ class Collision {
   double piece_m_ = 0.0;        // arc length of one capsule, l / N
   int end_pieces_ = 1;          // node intervals the end cylinder covers
   double end_m_ = 0.0;          // its length, end_pieces_ * piece_m_ >= r1
-  double threshold_m_ = 0.0;    // epsilon
   double part_tolerance_m_ = 0.0;
   double tube_tolerance_m_ = 0.0;
   mutable int narrow_calls_ = 0;

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <cstdio>
+#include <iostream>
+#include <cstdlib>
 
 #include <Eigen/LU>
 
@@ -16,21 +20,19 @@ namespace tubeplan::core {
 
 namespace {
 
-constexpr int kMaxUnknowns = 3 * kMaxContacts + 3;
+constexpr int kMaxUnknowns = 3 * kMaxLoads + 3;
 using SystemMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns,
                                    kMaxUnknowns>;
 using SystemVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
 // Friction, release and saturation decisions re-solve the tick's system; each pass settles at
 // least one contact, so kMaxContacts + 2 passes always suffice (the rest is a safety bound).
-constexpr int kMaxPasses = 2 * kMaxContacts + 4;
+constexpr int kMaxPasses = 3 * kMaxLoads + 4;
 
 bool IsBoundaryOf(states::TubeElement a, states::TubeElement b) {
   // The rim bounds both the end face and the side surface.
   return a == states::TubeElement::kEndRim &&
          (b == states::TubeElement::kEndFace || b == states::TubeElement::kSide);
 }
-
-bool AllFinite(const Eigen::Vector3d& v) { return v.allFinite(); }
 
 }  // namespace
 
@@ -49,6 +51,31 @@ struct Core::Impl {
        std::vector<std::array<int, 64>> element_of)
       : collision(scene, parts, capsules, std::move(element_of)), beam(scene) {}
 
+  // One load point of a PC in a tick.
+  struct Load {
+    int pc = 0;       // index into the tick's PCs
+    int end = 0;      // 0, or 1 for the far end of an extended contact
+    states::TubeElement tube = states::TubeElement::kSide;
+    int part_element = -1;
+    double s_m = 0.0;
+    double distance_m = 0.0;                                // d where x0 is
+    Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
+    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();         // surface point at the tick's start
+    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();       // x = base + p + R W R^T F
+    Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();     // stuck: held here tangentially
+    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();      // last tick's force (linearisation)
+    Eigen::Vector3d f_slide_W = Eigen::Vector3d::Zero();    // imposed friction while sliding
+    Eigen::Vector3d force_W = Eigen::Vector3d::Zero();      // result
+    Eigen::Vector3d x_W = Eigen::Vector3d::Zero();          // result
+    const scene::Friction* friction = nullptr;              // null: frictionless here
+    Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();        // surface point - centre, frame H
+    bool active = true, released = false, sliding = false, shifted = false;
+    bool matched = false, ghost = false;
+    bool SameKey(const Load& o) const {
+      return tube == o.tube && part_element == o.part_element && end == o.end;
+    }
+  };
+
   Collision collision;
   BeamChain beam;
 
@@ -57,32 +84,23 @@ struct Core::Impl {
   Eigen::Vector3d tip_tangent_H = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
-  std::array<ContactState, kMaxContacts> prev{};
+  std::array<Load, kMaxLoads> prev{};
   int prev_count = 0;
-  // The loads of the last tick as the beam saw them (for Centreline on request).
-  std::array<BeamLoad, kMaxContacts> loads{};
-  std::array<int, kMaxContacts> order{};
-  std::array<ElasticaSegment, kMaxContacts> segments{};
-  int load_count = 0, group_count = 0, segment_count = 0;
+  // The loads of the last tick as the beam saw them (the shape, and Centreline on request).
+  std::array<BeamLoad, kMaxLoads> beam_loads{};
+  std::array<int, kMaxLoads> order{};
+  std::array<ElasticaSegment, kMaxLoads> segments{};
+  int beam_count = 0, segment_count = 0;
   bool elastica_shape = false;
 
   // Per-tick scratch (kept here so that Step allocates nothing).
   std::array<RawContact, kMaxRawContacts> raw{};
   std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_W{};
+  std::array<Load, kMaxLoads> loads{};
+  std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W{};  // world frame
   SystemMatrix M;
   SystemVector rhs, z;
   Eigen::PartialPivLU<SystemMatrix> lu;
-
-  // Per contact, for the solve.
-  struct Solve {
-    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();       // load point where d was measured
-    Eigen::Vector3d base_H = Eigen::Vector3d::Zero();     // x_i = p + R (base_H + J F^H)
-    Eigen::Vector3d f_slide_W = Eigen::Vector3d::Zero();  // imposed friction when sliding
-    Eigen::Vector3d f_lin_H = Eigen::Vector3d::Zero();    // linearisation force (elastica)
-    bool active = true, sliding = false, shifted = false;
-  };
-  std::array<Solve, kMaxContacts> solve{};
-  std::array<std::array<Eigen::Matrix3d, kMaxContacts>, kMaxContacts> J{};  // H frame
 };
 
 Core::Core(const scene::Scene& scene) : scene_(scene) {
@@ -141,34 +159,40 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.p_hand_prev_W = X_WH.translation();
   m.p_held_prev_W = X_WH.translation();
   m.prev_count = 0;
-  m.load_count = m.group_count = m.segment_count = 0;
+  m.beam_count = m.segment_count = 0;
   m.elastica_shape = false;
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
   out_.X_WH = X_WH;
 }
 
+namespace {
+
+// A PC found this tick: its elements and the raw contacts that bound its region.
+struct PcFound {
+  states::TubeElement tube = states::TubeElement::kSide;
+  int part_element = -1;
+  int deepest = -1, first = -1, last = -1;  // raw contacts: smallest d, smallest s, largest s
+};
+
+}  // namespace
+
 const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   Impl& m = *impl_;
+  using Load = Impl::Load;
   const double T = scene_.model.time_step_s;
   const double K = scene_.contact.stiffness_N_per_m;
   const double eps = scene_.contact.threshold_m;
   const double Kt = K;  // tangential stiffness of a stuck contact: as stiff as the normal one
   const double l = scene_.tube.length_m;
   const int N = capsule_count_;
-  const bool frictionless_scene = [&] {
-    if (!scene_.friction.IsFrictionless()) return false;
-    for (const scene::BoxPart& part : scene_.parts)
-      if (part.friction && !part.friction->IsFrictionless()) return false;
-    return true;
-  }();
 
   StepOutput& out = out_;
   out.t_s = t_s;
   out.X_W_hand = X_W_hand;
   out.flags = 0;
   const Eigen::Matrix3d R_WH = X_W_hand.linear();
-  Eigen::Vector3d p_hand_W = X_W_hand.translation();
+  const Eigen::Vector3d p_hand_W = X_W_hand.translation();
   if (!p_hand_W.allFinite() || !R_WH.allFinite()) {
     // A non-finite hand pose: hold everything where it was and send nothing.
     out.flags |= kSolverFault;
@@ -177,18 +201,24 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return out;
   }
 
-  // 1. The tube where it is: last tick's held position, this tick's orientation, last shape.
+  // 1. The tube where it is: last tick's held position and shape, this tick's orientation.
   const Eigen::Vector3d p_start_W = m.p_held_prev_W;
   for (int k = 0; k <= N; ++k)
     m.nodes_W[std::size_t(k)] = p_start_W + R_WH * m.nodes_H[std::size_t(k)];
   const Eigen::Vector3d tip_tangent_W = R_WH * m.tip_tangent_H;
 
-  // 2. Collision.
+  // 2. Collision, in a band of 2 epsilon: a contact that closes during this tick is then in this
+  // tick's system (its force comes out zero if it stays open), and one that opens fades out.
   const int raw_count = m.collision.Query(
       std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
-      std::span<RawContact>(m.raw.data(), m.raw.size()));
+      2.0 * eps, std::span<RawContact>(m.raw.data(), m.raw.size()));
 
-  // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that PC.
+  if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) {
+    for (int i = 0; i < raw_count; ++i) std::fprintf(stderr, "t=%g raw %d tube %d elem %d d=%g s=%g p=(%g %g %g)\n", t_s, i, int(m.raw[std::size_t(i)].tube), m.raw[std::size_t(i)].part_element, m.raw[std::size_t(i)].distance_m, m.raw[std::size_t(i)].s_m, m.raw[std::size_t(i)].p_W_m.x(), m.raw[std::size_t(i)].p_W_m.y(), m.raw[std::size_t(i)].p_W_m.z());
+    std::fprintf(stderr, "tip node (%g %g %g) tangent (%g %g %g)\n", m.nodes_W[std::size_t(N)].x(), m.nodes_W[std::size_t(N)].y(), m.nodes_W[std::size_t(N)].z(), tip_tangent_W.x(), tip_tangent_W.y(), tip_tangent_W.z());
+  }
+  // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
+  // one's PC (an edge of the face a side lies on, the rim of an end face lying flat).
   for (int i = 0; i < raw_count; ++i) {
     RawContact& a = m.raw[std::size_t(i)];
     for (int j = 0; j < raw_count; ++j) {
@@ -204,77 +234,30 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
     }
   }
-  // Merge raw contacts of one element pair into one load point: the deepest one's distance and
-  // normal, the depth-weighted mean arc position (the resultant of an extended contact).
-  std::array<ContactState, kMaxContacts> pcs;
-  std::array<double, kMaxContacts> weight{};
-  int pc_count = 0;
+  std::array<PcFound, kMaxContacts> found{};
+  int found_count = 0;
   bool truncated = false;
   for (int i = 0; i < raw_count; ++i) {
     const RawContact& r = m.raw[std::size_t(i)];
-    if (r.overlap) out.flags |= kPenetration;
     int k = 0;
-    while (k < pc_count && !(pcs[std::size_t(k)].tube == r.tube &&
-                             pcs[std::size_t(k)].part_element == r.part_element))
+    while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
+                                found[std::size_t(k)].part_element == r.part_element))
       ++k;
-    const double w = eps - r.distance_m;  // > 0
-    if (k == pc_count) {
-      if (pc_count == kMaxContacts) {
-        // Full: replace the shallowest if this one is deeper.
-        int shallowest = 0;
-        for (int q = 1; q < pc_count; ++q)
-          if (pcs[std::size_t(q)].distance_m > pcs[std::size_t(shallowest)].distance_m)
-            shallowest = q;
+    if (k == found_count) {
+      if (found_count == kMaxContacts) {
         truncated = true;
-        if (r.distance_m >= pcs[std::size_t(shallowest)].distance_m) continue;
-        k = shallowest;
-        weight[std::size_t(k)] = 0.0;
-      } else {
-        ++pc_count;
-        weight[std::size_t(k)] = 0.0;
+        continue;
       }
-      ContactState& pc = pcs[std::size_t(k)];
-      pc = ContactState{};
-      pc.tube = r.tube;
-      pc.part_element = r.part_element;
-      pc.distance_m = r.distance_m;
-      pc.normal_W = r.normal_W;
-      pc.s_m = 0.0;
+      found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i};
+      continue;
     }
-    ContactState& pc = pcs[std::size_t(k)];
-    if (r.distance_m < pc.distance_m) {
-      pc.distance_m = r.distance_m;
-      pc.normal_W = r.normal_W;
-    }
-    pc.s_m += w * r.s_m;
-    weight[std::size_t(k)] += w;
-  }
-  if (truncated) out.flags |= kContactsTruncated;
-  for (int k = 0; k < pc_count; ++k) {
-    ContactState& pc = pcs[std::size_t(k)];
-    pc.s_m = std::clamp(pc.s_m / weight[std::size_t(k)], 0.0, l);
-    if (pc.tube != states::TubeElement::kSide) pc.s_m = l;
-  }
-  // Canonical order: by tube element, then part element (insertion sort: at most 6, stable).
-  for (int i = 1; i < pc_count; ++i) {
-    for (int j = i; j > 0; --j) {
-      const ContactState& a = pcs[std::size_t(j - 1)];
-      const ContactState& b = pcs[std::size_t(j)];
-      const bool in_order =
-          a.tube != b.tube ? a.tube < b.tube : a.part_element <= b.part_element;
-      if (in_order) break;
-      std::swap(pcs[std::size_t(j - 1)], pcs[std::size_t(j)]);
-    }
+    PcFound& pc = found[std::size_t(k)];
+    if (r.distance_m < m.raw[std::size_t(pc.deepest)].distance_m) pc.deepest = i;
+    if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
+    if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
   }
 
-  // 4. Loads, anchors, and the beam's compliance.
-  const auto find_prev = [&](const ContactState& pc) -> const ContactState* {
-    for (int q = 0; q < m.prev_count; ++q)
-      if (m.prev[std::size_t(q)].tube == pc.tube &&
-          m.prev[std::size_t(q)].part_element == pc.part_element)
-        return &m.prev[std::size_t(q)];
-    return nullptr;
-  };
+  // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
   const auto interpolate_node = [&](double s_m) {
     const double u = std::clamp(s_m / l * N, 0.0, static_cast<double>(N));
     const int k = std::min(static_cast<int>(u), N - 1);
@@ -282,100 +265,200 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return Eigen::Vector3d((1.0 - t) * m.nodes_H[std::size_t(k)] +
                            t * m.nodes_H[std::size_t(k) + 1]);
   };
-  for (int i = 0; i < pc_count; ++i) {
-    ContactState& pc = pcs[std::size_t(i)];
-    Impl::Solve& sv = m.solve[std::size_t(i)];
-    sv = Impl::Solve{};
-    sv.x0_W = p_start_W + R_WH * interpolate_node(pc.s_m);
-    const ContactState* before = find_prev(pc);
-    pc.anchor_W_m = before ? before->anchor_W_m : sv.x0_W;
-    sv.f_lin_H = before ? Eigen::Vector3d(R_WH.transpose() * before->force_W_N)
-                        : Eigen::Vector3d::Zero();
-    m.loads[std::size_t(i)] = BeamLoad{pc.s_m, sv.f_lin_H, 0.0, 0};
-  }
-  m.load_count = pc_count;
-  m.group_count = m.beam.Assign(m.loads, pc_count, m.order);
-  const bool want_elastica = scene_.model.beam == model::BeamModel::kElastica;
-  bool use_elastica = want_elastica && pc_count > 0 &&
-                      m.beam.ElasticaCovers(m.loads, pc_count, m.group_count);
-  if (want_elastica && pc_count > 0 && !use_elastica) out.flags |= kLinearFallback;
-  const Eigen::DiagonalMatrix<double, 3> lateral(1.0, 1.0, 0.0);
-  for (int i = 0; i < pc_count; ++i) {
-    for (int j = 0; j < pc_count; ++j) {
-      m.J[std::size_t(i)][std::size_t(j)] =
-          m.beam.Influence(m.loads[std::size_t(i)].s_m, m.loads[std::size_t(j)]) *
-          Eigen::Matrix3d(lateral);
+  int load_count = 0;
+  const auto add_load = [&](int pc, int end, const RawContact& r) {
+    if (load_count == kMaxLoads) {
+      truncated = true;
+      return;
     }
-    m.solve[std::size_t(i)].base_H = Eigen::Vector3d(0.0, 0.0, m.loads[std::size_t(i)].s_m);
-  }
-  if (use_elastica) {
-    // Newton about last tick's forces: x(F) ~ x_el(F_lin) + J (F - F_lin), with the elastica's
-    // own tangent for each segment's load and the linear influence for the loads before it.
-    m.segment_count = m.beam.SolveElasticaChain(m.loads, pc_count, m.order, m.segments);
-    for (int i = 0; i < pc_count; ++i) {
-      const BeamLoad& li = m.loads[std::size_t(i)];
-      const ElasticaSegment& seg = m.segments[std::size_t(li.group)];
-      Eigen::Vector3d f_group = Eigen::Vector3d::Zero();
-      for (int j = 0; j < pc_count; ++j)
-        if (m.loads[std::size_t(j)].group == li.group) f_group += m.loads[std::size_t(j)].f_H_N;
-      const Eigen::Matrix3d J_seg = m.beam.ElasticaCompliance(seg, f_group);
-      for (int j = 0; j < pc_count; ++j)
-        if (m.loads[std::size_t(j)].group == li.group) m.J[std::size_t(i)][std::size_t(j)] = J_seg;
-    }
-    for (int i = 0; i < pc_count; ++i) {
-      Eigen::Vector3d x_el = m.beam.ElasticaPoint(m.segments, m.segment_count,
-                                                  m.loads[std::size_t(i)].s_m);
-      for (int j = 0; j < pc_count; ++j)
-        x_el -= m.J[std::size_t(i)][std::size_t(j)] * m.loads[std::size_t(j)].f_H_N;
-      m.solve[std::size_t(i)].base_H = x_el;
+    Load& ld = m.loads[std::size_t(load_count++)];
+    ld = Load{};
+    ld.pc = pc;
+    ld.end = end;
+    ld.tube = r.tube;
+    ld.part_element = r.part_element;
+    ld.s_m = r.tube == states::TubeElement::kSide ? std::clamp(r.s_m, 0.0, l) : l;
+    ld.distance_m = r.distance_m;
+    ld.normal_W = r.normal_W;
+    // An end face lying flat presses over its whole annulus, whose centre of pressure is on the
+    // axis: its load point is the face's centre, wherever on the face GJK put its nearest point.
+    ld.x0_W = r.tube == states::TubeElement::kEndFace ? m.nodes_W[std::size_t(N)] : r.p_W_m;
+    const scene::Friction& friction =
+        scene::FrictionAt(scene_, elements_[std::size_t(r.part_element)].part_index);
+    ld.friction = friction.IsFrictionless() ? nullptr : &friction;
+    ld.anchor_W = ld.x0_W;
+    // In the band but not within epsilon: in the system only if this tick's motion closes it.
+    ld.active = r.distance_m < eps;
+    if (r.overlap) out.flags |= kPenetration;
+  };
+  for (int k = 0; k < found_count; ++k) {
+    const PcFound& pc = found[std::size_t(k)];
+    const RawContact& first = m.raw[std::size_t(pc.first)];
+    const RawContact& last = m.raw[std::size_t(pc.last)];
+    if (last.s_m - first.s_m > m.beam.group_tolerance_m()) {
+      add_load(k, 0, first);
+      add_load(k, 1, last);
+    } else {
+      add_load(k, 0, m.raw[std::size_t(pc.deepest)]);
     }
   }
+  // Each load continues last tick's load of the same element pair and end; failing that, the
+  // nearest one (within a tube radius) on the same part element, whatever the tube element:
+  // a rim contact that becomes a side contact as the tube lays down keeps its force and anchor.
+  std::array<bool, kMaxLoads> taken{};
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int i = 0; i < load_count; ++i) {
+      Load& ld = m.loads[std::size_t(i)];
+      if (ld.matched) continue;
+      int best = -1;
+      double best_ds = m.beam.group_tolerance_m();
+      for (int q = 0; q < m.prev_count; ++q) {
+        const Load& before = m.prev[std::size_t(q)];
+        if (taken[std::size_t(q)] || before.part_element != ld.part_element) continue;
+        if (pass == 0 && !before.SameKey(ld)) continue;
+        const double ds = std::abs(before.s_m - ld.s_m);
+        if (pass == 0 || ds <= best_ds) best = q, best_ds = ds;
+        if (pass == 0) break;
+      }
+      if (best < 0) continue;
+      const Load& before = m.prev[std::size_t(best)];
+      taken[std::size_t(best)] = true;
+      ld.matched = true;
+      if (before.active && ld.friction) ld.anchor_W = before.anchor_W;
+      ld.f_lin_W = before.force_W;
+    }
+  }
+  // A load of last tick that nothing continues but that carried force is still in the shape:
+  // it stays in this tick as a ghost, open, so that its force is taken out of the shape.
+  for (int q = 0; q < m.prev_count; ++q) {
+    const Load& before = m.prev[std::size_t(q)];
+    if (taken[std::size_t(q)] || before.force_W.isZero(0.0)) continue;
+    if (load_count == kMaxLoads) {
+      truncated = true;
+      break;
+    }
+    Load& ghost = m.loads[std::size_t(load_count++)];
+    ghost = before;
+    ghost.pc = -1;
+    ghost.f_lin_W = before.force_W;
+    ghost.active = false;
+    ghost.released = true;
+    ghost.sliding = ghost.shifted = false;
+    ghost.ghost = true;
+  }
+  if (truncated) out.flags |= kContactsTruncated;
 
-  // 5. Solve contacts, coupling and beam together. Unknowns: the contact forces F_i (W) and the
-  // held-end position p. Contact i: F_i = K n (eps - d_i - n.(x_i - x0_i)) + Kt T (a_i - x_i)
-  // (stuck) or + f_i (sliding), with x_i = p + R (base_i + sum_j J_ij R^T F_j). Coupling:
-  // K_c (h - p) + B (v_h - (p - p_prev) / T) + sum F_i = 0 (the tube and proxy are massless).
-  const double Kc = coupling_stiffness_;
-  const double B = coupling_damping_;
-  const double Kc_eff = Kc + B / T;
+  // 5. The beam's compliance between the load points, about last tick's forces.
+  for (int i = 0; i < load_count; ++i) {
+    Load& ld = m.loads[std::size_t(i)];
+    if (!ld.ghost) {
+      const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(ld.s_m);
+      ld.r_H_m = R_WH.transpose() * (ld.x0_W - centre_W);
+    }
+    m.beam_loads[std::size_t(i)] =
+        BeamLoad{ld.s_m, R_WH.transpose() * ld.f_lin_W, ld.r_H_m, 0.0, 0, ld.pc};
+  }
+  // The cantilever's structure (cuts, clamps) comes from the loads that carry force: those in
+  // contact now and those that carried force last tick (their force is in the current shape).
+  // A load merely in the band must not cut the tube. Rebuilt when a load closes in a pass.
+  const bool want_elastica = scene_.model.beam == model::BeamModel::kElastica;
+  const Eigen::Matrix3d lateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
+  std::array<bool, kMaxLoads> member{};
+  bool use_elastica = false;
+  const auto build_compliance = [&] {
+    for (int i = 0; i < load_count; ++i) {
+      const Load& ld = m.loads[std::size_t(i)];
+      member[std::size_t(i)] = ld.active || !ld.f_lin_W.isZero(0.0);
+    }
+    int members = 0;
+    const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
+    use_elastica = want_elastica && members > 0 &&
+                   m.beam.ElasticaCovers(m.beam_loads, m.order, members, groups);
+    for (int i = 0; i < load_count; ++i)
+      for (int j = 0; j < load_count; ++j)
+        m.W[std::size_t(i)][std::size_t(j)] =
+            member[std::size_t(j)]
+                ? m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)])
+                : Eigen::Matrix3d::Zero();
+    if (use_elastica) {
+      // Within a segment the elastica's own tangent replaces the linear force compliance; the
+      // rotation terms and the loads of earlier segments keep their linear values.
+      const int segment_count = m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
+      for (int g = 0; g < segment_count; ++g) {
+        Eigen::Vector3d f_group = Eigen::Vector3d::Zero();
+        for (int k = 0; k < members; ++k) {
+          const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
+          if (b.group == g) f_group += b.f_H_N;
+        }
+        const Eigen::Matrix3d J = m.beam.ElasticaCompliance(m.segments[std::size_t(g)], f_group);
+        for (int ki = 0; ki < members; ++ki) {
+          const int i = m.order[std::size_t(ki)];
+          if (m.beam_loads[std::size_t(i)].group != g) continue;
+          for (int kj = 0; kj < members; ++kj) {
+            const int j = m.order[std::size_t(kj)];
+            if (m.beam_loads[std::size_t(j)].group != g) continue;
+            const double uF =
+                m.beam.Influence(m.beam_loads[std::size_t(i)].s_m, m.beam_loads[std::size_t(j)]);
+            m.W[std::size_t(i)][std::size_t(j)] += J - uF * lateral;
+          }
+        }
+      }
+    }
+    for (int i = 0; i < load_count; ++i) {
+      Load& ld = m.loads[std::size_t(i)];
+      ld.base_W = ld.x0_W - p_start_W;
+      for (int j = 0; j < load_count; ++j) {
+        Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+        Wij = R_WH * Wij * R_WH.transpose();
+        ld.base_W -= Wij * m.loads[std::size_t(j)].f_lin_W;
+      }
+    }
+  };
+  build_compliance();
+  if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 0.5e-3)
+    for (int i = 0; i < load_count; ++i) { const Load& ld = m.loads[std::size_t(i)]; std::fprintf(stderr, "load %d tube %d end %d s=%g d=%g active=%d ghost=%d member=%d flin=(%g %g %g)\n", i, int(ld.tube), ld.end, ld.s_m, ld.distance_m, int(ld.active), int(ld.ghost), int(member[std::size_t(i)]), ld.f_lin_W.x(), ld.f_lin_W.y(), ld.f_lin_W.z()); }
+  if (want_elastica && load_count > 0 && !use_elastica) out.flags |= kLinearFallback;
+
+  // 6. Solve contacts, coupling and beam together. Unknowns: the load forces F_i (W) and the
+  // held-end position p. Load i: F_i = K n (eps - d_i - n.(x_i - x0_i)) + Kt T (a_i - x_i) when
+  // stuck, + f_i when sliding; its point x_i = base_i + p + sum_j W_ij F_j. Coupling:
+  // K_c (h - p) + B (v_h - (p - p_prev) / T) + sum F_i = 0 (tube and proxy are massless).
+  const double Kc_eff = coupling_stiffness_ + coupling_damping_ / T;
   const Eigen::Vector3d v_hand_W = (p_hand_W - m.p_hand_prev_W) / T;
-  Eigen::Vector3d A = Kc * p_hand_W + B * v_hand_W + (B / T) * m.p_held_prev_W;
+  const Eigen::Vector3d A_free = coupling_stiffness_ * p_hand_W + coupling_damping_ * v_hand_W +
+                                 (coupling_damping_ / T) * m.p_held_prev_W;
+  Eigen::Vector3d A = A_free;
   const double max_force = scene_.device.max_force_N;
-  std::array<int, kMaxContacts> slot{};
+  std::array<int, kMaxLoads> slot{};
   Eigen::Vector3d p_W = p_start_W;
-  bool solved = false;
-  bool saturated = false;
+  bool solved = false, saturated = false;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     int n_active = 0;
-    for (int i = 0; i < pc_count; ++i) slot[std::size_t(i)] = m.solve[std::size_t(i)].active ? n_active++ : -1;
+    for (int i = 0; i < load_count; ++i)
+      slot[std::size_t(i)] = m.loads[std::size_t(i)].active ? n_active++ : -1;
     const int n = 3 * n_active + 3;
     m.M.setZero(n, n);
     m.rhs.setZero(n);
-    for (int i = 0; i < pc_count; ++i) {
+    for (int i = 0; i < load_count; ++i) {
       const int si = slot[std::size_t(i)];
       if (si < 0) continue;
-      const ContactState& pc = pcs[std::size_t(i)];
-      const Impl::Solve& sv = m.solve[std::size_t(i)];
-      const Eigen::Vector3d& nrm = pc.normal_W;
+      const Load& ld = m.loads[std::size_t(i)];
+      const Eigen::Vector3d& nrm = ld.normal_W;
       const Eigen::Matrix3d NN = nrm * nrm.transpose();
       const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
-      const bool frictional = !frictionless_scene &&
-                              !scene::FrictionAt(scene_, elements_[std::size_t(pc.part_element)].part_index).IsFrictionless();
-      const bool stuck = frictional && !sv.sliding;
+      const bool stuck = ld.friction && !ld.sliding;
       const Eigen::Matrix3d G = K * NN + (stuck ? Kt : 0.0) * Tp;
-      Eigen::Vector3d b = K * nrm * (eps - pc.distance_m + nrm.dot(sv.x0_W));
-      if (stuck) b += Kt * (Tp * pc.anchor_W_m);
-      if (sv.sliding) b += sv.f_slide_W;
+      Eigen::Vector3d b = K * nrm * (eps - ld.distance_m + nrm.dot(ld.x0_W));
+      if (stuck) b += Kt * (Tp * ld.anchor_W);
+      if (ld.sliding) b += ld.f_slide_W;
       const int r = 3 * si;
       m.M.block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
-      for (int j = 0; j < pc_count; ++j) {
+      for (int j = 0; j < load_count; ++j) {
         const int sj = slot[std::size_t(j)];
-        if (sj < 0) continue;
-        m.M.block<3, 3>(r, 3 * sj) +=
-            G * R_WH * m.J[std::size_t(i)][std::size_t(j)] * R_WH.transpose();
+        if (sj >= 0) m.M.block<3, 3>(r, 3 * sj) += G * m.W[std::size_t(i)][std::size_t(j)];
       }
       m.M.block<3, 3>(r, n - 3) = G;
-      m.rhs.segment<3>(r) = b - G * (R_WH * sv.base_H);
+      m.rhs.segment<3>(r) = b - G * ld.base_W;
       m.M.block<3, 3>(n - 3, r) = -Eigen::Matrix3d::Identity();
     }
     m.M.block<3, 3>(n - 3, n - 3) = Kc_eff * Eigen::Matrix3d::Identity();
@@ -385,54 +468,74 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (!m.z.allFinite()) break;
     p_W = m.z.segment<3>(n - 3);
 
-    // Decisions: release contacts that pull, slide those beyond the friction limit, saturate
-    // the coupling at the device's force. Each changes the system: solve again.
+    // Decisions: release a load that pulls, slide one beyond its friction limit, saturate the
+    // coupling at the device's force. Each changes the system: solve again.
     bool changed = false;
-    for (int i = 0; i < pc_count && !changed; ++i) {
+    for (int i = 0; i < load_count && !changed; ++i) {
       const int si = slot[std::size_t(i)];
-      if (si < 0) continue;
-      ContactState& pc = pcs[std::size_t(i)];
-      Impl::Solve& sv = m.solve[std::size_t(i)];
+      Load& ld = m.loads[std::size_t(i)];
+      if (si < 0) {
+        if (ld.released) continue;
+        // An open load: does this tick's motion bring it within epsilon?
+        Eigen::Vector3d x = ld.base_W + p_W;
+        for (int j = 0; j < load_count; ++j) {
+          const int sj = slot[std::size_t(j)];
+          if (sj >= 0) x += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+        }
+        if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 0.5e-3) std::fprintf(stderr, "open %d dlin=%g base=(%g %g %g) p=(%g %g %g)\n", i, ld.distance_m + ld.normal_W.dot(x - ld.x0_W), ld.base_W.x(), ld.base_W.y(), ld.base_W.z(), p_W.x(), p_W.y(), p_W.z());
+        if (ld.distance_m + ld.normal_W.dot(x - ld.x0_W) < eps) {
+          ld.active = true;
+          changed = true;
+          if (!member[std::size_t(i)]) build_compliance();  // it cuts the tube now
+        }
+        continue;
+      }
       const Eigen::Vector3d F = m.z.segment<3>(3 * si);
-      const double normal_N = pc.normal_W.dot(F);
+      const double normal_N = ld.normal_W.dot(F);
+      if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) std::fprintf(stderr, "pass %d load %d d=%g N=%g F=(%g %g %g) x0=(%g %g %g) base=(%g %g %g) anchor=(%g %g %g) flin=(%g %g %g)\n", pass, i, ld.distance_m, normal_N, F.x(), F.y(), F.z(), ld.x0_W.x(), ld.x0_W.y(), ld.x0_W.z(), ld.base_W.x(), ld.base_W.y(), ld.base_W.z(), ld.anchor_W.x(), ld.anchor_W.y(), ld.anchor_W.z(), ld.f_lin_W.x(), ld.f_lin_W.y(), ld.f_lin_W.z());
+      if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) { Eigen::IOFormat f(4, 0, ", ", "; ", "", "", "[", "]"); std::cerr << "W00 " << m.W[0][0].format(f) << " r_H " << m.beam_loads[0].r_H_m.transpose() << " p " << p_W.transpose() << "\n"; }
       if (normal_N < 0.0) {
-        sv.active = false;
+        ld.active = false;
+        ld.released = true;  // once released in a tick it stays open: no cycling
         changed = true;
         break;
       }
-      const scene::Friction& friction =
-          scene::FrictionAt(scene_, elements_[std::size_t(pc.part_element)].part_index);
-      if (frictionless_scene || friction.IsFrictionless()) continue;
-      const Eigen::Vector3d Ft = F - normal_N * pc.normal_W;
-      if (!sv.sliding) {
-        const FrictionResult fr = ReturnMap(friction, Ft, normal_N, Kt);
+      if (!ld.friction) continue;
+      const Eigen::Vector3d Ft = F - normal_N * ld.normal_W;
+      if (!ld.sliding) {
+        const FrictionResult fr = ReturnMap(*ld.friction, Ft, normal_N, Kt);
         if (!fr.sliding) continue;
-        if (scene_.model.slip == scene::SlipRule::kPaper && !sv.shifted) {
+        if (scene_.model.slip == scene::SlipRule::kPaper && !ld.shifted) {
           // The paper: the contact point moves with the held end's tangential motion, then the
           // force is computed again (and limited below if that is still not enough).
           const Eigen::Vector3d dp = p_W - m.p_held_prev_W;
-          pc.anchor_W_m += dp - pc.normal_W * pc.normal_W.dot(dp);
-          sv.shifted = true;
+          ld.anchor_W += dp - ld.normal_W * ld.normal_W.dot(dp);
+          ld.shifted = true;
         } else {
-          sv.sliding = true;
-          sv.f_slide_W = fr.force_N;
+          ld.sliding = true;
+          ld.f_slide_W = fr.force_N;
         }
         changed = true;
       } else {
         // Keep the kinetic force consistent with the normal force it now presses with.
-        const double fk = FrictionLimit(friction, friction.kinetic_coefficient, normal_N);
-        const double now = sv.f_slide_W.norm();
+        const double fk =
+            FrictionLimit(*ld.friction, ld.friction->kinetic_coefficient, normal_N);
+        const double now = ld.f_slide_W.norm();
         if (now > 0.0 && std::abs(fk - now) > 1e-9 * (1.0 + fk)) {
-          sv.f_slide_W *= fk / now;
+          ld.f_slide_W *= fk / now;
           changed = true;
         }
       }
     }
-    if (!changed) {
+    if (changed) {
+      // The contact set changed: saturation is decided again on the new solution.
+      A = A_free;
+      saturated = false;
+    } else {
       const Eigen::Vector3d coupling_W = A - Kc_eff * p_W;
       const double magnitude = coupling_W.norm();
       if (magnitude > max_force * (1.0 + 1e-12)) {
-        // The spring cannot pull harder than the device can push: move its hand end towards
+        // The spring cannot pull harder than the device can push: its hand end moves towards
         // the proxy until it carries exactly the device's maximum; the proxy separates.
         A = Kc_eff * p_W + coupling_W * (max_force / magnitude);
         saturated = true;
@@ -455,55 +558,104 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return out;
   }
 
-  // 6. Results per contact; anchors of sliding contacts follow (the spring then carries f_k).
+  // 7. Results per load; a sliding load's anchor follows it (the spring then carries f_k).
   Eigen::Vector3d force_W = Eigen::Vector3d::Zero(), torque_W = Eigen::Vector3d::Zero();
-  int kept = 0;
-  for (int i = 0; i < pc_count; ++i) {
+  int beam_count = 0;
+  for (int i = 0; i < load_count; ++i) {
+    Load& ld = m.loads[std::size_t(i)];
     const int si = slot[std::size_t(i)];
-    if (si < 0) continue;
-    ContactState pc = pcs[std::size_t(i)];
-    const Impl::Solve& sv = m.solve[std::size_t(i)];
-    const Eigen::Vector3d F = m.z.segment<3>(3 * si);
-    Eigen::Vector3d x_H = sv.base_H;
-    for (int j = 0; j < pc_count; ++j) {
+    ld.x_W = ld.base_W + p_W;
+    for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
-      if (sj >= 0)
-        x_H += m.J[std::size_t(i)][std::size_t(j)] * (R_WH.transpose() * m.z.segment<3>(3 * sj));
+      if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
     }
-    pc.p_WC_m = p_W + R_WH * x_H;
-    pc.normal_force_N = std::max(0.0, pc.normal_W.dot(F));
-    pc.friction_W_N = F - pc.normal_W.dot(F) * pc.normal_W;
-    pc.force_W_N = F;
-    pc.sliding = sv.sliding;
-    pc.distance_m = pc.distance_m + pc.normal_W.dot(pc.p_WC_m - sv.x0_W);
-    const scene::Friction& friction =
-        scene::FrictionAt(scene_, elements_[std::size_t(pc.part_element)].part_index);
-    pc.friction_limit_N = frictionless_scene || friction.IsFrictionless()
-                              ? 0.0
-                              : FrictionLimit(friction, friction.static_coefficient,
-                                              pc.normal_force_N);
-    if (sv.sliding) {
-      pc.anchor_W_m = pc.p_WC_m + pc.friction_W_N / Kt;
-    } else if (frictionless_scene || friction.IsFrictionless()) {
-      pc.anchor_W_m = pc.p_WC_m;
+    ld.force_W = si >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * si)) : Eigen::Vector3d::Zero();
+    ld.distance_m += ld.normal_W.dot(ld.x_W - ld.x0_W);
+    if (!ld.active || !ld.friction) {
+      ld.anchor_W = ld.x_W;
+    } else if (ld.sliding) {
+      const Eigen::Vector3d Ft = ld.force_W - ld.normal_W.dot(ld.force_W) * ld.normal_W;
+      ld.anchor_W = ld.x_W + Ft / Kt;
     }
-    force_W += F;
-    torque_W += (pc.p_WC_m - p_W).cross(F);
-    m.loads[std::size_t(kept)] = BeamLoad{pc.s_m, R_WH.transpose() * F, 0.0, 0};
-    out.contacts[std::size_t(kept++)] = pc;
+    if (!ld.active) continue;
+    force_W += ld.force_W;
+    torque_W += (ld.x_W - p_W).cross(ld.force_W);
+    m.beam_loads[std::size_t(beam_count++)] =
+        BeamLoad{ld.s_m, R_WH.transpose() * ld.force_W, ld.r_H_m, 0.0, 0, ld.pc};
+  }
+
+  // PCs: those with an active load, aggregated over their loads, in canonical order.
+  int kept = 0;
+  for (int k = 0; k < found_count; ++k) {
+    ContactState pc;
+    pc.tube = found[std::size_t(k)].tube;
+    pc.part_element = found[std::size_t(k)].part_element;
+    pc.distance_m = std::numeric_limits<double>::infinity();
+    const scene::Friction* friction = nullptr;
+    for (int i = 0; i < load_count; ++i) {
+      const Load& ld = m.loads[std::size_t(i)];
+      if (ld.pc != k || !ld.active) continue;
+      ++pc.loads;
+      friction = ld.friction;
+      const double normal_N = std::max(0.0, ld.normal_W.dot(ld.force_W));
+      const Eigen::Vector3d Ft = ld.force_W - ld.normal_W.dot(ld.force_W) * ld.normal_W;
+      pc.normal_force_N += normal_N;
+      pc.friction_W_N += Ft;
+      pc.force_W_N += ld.force_W;
+      pc.sliding = pc.sliding || ld.sliding;
+      if (ld.friction) {
+        const double limit = FrictionLimit(*ld.friction, ld.friction->static_coefficient, normal_N);
+        const double ratio = limit > 0.0 ? Ft.norm() / limit : (Ft.norm() > 0.0 ? 1.0 : 0.0);
+        pc.friction_ratio = std::max(pc.friction_ratio, ratio);
+      }
+      if (ld.distance_m < pc.distance_m) {
+        pc.distance_m = ld.distance_m;
+        pc.normal_W = ld.normal_W;
+        pc.p_WC_m = ld.x_W;
+        pc.s_m = ld.s_m;
+      }
+    }
+    if (pc.loads == 0) continue;
+    pc.friction_limit_N =
+        friction ? FrictionLimit(*friction, friction->static_coefficient, pc.normal_force_N) : 0.0;
+    int at = kept++;
+    while (at > 0) {
+      const ContactState& before = out.contacts[std::size_t(at - 1)];
+      const bool in_order = before.tube != pc.tube ? before.tube < pc.tube
+                                                   : before.part_element < pc.part_element;
+      if (in_order) break;
+      out.contacts[std::size_t(at)] = before;
+      --at;
+    }
+    out.contacts[std::size_t(at)] = pc;
   }
   out.contact_count = kept;
 
-  // 7. The shape under the solved loads: the next tick's capsules, energy, strain, markers.
-  m.load_count = kept;
-  m.group_count = m.beam.Assign(m.loads, kept, m.order);
-  m.elastica_shape = want_elastica && kept > 0 &&
-                     m.beam.ElasticaCovers(m.loads, kept, m.group_count);
+  // 8. The shape under the solved loads: the next tick's capsules, energy, strain, markers.
+  m.beam_count = beam_count;
+  std::array<bool, kMaxLoads> all{};
+  all.fill(true);
+  int members = 0;
+  const int groups = m.beam.Assign(m.beam_loads, beam_count, all, m.order, members);
+  m.elastica_shape = want_elastica && beam_count > 0 &&
+                     m.beam.ElasticaCovers(m.beam_loads, m.order, beam_count, groups);
   const double EI = m.beam.bending_stiffness_Nm2();
   const double r1 = scene_.tube.outer_radius_m;
   double energy_J = 0.0, strain = 0.0;
+  const auto bend_at = [&](double s) {
+    // Where the tube curves to at s (lateral, H): the loads beyond s on its cantilever, each
+    // force by its lever and each offset moment turned into the direction it bends towards.
+    Eigen::Vector3d bend = Eigen::Vector3d::Zero();
+    for (int j = 0; j < beam_count; ++j) {
+      const BeamLoad& b = m.beam_loads[std::size_t(j)];
+      if (!(b.clamp_m <= s && s < b.s_m)) continue;
+      const Eigen::Vector3d moment = b.r_H_m.cross(b.f_H_N);
+      bend += (b.s_m - s) * lateral * b.f_H_N + (lateral * moment).cross(Eigen::Vector3d::UnitZ());
+    }
+    return bend;
+  };
   if (m.elastica_shape) {
-    m.segment_count = m.beam.SolveElasticaChain(m.loads, kept, m.order, m.segments);
+    m.segment_count = m.beam.SolveElasticaChain(m.beam_loads, beam_count, m.order, m.segments);
     for (int k = 0; k <= N; ++k)
       m.nodes_H[std::size_t(k)] = m.beam.ElasticaPoint(m.segments, m.segment_count, l * k / N);
     m.tip_tangent_H = m.beam.ElasticaTipTangent(m.segments, m.segment_count);
@@ -515,37 +667,33 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
   } else {
     m.segment_count = 0;
-    Eigen::Vector2d slope = Eigen::Vector2d::Zero();
+    Eigen::Vector3d rotation = Eigen::Vector3d::Zero();
     for (int k = 0; k <= N; ++k) {
       const double s = l * k / N;
-      Eigen::Vector2d lateral_m = Eigen::Vector2d::Zero();
-      for (int j = 0; j < kept; ++j)
-        lateral_m += m.beam.Influence(s, m.loads[std::size_t(j)]) *
-                     m.loads[std::size_t(j)].f_H_N.head<2>();
-      m.nodes_H[std::size_t(k)] = Eigen::Vector3d(lateral_m.x(), lateral_m.y(), s);
+      Eigen::Vector3d x = Eigen::Vector3d(0.0, 0.0, s);
+      for (int j = 0; j < beam_count; ++j)
+        x += m.beam.CentreDisplacement(s, m.beam_loads[std::size_t(j)]);
+      m.nodes_H[std::size_t(k)] = x;
     }
-    for (int j = 0; j < kept; ++j)
-      slope += m.beam.InfluenceSlope(l, m.loads[std::size_t(j)]) *
-               m.loads[std::size_t(j)].f_H_N.head<2>();
-    m.tip_tangent_H = Eigen::Vector3d(slope.x(), slope.y(), 1.0).normalized();
-    // U = 1/2 sum over loads on the same cantilever of F_i . infl F_j (the compliance energy).
-    for (int i = 0; i < kept; ++i)
-      for (int j = 0; j < kept; ++j) {
-        const BeamLoad& a = m.loads[std::size_t(i)];
-        const BeamLoad& b = m.loads[std::size_t(j)];
-        if (a.clamp_m != b.clamp_m) continue;
-        energy_J += 0.5 * m.beam.Influence(a.s_m, b) * a.f_H_N.head<2>().dot(b.f_H_N.head<2>());
+    for (int j = 0; j < beam_count; ++j)
+      rotation += m.beam.SectionRotation(l, m.beam_loads[std::size_t(j)]);
+    m.tip_tangent_H = (Eigen::Vector3d::UnitZ() + rotation.cross(Eigen::Vector3d::UnitZ())).normalized();
+    // U = 1/2 sum over loads on one cantilever of F_i . W_ij F_j: the work of the loads.
+    for (int i = 0; i < beam_count; ++i)
+      for (int j = 0; j < beam_count; ++j) {
+        const BeamLoad& a = m.beam_loads[std::size_t(i)];
+        const BeamLoad& b = m.beam_loads[std::size_t(j)];
+        if (a.clamp_m == b.clamp_m) energy_J += 0.5 * a.f_H_N.dot(m.beam.Compliance(a, b) * b.f_H_N);
       }
-    // The bending moment is piecewise linear between clamps and load points: its largest value
-    // is at one of them.
-    for (int c = 0; c < 2 * kept; ++c) {
-      const double s = c < kept ? m.loads[std::size_t(c)].clamp_m : m.loads[std::size_t(c - kept)].s_m;
-      Eigen::Vector2d moment = Eigen::Vector2d::Zero();
-      for (int j = 0; j < kept; ++j) {
-        const BeamLoad& b = m.loads[std::size_t(j)];
-        if (b.clamp_m <= s && s < b.s_m) moment += (b.s_m - s) * b.f_H_N.head<2>();
+    // The bending moment is piecewise linear between clamps and load points (with jumps at the
+    // offset moments): its largest value is at one of them, from either side.
+    for (int c = 0; c < 2 * beam_count; ++c) {
+      const BeamLoad& at = m.beam_loads[std::size_t(c % beam_count)];
+      const double s = c < beam_count ? at.clamp_m : at.s_m;
+      for (const double side : {s, s - 1e-9 * l}) {
+        if (side < 0.0) continue;
+        strain = std::max(strain, r1 * bend_at(side).norm() / EI);
       }
-      strain = std::max(strain, r1 * moment.norm() / EI);
     }
   }
   out.energy_J = energy_J;
@@ -554,7 +702,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
 
   // Markers (contact-states.md): no bending below the threshold; the end face and rim never
   // deform; a side contact is concave or convex by the side of the bend it touches, judged by
-  // the bending moment midway along the cantilever piece that ends at it.
+  // where the tube curves midway along the piece of cantilever that ends at it.
   const bool bends = out.tip_deflection_m > scene_.contact.bend_threshold_m;
   for (int i = 0; i < kept; ++i) {
     ContactState& pc = out.contacts[std::size_t(i)];
@@ -566,53 +714,43 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       pc.marker = states::Marker::kBent;
       continue;
     }
-    const BeamLoad& own = m.loads[std::size_t(i)];
-    double before_m = own.clamp_m;
-    for (int j = 0; j < kept; ++j) {
-      const double sj = m.loads[std::size_t(j)].s_m;
-      if (sj < own.s_m - m.beam.group_tolerance_m()) before_m = std::max(before_m, sj);
+    double before_m = 0.0;
+    for (int j = 0; j < beam_count; ++j) {
+      const double sj = m.beam_loads[std::size_t(j)].s_m;
+      if (sj < pc.s_m - m.beam.group_tolerance_m()) before_m = std::max(before_m, sj);
     }
-    const double mid = 0.5 * (before_m + own.s_m);
-    Eigen::Vector2d moment = Eigen::Vector2d::Zero();
-    for (int j = 0; j < kept; ++j) {
-      const BeamLoad& b = m.loads[std::size_t(j)];
-      if (b.clamp_m <= mid && mid < b.s_m) moment += (b.s_m - mid) * b.f_H_N.head<2>();
-    }
-    const Eigen::Vector2d n_H = (R_WH.transpose() * pc.normal_W).head<2>();
-    const double side = moment.dot(n_H);
-    // The tube curves towards `moment`: along the normal (away from the part) the part touches
-    // the outside of the bend.
-    if (side > 1e-12 * moment.norm())
+    const Eigen::Vector3d bend = bend_at(0.5 * (before_m + pc.s_m));
+    const Eigen::Vector3d n_H = lateral * (R_WH.transpose() * pc.normal_W);
+    const double side = bend.dot(n_H);
+    // Curving along the normal (away from the part): the part touches the outside of the bend.
+    if (side > 1e-9 * bend.norm())
       pc.marker = states::Marker::kConvex;
-    else if (side < -1e-12 * moment.norm())
+    else if (side < -1e-9 * bend.norm())
       pc.marker = states::Marker::kConcave;
     else
       pc.marker = states::Marker::kBent;
   }
 
-  // 8. The operator's wrench, and the state for the next tick.
+  // 9. The operator's wrench, and the state for the next tick.
   out.X_WH = X_W_hand;
   out.X_WH.translation() = p_W;
   out.force_W_N = force_W;
   out.torque_W_Nm = torque_W;
-  if (force_W.norm() > max_force * (1.0 + 1e-9) ||
-      torque_W.norm() > scene_.device.max_torque_Nm)
+  if (force_W.norm() > max_force * (1.0 + 1e-9) || torque_W.norm() > scene_.device.max_torque_Nm)
     out.flags |= kForceClamped;
-  const bool finite = AllFinite(force_W) && AllFinite(torque_W) && AllFinite(p_W) &&
+  const bool finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
                       std::isfinite(energy_J) && std::isfinite(strain);
   if (!finite) {
-    out.flags |= kSolverFault;
-    out.force_W_N.setZero();
-    out.torque_W_Nm.setZero();
-    out.contact_count = 0;
-    Reset(Eigen::Isometry3d(X_W_hand));
+    Reset(X_W_hand);
     out.flags |= kSolverFault;
     return out;
   }
   m.p_hand_prev_W = p_hand_W;
   m.p_held_prev_W = p_W;
-  m.prev = out.contacts;
-  m.prev_count = kept;
+  // Ghosts have done their work; the next tick continues this tick's real loads.
+  m.prev_count = 0;
+  for (int i = 0; i < load_count; ++i)
+    if (!m.loads[std::size_t(i)].ghost) m.prev[std::size_t(m.prev_count++)] = m.loads[std::size_t(i)];
   return out;
 }
 
@@ -624,15 +762,12 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
   const Eigen::Vector3d p_WH = out_.X_WH.translation();
   for (std::size_t k = 0; k < count; ++k) {
     const double s = count > 1 ? l * double(k) / double(count - 1) : l;
-    Eigen::Vector3d x_H;
+    Eigen::Vector3d x_H(0.0, 0.0, s);
     if (m.elastica_shape) {
       x_H = m.beam.ElasticaPoint(m.segments, m.segment_count, s);
     } else {
-      Eigen::Vector2d lateral_m = Eigen::Vector2d::Zero();
-      for (int j = 0; j < m.load_count; ++j)
-        lateral_m += m.beam.Influence(s, m.loads[std::size_t(j)]) *
-                     m.loads[std::size_t(j)].f_H_N.head<2>();
-      x_H = Eigen::Vector3d(lateral_m.x(), lateral_m.y(), s);
+      for (int j = 0; j < m.beam_count; ++j)
+        x_H += m.beam.CentreDisplacement(s, m.beam_loads[std::size_t(j)]);
     }
     p_W_m[k] = p_WH + R_WH * x_H;
   }

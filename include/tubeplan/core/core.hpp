@@ -41,6 +41,10 @@ namespace tubeplan::core {
 /// Most load points (merged PCs) the core resolves at once; further PCs, the shallowest, are
 /// dropped for that tick and flagged kContactsTruncated.
 inline constexpr int kMaxContacts = 6;
+/// Most load points at once: a PC whose contact region is longer than a tube radius (a side lying
+/// along a face) is carried by two, at the ends of the region, so that its resultant can move
+/// and its moment is carried; others by one.
+inline constexpr int kMaxLoads = 8;
 /// Most capsules in the tube's chain (the count is chosen per scene, see ChainCapsuleCount).
 inline constexpr int kMaxCapsules = 48;
 
@@ -59,16 +63,19 @@ struct ContactState {
   states::TubeElement tube = states::TubeElement::kSide;
   states::Marker marker = states::Marker::kNone;
   int part_element = -1;  ///< index into Core::elements()
-  double s_m = 0.0;       ///< arc position of the load point on the centreline [m]
+  int loads = 0;          ///< load points carrying it (1 or 2)
+  double s_m = 0.0;       ///< arc position of its (deepest) load point on the centreline [m]
   double distance_m = 0.0;  ///< smallest distance d between the two elements [m]
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< unit, from the part into the tube
-  Eigen::Vector3d p_WC_m = Eigen::Vector3d::Zero();     ///< load point (centreline) in W [m]
-  Eigen::Vector3d anchor_W_m = Eigen::Vector3d::Zero(); ///< where the stuck load point is held
-  double normal_force_N = 0.0;                          ///< >= 0
+  Eigen::Vector3d p_WC_m = Eigen::Vector3d::Zero();     ///< deepest contact point on the tube
+  double normal_force_N = 0.0;                          ///< sum over its load points, >= 0
   Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< tangential force on the tube
   Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();     ///< total force on the tube
-  double friction_limit_N = 0.0;  ///< f_max = mu_s N0 (N/N0)^beta at this normal force
-  bool sliding = false;
+  /// Largest |friction| / f_max(mu_s, N) over its load points (<= 1 always; 1 when sliding
+  /// with mu_k = mu_s) and f_max of the total normal force.
+  double friction_ratio = 0.0;
+  double friction_limit_N = 0.0;
+  bool sliding = false;   ///< any of its load points slides
 };
 
 /// What one tick returns. Plain data; valid until the next Step.

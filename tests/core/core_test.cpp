@@ -1,0 +1,153 @@
+// Physics of the core against closed forms on small scenes made here (issue 3's list).
+#include <cmath>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/model/tube.hpp>
+
+using namespace tubeplan;
+
+namespace {
+
+// A tube along world +z from the held end at the origin; parts added by the test.
+scene::Scene TubeScene(double E_Pa = 200e9, double r1 = 3e-3, double r2 = 2.5e-3, double l = 0.3) {
+  scene::Scene s;
+  s.name = "test";
+  s.tube = {r1, r2, l, E_Pa, 0.3};
+  s.contact.stiffness_N_per_m = 1e4;
+  s.contact.threshold_m = 1e-3;
+  s.contact.bend_threshold_m = 1e-4;
+  s.device.coupling_stiffness_N_per_m = 400.0;
+  s.device.coupling_damping_Ns_per_m = 0.0;
+  s.model.beam = model::BeamModel::kLinear;
+  return s;
+}
+
+scene::BoxPart Box(const std::string& name, Eigen::Vector3d size, Eigen::Vector3d centre) {
+  scene::BoxPart b;
+  b.name = name;
+  b.size_m = size;
+  b.X_WP = Eigen::Translation3d(centre) * Eigen::Isometry3d::Identity();
+  return b;
+}
+
+Eigen::Isometry3d At(Eigen::Vector3d p) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = p;
+  return X;
+}
+
+// Holds the hand at X for `ticks` ticks (the damper relaxes; the state settles).
+const core::StepOutput& Hold(core::Core& c, const Eigen::Isometry3d& X, int ticks, double& t) {
+  const core::StepOutput* out = nullptr;
+  for (int i = 0; i < ticks; ++i) out = &c.Step(t += 1e-3, X);
+  return *out;
+}
+
+}  // namespace
+
+TEST_CASE("A frictionless wall facing the tip: normal force K (eps - d), no bending", "[core]") {
+  scene::Scene s = TubeScene();
+  const double l = s.tube.length_m;
+  // The wall's bottom face 0.5 mm beyond the tip: inside epsilon already.
+  s.parts.push_back(Box("wall", {0.1, 0.1, 0.02}, {0.0, 0.0, l + 0.5e-3 + 0.01}));
+  core::Core c(s);
+  double t = 0.0;
+  for (const double push_m : {0.0, 1e-3, 5e-3, 15e-3}) {
+    const core::StepOutput& out = Hold(c, At({0.0, 0.0, push_m}), 300, t);
+    INFO("push " << push_m << " m: " << c.FormationText());
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    CHECK(pc.tube == states::TubeElement::kEndFace);
+    CHECK(c.elements()[std::size_t(pc.part_element)].name == "wall.bottom");
+    CHECK(pc.marker == states::Marker::kNone);
+    // The penalty law on the distance the core reports.
+    CHECK(pc.normal_force_N == Approx(1e4 * (1e-3 - pc.distance_m)).epsilon(1e-9));
+    // Springs in series: coupling 400 N/m and contact 1e4 N/m between the hand and the wall's
+    // epsilon surface; the tube is axially rigid.
+    const double gap_m = 0.5e-3 - 1e-3;  // wall face minus epsilon, from the undeformed tip
+    const double expected = std::max(0.0, (push_m - gap_m) / (1.0 / 400.0 + 1.0 / 1e4));
+    CHECK(out.force_W_N.z() == Approx(-expected).epsilon(1e-6));
+    CHECK(out.force_W_N.head<2>().norm() < 1e-9);
+    CHECK(out.tip_deflection_m < 1e-12);
+    CHECK(out.energy_J < 1e-15);
+  }
+}
+
+TEST_CASE("Tip stuck on a wall, the hand moves sideways: 3EI/l^3 in series, then kinetic", "[core]") {
+  scene::Scene s = TubeScene();
+  const double l = s.tube.length_m;
+  s.friction = {0.5, 0.2, 1.0, 1.0};
+  s.parts.push_back(Box("wall", {0.1, 0.1, 0.02}, {0.0, 0.0, l + 0.5e-3 + 0.01}));
+  core::Core c(s);
+  const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
+  const double k_tip = 3.0 * EI / (l * l * l);
+  // Coupling, bending and the tangential contact spring (as stiff as K) in series.
+  const double k_series = 1.0 / (1.0 / 400.0 + 1.0 / k_tip + 1.0 / 1e4);
+  double t = 0.0;
+  const double push_m = 2e-3;
+  const core::StepOutput& pressed = Hold(c, At({0.0, 0.0, push_m}), 300, t);
+  REQUIRE(pressed.contact_count == 1);
+  const double N = pressed.contacts[0].normal_force_N;
+  // The hand moves sideways 5 um per tick (5 mm/s) and the tube is checked at every tick.
+  bool slid = false;
+  for (int tick = 1; tick <= 1000; ++tick) {
+    const double delta_m = 5e-6 * tick;
+    const core::StepOutput& out = c.Step(t += 1e-3, At({delta_m, 0.0, push_m}));
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    // The tube is axially rigid and the wall flat, so the normal force changes only because the
+    // end face tilts by theta = F l^2 / (2 E I) and its near rim comes closer by r1 theta.
+    const double theta = std::abs(out.force_W_N.x()) * l * l / (2.0 * EI);
+    CHECK(std::abs(pc.normal_force_N - N) <= 1e4 * s.tube.outer_radius_m * theta + 1e-9);
+    CHECK(pc.friction_W_N.norm() <= pc.friction_limit_N * (1.0 + 1e-12));
+    if (!slid && !pc.sliding) {
+      // Stuck: the spring chain's force; the wall holds the tip back (-x on the tube). The hand
+      // moves, so the coupling's damper (0 here) adds nothing; 1e-6 covers the linearisation
+      // of the rim's approach above.
+      CHECK(out.force_W_N.x() == Approx(-delta_m * k_series).epsilon(1e-6));
+    }
+    if (pc.sliding) {
+      slid = true;
+      // Sliding: exactly the kinetic force at this normal force (mu_k N, beta = 1), and the
+      // static limit was reached first.
+      CHECK(pc.friction_W_N.norm() == Approx(0.2 * pc.normal_force_N).epsilon(1e-8));
+      CHECK(delta_m * k_series >= 0.5 * N * (1.0 - 1e-3));
+    }
+  }
+  CHECK(slid);
+}
+
+TEST_CASE("The side on an edge at distance a: stiffness 3EI/a^3 in series, convex", "[core]") {
+  scene::Scene s = TubeScene();
+  const double r1 = s.tube.outer_radius_m;
+  const double a = 0.2;
+  const double d0 = 0.5e-3;
+  // A 20 mm cube turned 45 degrees about y: one edge (along y) points at the tube, at height a.
+  scene::BoxPart block = Box("block", {0.02, 0.02, 0.02}, {r1 + d0 + 0.01 * std::sqrt(2.0), 0.0, a});
+  block.X_WP.linear() = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  s.parts.push_back(block);
+  core::Core c(s);
+  const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
+  const double k_series = 1.0 / (1.0 / 400.0 + a * a * a / (3.0 * EI) + 1.0 / 1e4);
+  double t = 0.0;
+  for (const double delta_m : {0.0, 1e-3, 3e-3}) {
+    const core::StepOutput& out = Hold(c, At({delta_m, 0.0, 0.0}), 300, t);
+    INFO("delta " << delta_m << ": " << c.FormationText());
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    CHECK(pc.tube == states::TubeElement::kSide);
+    CHECK(c.elements()[std::size_t(pc.part_element)].kind == scene::ElementKind::kEdge);
+    // The tube's slope at a, theta = F a^2 / (2 E I) <= 3.5e-3 rad here, moves the touching point
+    // along the axis by r1 theta (<= 1.1e-5 m) and turns the normal off x, which changes the
+    // force by about theta^2 (<= 1.2e-5 relative).
+    const double theta = std::abs(out.force_W_N.x()) * a * a / (2.0 * EI);
+    CHECK(pc.s_m == Approx(a).margin(1.01 * r1 * theta + 1e-9));
+    // Plus K times GJK's distance error for an edge (measured below 1e-9 m): 1e-5 N.
+    CHECK(-out.force_W_N.x() == Approx((delta_m + 1e-3 - d0) * k_series)
+                                    .epsilon(2.0 * theta * theta)
+                                    .margin(1e-5));
+    if (out.tip_deflection_m > 1e-4) CHECK(pc.marker == states::Marker::kConvex);
+  }
+}
