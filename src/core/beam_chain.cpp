@@ -106,9 +106,9 @@ Coefficients Coeffs(double a, double b, double EI) {
 }
 }  // namespace
 
-Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j) const {
+Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool moments) const {
   const Coefficients c = Coeffs(i.s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
-  const Eigen::Matrix3d Rj = Skew(j.r_H_m);
+  const Eigen::Matrix3d Rj = moments ? Skew(j.r_H_m) : Eigen::Matrix3d::Zero();
   return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
 }
 
@@ -133,11 +133,19 @@ bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxLoads>& loads,
   std::array<double, kMaxLoads> length;
   resultant.fill(Eigen::Vector3d::Zero());
   length.fill(0.0);
+  std::array<double, kMaxLoads> first;
+  first.fill(0.0);
   for (int k = 0; k < count; ++k) {
+    // Groups are runs of `order` (it is sorted by arc position).
     const BeamLoad& load = loads[std::size_t(order[std::size_t(k)])];
-    resultant[std::size_t(load.group)] += load.f_H_N;
-    length[std::size_t(load.group)] =
-        std::max(length[std::size_t(load.group)], load.s_m - load.clamp_m);
+    const std::size_t g = std::size_t(load.group);
+    if (k == 0 || loads[std::size_t(order[std::size_t(k - 1)])].group != load.group)
+      first[g] = load.s_m;
+    resultant[g] += load.f_H_N;
+    length[g] = std::max(length[g], load.s_m - load.clamp_m);
+    // The elastica takes one load at the segment's end. A region up to a tube diameter long (the
+    // end cylinder's side on a face) is taken as that load; a side lying along a face is not.
+    if (load.s_m - first[g] > 2.0 * group_tolerance_m_) return false;
   }
   for (int g = 0; g < groups; ++g) {
     const double L = length[std::size_t(g)];

@@ -73,7 +73,9 @@ class BeamChain {
   double InfluenceSlope(double s_m, const BeamLoad& load) const;
 
   /// W_ij above [m/N], frame H: displacement of load i's surface point per force of load j.
-  Eigen::Matrix3d Compliance(const BeamLoad& i, const BeamLoad& j) const;
+  /// Without `moments` the offset moment r_j x F_j is left out (the elastica carries tip forces
+  /// only, and the compliance must describe the shape the model will produce).
+  Eigen::Matrix3d Compliance(const BeamLoad& i, const BeamLoad& j, bool moments = true) const;
   /// Displacement of the centre at s_m [m] and rotation of its section [rad], frame H, under
   /// load j (force and the moment of its offset).
   Eigen::Vector3d CentreDisplacement(double s_m, const BeamLoad& j) const;

@@ -3,9 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <iostream>
-#include <cstdlib>
 
 #include <Eigen/LU>
 
@@ -213,10 +210,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
       2.0 * eps, std::span<RawContact>(m.raw.data(), m.raw.size()));
 
-  if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) {
-    for (int i = 0; i < raw_count; ++i) std::fprintf(stderr, "t=%g raw %d tube %d elem %d d=%g s=%g p=(%g %g %g)\n", t_s, i, int(m.raw[std::size_t(i)].tube), m.raw[std::size_t(i)].part_element, m.raw[std::size_t(i)].distance_m, m.raw[std::size_t(i)].s_m, m.raw[std::size_t(i)].p_W_m.x(), m.raw[std::size_t(i)].p_W_m.y(), m.raw[std::size_t(i)].p_W_m.z());
-    std::fprintf(stderr, "tip node (%g %g %g) tangent (%g %g %g)\n", m.nodes_W[std::size_t(N)].x(), m.nodes_W[std::size_t(N)].y(), m.nodes_W[std::size_t(N)].z(), tip_tangent_W.x(), tip_tangent_W.y(), tip_tangent_W.z());
-  }
   // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
   // one's PC (an edge of the face a side lies on, the rim of an end face lying flat).
   for (int i = 0; i < raw_count; ++i) {
@@ -377,9 +370,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     for (int i = 0; i < load_count; ++i)
       for (int j = 0; j < load_count; ++j)
         m.W[std::size_t(i)][std::size_t(j)] =
-            member[std::size_t(j)]
-                ? m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)])
-                : Eigen::Matrix3d::Zero();
+            member[std::size_t(j)] ? m.beam.Compliance(m.beam_loads[std::size_t(i)],
+                                                       m.beam_loads[std::size_t(j)], !use_elastica)
+                                   : Eigen::Matrix3d::Zero();
     if (use_elastica) {
       // Within a segment the elastica's own tangent replaces the linear force compliance; the
       // rotation terms and the loads of earlier segments keep their linear values.
@@ -415,8 +408,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
   };
   build_compliance();
-  if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 0.5e-3)
-    for (int i = 0; i < load_count; ++i) { const Load& ld = m.loads[std::size_t(i)]; std::fprintf(stderr, "load %d tube %d end %d s=%g d=%g active=%d ghost=%d member=%d flin=(%g %g %g)\n", i, int(ld.tube), ld.end, ld.s_m, ld.distance_m, int(ld.active), int(ld.ghost), int(member[std::size_t(i)]), ld.f_lin_W.x(), ld.f_lin_W.y(), ld.f_lin_W.z()); }
   if (want_elastica && load_count > 0 && !use_elastica) out.flags |= kLinearFallback;
 
   // 6. Solve contacts, coupling and beam together. Unknowns: the load forces F_i (W) and the
@@ -482,7 +473,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
           const int sj = slot[std::size_t(j)];
           if (sj >= 0) x += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
         }
-        if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 0.5e-3) std::fprintf(stderr, "open %d dlin=%g base=(%g %g %g) p=(%g %g %g)\n", i, ld.distance_m + ld.normal_W.dot(x - ld.x0_W), ld.base_W.x(), ld.base_W.y(), ld.base_W.z(), p_W.x(), p_W.y(), p_W.z());
         if (ld.distance_m + ld.normal_W.dot(x - ld.x0_W) < eps) {
           ld.active = true;
           changed = true;
@@ -492,8 +482,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
       const Eigen::Vector3d F = m.z.segment<3>(3 * si);
       const double normal_N = ld.normal_W.dot(F);
-      if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) std::fprintf(stderr, "pass %d load %d d=%g N=%g F=(%g %g %g) x0=(%g %g %g) base=(%g %g %g) anchor=(%g %g %g) flin=(%g %g %g)\n", pass, i, ld.distance_m, normal_N, F.x(), F.y(), F.z(), ld.x0_W.x(), ld.x0_W.y(), ld.x0_W.z(), ld.base_W.x(), ld.base_W.y(), ld.base_W.z(), ld.anchor_W.x(), ld.anchor_W.y(), ld.anchor_W.z(), ld.f_lin_W.x(), ld.f_lin_W.y(), ld.f_lin_W.z());
-      if (std::getenv("TP_DEBUG") && std::abs(t_s - std::atof(std::getenv("TP_DEBUG"))) < 1.5e-3) { Eigen::IOFormat f(4, 0, ", ", "; ", "", "", "[", "]"); std::cerr << "W00 " << m.W[0][0].format(f) << " r_H " << m.beam_loads[0].r_H_m.transpose() << " p " << p_W.transpose() << "\n"; }
       if (normal_N < 0.0) {
         ld.active = false;
         ld.released = true;  // once released in a tick it stays open: no cycling
