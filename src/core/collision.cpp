@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 namespace tubeplan::core {
 namespace {
@@ -57,6 +58,68 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     Part part{p, fcl::Boxd(box.size_m), box.X_WP, box.X_WP.inverse(), 0.5 * box.size_m};
     parts_.push_back(part);
   }
+}
+
+double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 const Eigen::Vector3d& half, double& t_min) {
+  // f(t) = sum over axes of max(0, |a + t (b - a)| - h)^2 is convex and, between the parameters
+  // where a coordinate crosses a face plane (at most six), quadratic in t: minimise it exactly on
+  // each piece. All points in the box's frame.
+  const Eigen::Vector3d d = b - a;
+  std::array<double, 8> cuts{};
+  int n = 0;
+  cuts[std::size_t(n++)] = 0.0;
+  cuts[std::size_t(n++)] = 1.0;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0.0) continue;
+    for (const double side : {-1.0, 1.0}) {
+      const double t = (side * half[k] - a[k]) / d[k];
+      if (t > 0.0 && t < 1.0) cuts[std::size_t(n++)] = t;
+    }
+  }
+  for (int i = 1; i < n; ++i)  // insertion sort: at most 8
+    for (int j = i; j > 0 && cuts[std::size_t(j - 1)] > cuts[std::size_t(j)]; --j)
+      std::swap(cuts[std::size_t(j - 1)], cuts[std::size_t(j)]);
+  double best = std::numeric_limits<double>::infinity();
+  t_min = 0.0;
+  for (int i = 0; i + 1 < n; ++i) {
+    const double t0 = cuts[std::size_t(i)], t1 = cuts[std::size_t(i) + 1];
+    const double tm = 0.5 * (t0 + t1);
+    // On this piece each axis is below, inside or above the box: f = A t^2 + B t + C.
+    double A = 0.0, B = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = a[k] + tm * d[k];
+      if (std::abs(x) <= half[k]) continue;
+      const double offset = a[k] - (x > 0.0 ? half[k] : -half[k]);  // (offset + t d)^2
+      A += d[k] * d[k];
+      B += 2.0 * offset * d[k];
+    }
+    double t = A > 0.0 ? std::clamp(-B / (2.0 * A), t0, t1) : t0;
+    // Evaluate f directly (not from A, B, C) so that the value carries no cancellation.
+    double f = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double excess = std::abs(a[k] + t * d[k]) - half[k];
+      if (excess > 0.0) f += excess * excess;
+    }
+    if (f < best) best = f, t_min = t;
+  }
+  return best;
+}
+
+bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_W,
+                                   const Eigen::Vector3d& b_W, double& distance_m,
+                                   Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W) const {
+  const Eigen::Vector3d a_P = part.X_PW * a_W;
+  const Eigen::Vector3d b_P = part.X_PW * b_W;
+  double t = 0.0;
+  const double axis_m = std::sqrt(SegmentBoxDistanceSquared(a_P, b_P, part.half_m, t));
+  const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
+  const Eigen::Vector3d q_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
+  if (!(axis_m > radius_m_)) return false;  // overlap (or the axis inside the box)
+  distance_m = axis_m - radius_m_;
+  q_part_W = part.X_WP * q_P;
+  p_tube_W = part.X_WP * (c_P + (q_P - c_P) * (radius_m_ / axis_m));
+  return true;
 }
 
 std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) const {
@@ -130,8 +193,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
       ++narrow_calls_;
       const bool separated =
           is_end ? solver_.shapeDistance(end_, X_WS, part.box, part.X_WP, &d, &p_tube_W, &q_part_W)
-                 : solver_.shapeDistance(capsule_, X_WS, part.box, part.X_WP, &d, &p_tube_W,
-                                         &q_part_W);
+                 : CapsuleBoxDistance(part, a_W, b_W, d, p_tube_W, q_part_W);
       RawContact c;
       c.part = part.index;
       if (separated && d >= band_m) continue;

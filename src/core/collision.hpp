@@ -35,6 +35,11 @@ struct RawContact {
 
 inline constexpr int kMaxRawContacts = 4 * kMaxCapsules;
 
+/// Squared distance from the segment a-b to the box [-half, half] (all in the box's frame), and
+/// the segment parameter t in [0, 1] of a nearest point. Exact (convex piecewise quadratic).
+double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 const Eigen::Vector3d& half, double& t_min);
+
 class Collision {
  public:
   /// `element_of[part][mask]` is the element index of a face mask of a part.
@@ -67,6 +72,10 @@ class Collision {
   std::uint8_t FaceMask(const Part& part, const Eigen::Vector3d& q_W) const;
   bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
                         double band_m) const;
+  // Capsule (segment a-b swept by r1) against the box, in closed form; false when they overlap.
+  bool CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                          double& distance_m, Eigen::Vector3d& p_tube_W,
+                          Eigen::Vector3d& q_part_W) const;
   void Overlapping(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
                    RawContact& c) const;
 
@@ -74,7 +83,7 @@ class Collision {
   std::vector<std::array<int, 64>> element_of_;
   fcl::Capsuled capsule_;
   fcl::Cylinderd end_;
-  fcl::detail::GJKSolver_indep<double> solver_;
+  mutable fcl::detail::GJKSolver_indep<double> solver_;
   double radius_m_ = 0.0;
   double length_m_ = 0.0;
   double piece_m_ = 0.0;        // arc length of one capsule, l / N

@@ -769,6 +769,8 @@ states::ContactFormation Core::Formation() const {
   return cf;
 }
 
+int Core::narrow_phase_calls() const { return impl_->collision.last_narrow_phase_calls(); }
+
 std::string Core::FormationText() const { return states::ToString(Formation()); }
 
 }  // namespace tubeplan::core
