@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/model/elastica.hpp>
 #include <tubeplan/model/linear_beam.hpp>
@@ -27,7 +28,8 @@ namespace tubeplan::cli {
 namespace {
 
 struct BenchOptions {
-  std::string scene_path;
+  std::string scene_path = "scenes/groove.yaml";
+  bool beam_only = false;
   int samples = 2000;
   bool json = false;
 };
@@ -40,6 +42,9 @@ struct Scenario {
   /// Runs calls_per_sample calls with inputs chosen by the sample index; returns a value that
   /// depends on every result so the compiler cannot drop the work.
   std::function<double(int sample)> run;
+  double target_p999_s = 0.0;  ///< the figure set for p99.9; 0 when none
+  /// For core scenarios: what the core was doing while timed (asked after the run).
+  std::function<nlohmann::json()> state = nullptr;
 };
 
 struct Figures {
@@ -141,15 +146,129 @@ std::vector<Scenario> MakeScenarios(const model::TubeSpec& spec) {
   return scenarios;
 }
 
+Eigen::Isometry3d HandPose(double x_m, double y_m, double z_m, double tip_down_deg,
+                           double yaw_deg) {
+  // The groove scene's convention: roll -90 deg lays the tube's z along world +y; a further roll
+  // tips the free end down, and yaw turns the tube about the vertical.
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = (Eigen::AngleAxisd(yaw_deg * kDeg, Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd((-90.0 - tip_down_deg) * kDeg, Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
+  X.translation() = Eigen::Vector3d(x_m, y_m, z_m);
+  return X;
+}
+
+// One core scenario: the hand moves from the scene's start to `at` in 0.5 s, stays 0.3 s, and is
+// then timed tick by tick while `motion` (a function of the tick index) moves it about there.
+struct CoreRun {
+  std::shared_ptr<core::Core> core;
+  double t_s = 0.0;
+  long tick = 0;
+};
+
+Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string what,
+                      Eigen::Isometry3d at,
+                      std::function<Eigen::Isometry3d(const Eigen::Isometry3d&, long)> motion,
+                      bool mesh = false) {
+  auto run = std::make_shared<CoreRun>();
+  run->core = std::make_shared<core::Core>(scene);
+  const Eigen::Isometry3d start = scene.X_WH_start;
+  const double T = scene.model.time_step_s;
+  for (int i = 0; i <= 800; ++i) {
+    const double u = std::min(1.0, i / 500.0);
+    const double w = u * u * (3.0 - 2.0 * u);
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.translation() = (1.0 - w) * start.translation() + w * at.translation();
+    X.linear() = Eigen::Quaterniond(start.linear())
+                     .slerp(w, Eigen::Quaterniond(at.linear()))
+                     .toRotationMatrix();
+    run->core->Step(run->t_s += T, X);
+  }
+  Scenario s{std::move(name), std::move(what), 1, 5e-6, nullptr, 25e-6};
+  s.run = [run, at, motion, mesh, T](int) {
+    const core::StepOutput& out = run->core->Step(run->t_s += T, motion(at, run->tick++));
+    double acc = out.force_W_N.x() + out.energy_J;
+    if (mesh) {
+      std::array<Eigen::Vector3d, 21> centreline;
+      run->core->Centreline(centreline);
+      acc += centreline.back().z();
+    }
+    return acc;
+  };
+  s.state = [run] {
+    return nlohmann::json{{"cf", run->core->FormationText()},
+                          {"pcs", run->core->last().contact_count},
+                          {"narrow_phase_calls", run->core->narrow_phase_calls()},
+                          {"capsules", run->core->capsule_count()}};
+  };
+  return s;
+}
+
+std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
+  std::vector<Scenario> out;
+  // A small dither keeps every tick doing real work without changing the state.
+  const auto dither = [](const Eigen::Isometry3d& X, long k) {
+    Eigen::Isometry3d Y = X;
+    Y.translation().z() += 20e-6 * std::sin(0.05 * double(k));
+    return Y;
+  };
+  const auto slide = [](const Eigen::Isometry3d& X, long k) {
+    // Back and forth along the groove, +-10 mm at 20 mm/s: the tip slides except at the turns.
+    const double phase = std::fmod(double(k) * 1e-3 * 20e-3, 40e-3);
+    Eigen::Isometry3d Y = X;
+    Y.translation().y() += phase < 20e-3 ? phase - 10e-3 : 30e-3 - phase;
+    return Y;
+  };
+  const Eigen::Isometry3d free_pose = scene.X_WH_start;
+  const Eigen::Isometry3d end_pose = HandPose(0.0, -0.090, 0.0455, 15.0, 0.0);
+  out.push_back(CoreScenario(scene, "core.free", "free motion above the groove", free_pose,
+                             [](const Eigen::Isometry3d& X, long k) {
+                               Eigen::Isometry3d Y = X;
+                               Y.translation().x() += 5e-3 * std::sin(2e-3 * double(k));
+                               return Y;
+                             }));
+  out.push_back(CoreScenario(scene, "core.end_stuck", "the tip pressed on the floor, stuck",
+                             end_pose, dither));
+  out.push_back(CoreScenario(scene, "core.end_sliding", "the tip sliding along the floor",
+                             end_pose, slide));
+  out.push_back(CoreScenario(scene, "core.two_pcs",
+                             "the tip on the floor and the side along the left wall",
+                             HandPose(-1.6e-3, -0.090, 0.0455, 15.0, 0.0), dither));
+  out.push_back(CoreScenario(
+      scene, "core.three_pcs",
+      "lying in the groove, turned to touch both walls: floor, left wall, right wall",
+      HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -1.2), dither));
+  // The leave-out effect: the same stuck tip without friction, and with the shape asked for.
+  scene::Scene frictionless = scene;
+  frictionless.friction = scene::Friction{};
+  for (scene::BoxPart& part : frictionless.parts) part.friction.reset();
+  out.push_back(CoreScenario(frictionless, "core.end_pressed.frictionless",
+                             "core.end_stuck on the scene without friction", end_pose, dither));
+  out.push_back(CoreScenario(scene, "core.end_stuck.mesh",
+                             "core.end_stuck and the centreline (21 points) every tick", end_pose,
+                             dither, true));
+  scene::Scene linear = scene;
+  linear.model.beam = model::BeamModel::kLinear;
+  out.push_back(CoreScenario(linear, "core.end_stuck.linear",
+                             "core.end_stuck with the linear beam model", end_pose, dither));
+  out.push_back(CoreScenario(linear, "core.three_pcs.linear",
+                             "core.three_pcs with the linear beam model",
+                             HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -1.2), dither));
+  return out;
+}
+
 int RunBench(const BenchOptions& o, Streams io) {
   // The default tube is the shipped groove scene's (scenes/groove.yaml), so figures are comparable
   // without a file.
-  model::TubeSpec spec{0.008, 0.005, 0.150, 3.0e6, 0.5};
-  if (!o.scene_path.empty()) {
-    const io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
-    io.err << loaded.diagnostics.FormatAll();
-    if (!loaded.scene) return kExitBadInput;
-    spec = loaded.scene->tube;
+  const io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
+  io.err << loaded.diagnostics.FormatAll();
+  if (!loaded.scene) return kExitBadInput;
+  const model::TubeSpec spec = loaded.scene->tube;
+  std::vector<Scenario> scenarios = MakeScenarios(spec);
+  if (!o.beam_only) {
+    std::vector<Scenario> core_scenarios = MakeCoreScenarios(*loaded.scene);
+    scenarios.insert(scenarios.end(), core_scenarios.begin(), core_scenarios.end());
   }
   double sink = 0.0;
   nlohmann::json results = nlohmann::json::array();
@@ -158,7 +277,7 @@ int RunBench(const BenchOptions& o, Streams io) {
            << std::setw(11) << "p99" << std::setw(11) << "p99.9" << std::setw(11) << "max"
            << "   target\n";
   }
-  for (const Scenario& scenario : MakeScenarios(spec)) {
+  for (const Scenario& scenario : scenarios) {
     const Figures f = Measure(scenario, o.samples, sink);
     if (o.json) {
       // Field names follow the core's benchmark schema (issue 3): microseconds, and ticks_per_s
@@ -176,6 +295,11 @@ int RunBench(const BenchOptions& o, Streams io) {
         entry["target_median_us"] = scenario.target_s * 1e6;
         entry["target_met"] = f.median_s < scenario.target_s;
       }
+      if (scenario.target_p999_s > 0.0) {
+        entry["target_p999_us"] = scenario.target_p999_s * 1e6;
+        entry["target_met"] = f.median_s < scenario.target_s && f.p999_s < scenario.target_p999_s;
+      }
+      if (scenario.state) entry["state"] = scenario.state();
       results.push_back(entry);
     } else {
       io.out << std::left << std::setw(28) << scenario.name << std::right << std::setw(11)
@@ -185,6 +309,15 @@ int RunBench(const BenchOptions& o, Streams io) {
         io.out << (f.median_s < scenario.target_s ? "< " : "MISSED < ") << Human(scenario.target_s);
       } else {
         io.out << "-";
+      }
+      if (scenario.target_p999_s > 0.0) {
+        io.out << (f.p999_s < scenario.target_p999_s ? ", p99.9 < " : ", p99.9 MISSED < ")
+               << Human(scenario.target_p999_s);
+      }
+      if (scenario.state) {
+        const nlohmann::json state = scenario.state();
+        io.out << "   " << state["cf"].get<std::string>() << " (" << state["narrow_phase_calls"]
+               << " narrow-phase queries)";
       }
       io.out << "\n";
     }
@@ -208,8 +341,13 @@ int RunBench(const BenchOptions& o, Streams io) {
 Command AddBenchCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<BenchOptions>();
   CLI::App* sub = app.add_subcommand(
-      "bench", "Measure the speed of the beam models (median, p99, p99.9, max per call).");
-  sub->add_option("--scene", options->scene_path, "take the tube from this scene file");
+      "bench",
+      "Measure the speed of the beam models and of the core's tick in free motion, one end "
+      "contact stuck and sliding, two and three PCs (median, p99, p99.9, max).");
+  sub->add_option("--scene", options->scene_path,
+                  "the scene of the core scenarios and the tube of the beam ones (default "
+                  "scenes/groove.yaml, relative to the working directory)");
+  sub->add_flag("--beam-only", options->beam_only, "only the beam models' scenarios");
   sub->add_option("--samples", options->samples, "timed samples per scenario")
       ->check(CLI::Range(10, 10000000));
   sub->add_flag("--json", options->json, "print one JSON document (times in microseconds)");
