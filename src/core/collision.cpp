@@ -55,7 +55,16 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
   solver_.gjk_max_iterations = 128;
   for (const std::uint32_t p : parts) {
     const scene::BoxPart& box = scene.parts[p];
-    Part part{p, fcl::Boxd(box.size_m), box.X_WP, box.X_WP.inverse(), 0.5 * box.size_m};
+    Part part;
+    part.index = p;
+    part.box = fcl::Boxd(box.size_m);
+    part.X_WP = box.X_WP;
+    part.X_PW = box.X_WP.inverse();
+    part.R_WP = box.X_WP.linear();
+    part.p_WP = box.X_WP.translation();
+    part.R_PW = part.R_WP.transpose();
+    part.p_PW = -(part.R_PW * part.p_WP);
+    part.half_m = 0.5 * box.size_m;
     parts_.push_back(part);
   }
 }
@@ -106,24 +115,22 @@ double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d
   return best;
 }
 
-bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_W,
-                                   const Eigen::Vector3d& b_W, double& distance_m,
+bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P,
+                                   const Eigen::Vector3d& b_P, double& distance_m,
                                    Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W) const {
-  const Eigen::Vector3d a_P = part.X_PW * a_W;
-  const Eigen::Vector3d b_P = part.X_PW * b_W;
   double t = 0.0;
   const double axis_m = std::sqrt(SegmentBoxDistanceSquared(a_P, b_P, part.half_m, t));
   const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
   const Eigen::Vector3d q_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
   if (!(axis_m > radius_m_)) return false;  // overlap (or the axis inside the box)
   distance_m = axis_m - radius_m_;
-  q_part_W = part.X_WP * q_P;
-  p_tube_W = part.X_WP * (c_P + (q_P - c_P) * (radius_m_ / axis_m));
+  q_part_W = part.ToWorld(q_P);
+  p_tube_W = part.ToWorld(c_P + (q_P - c_P) * (radius_m_ / axis_m));
   return true;
 }
 
 std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) const {
-  const Eigen::Vector3d q_P = part.X_PW * q_W;
+  const Eigen::Vector3d q_P = part.ToPart(q_W);
   std::uint8_t mask = 0;
   for (int a = 0; a < 3; ++a) {
     if (q_P[a] >= part.half_m[a] - part_tolerance_m_) mask |= std::uint8_t(1u << kPositiveFace[a]);
@@ -137,12 +144,10 @@ std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) c
   return std::uint8_t(1u << (q_P[best] >= 0.0 ? kPositiveFace[best] : kNegativeFace[best]));
 }
 
-bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_W,
-                                 const Eigen::Vector3d& b_W, double band_m) const {
-  // The piece's bounding box in the part's frame, grown by its radius and epsilon, against the
+bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_P,
+                                 const Eigen::Vector3d& b_P, double band_m) const {
+  // The piece's bounding box in the part's frame, grown by its radius and the band, against the
   // part: exact for the box's own axes, so rotated parts cull as well as aligned ones.
-  const Eigen::Vector3d a_P = part.X_PW * a_W;
-  const Eigen::Vector3d b_P = part.X_PW * b_W;
   const double grow = radius_m_ + band_m;
   for (int k = 0; k < 3; ++k) {
     const double lo = std::min(a_P[k], b_P[k]) - grow;
@@ -157,15 +162,15 @@ void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
   // GJK reports overlap without a depth. The contact is taken at the piece's midpoint, pushed out
   // through the face of the part nearest to it, at distance 0: the largest penalty force, K eps,
   // and a defined normal. The tick is flagged kPenetration by the caller.
-  const Eigen::Vector3d m_P = part.X_PW * (0.5 * (a_W + b_W));
+  const Eigen::Vector3d m_P = part.ToPart(0.5 * (a_W + b_W));
   int axis = 0;
   for (int a = 1; a < 3; ++a)
     if (part.half_m[a] - std::abs(m_P[a]) < part.half_m[axis] - std::abs(m_P[axis])) axis = a;
   const double side = m_P[axis] >= 0.0 ? 1.0 : -1.0;
   Eigen::Vector3d q_P = m_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
   q_P[axis] = side * part.half_m[axis];
-  c.q_W_m = part.X_WP * q_P;
-  c.normal_W = part.X_WP.linear() * (side * Eigen::Vector3d::Unit(axis));
+  c.q_W_m = part.ToWorld(q_P);
+  c.normal_W = part.R_WP * (side * Eigen::Vector3d::Unit(axis));
   c.distance_m = 0.0;
   c.overlap = true;
 }
@@ -179,25 +184,49 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
   narrow_calls_ = 0;
   const Eigen::Vector3d tip_W = nodes_W.back();
   const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
+  const std::size_t node_count = nodes_W.size();
   for (const Part& part : parts_) {
+    // The whole tube's bounding box first: most parts are nowhere near it.
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (std::size_t i = 0; i < node_count; ++i) {
+      nodes_P_[i] = part.ToPart(nodes_W[i]);
+      lo = lo.cwiseMin(nodes_P_[i]);
+      hi = hi.cwiseMax(nodes_P_[i]);
+    }
+    const double grow = radius_m_ + band_m;
+    if (((lo.array() - grow) > part.half_m.array()).any() ||
+        ((hi.array() + grow) < -part.half_m.array()).any())
+      continue;
+    const Eigen::Vector3d end_start_P = part.ToPart(end_start_W);
     for (int k = 0; k < pieces; ++k) {
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
       const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];
-      if (!PassesBroadPhase(part, a_W, b_W, band_m)) continue;
+      const Eigen::Vector3d& a_P = is_end ? end_start_P : nodes_P_[std::size_t(k)];
+      const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
+      if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
       if (count == static_cast<int>(out.size())) return count;
+      if (is_end) {
+        // The capsule on the end piece's axis contains the cylinder: if it is farther than the
+        // band, so is the cylinder, and FCL's GJK (microseconds) is not needed.
+        double bound_m = 0.0;
+        Eigen::Vector3d unused_p, unused_q;
+        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q) && bound_m >= band_m)
+          continue;
+      }
 
-      const Eigen::Isometry3d X_WS = SegmentPose(a_W, b_W);
       double d = 0.0;
       Eigen::Vector3d p_tube_W, q_part_W;
       ++narrow_calls_;
       const bool separated =
-          is_end ? solver_.shapeDistance(end_, X_WS, part.box, part.X_WP, &d, &p_tube_W, &q_part_W)
-                 : CapsuleBoxDistance(part, a_W, b_W, d, p_tube_W, q_part_W);
+          is_end ? solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box, part.X_WP, &d,
+                                         &p_tube_W, &q_part_W)
+                 : CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
       RawContact c;
       c.part = part.index;
       if (separated && d >= band_m) continue;
-      const Eigen::Vector3d axis_W = X_WS.linear().col(2);
+      const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
       if (separated && d > 0.0) {
         c.distance_m = d;
         c.q_W_m = q_part_W;
@@ -211,7 +240,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
       c.part_element = element_of_[part.index][c.face_mask];
 
       // The centreline point under the contact, and which element of the tube touches.
-      const Eigen::Vector3d centre_W = X_WS.translation();
+      const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);
       const double half_m = 0.5 * (is_end ? end_m_ : piece_m_);
       const double along = std::clamp((p_tube_W - centre_W).dot(axis_W), -half_m, half_m);
       const double s0 = is_end ? length_m_ - end_m_ : piece_m_ * k;
