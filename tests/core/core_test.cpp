@@ -151,3 +151,111 @@ TEST_CASE("The side on an edge at distance a: stiffness 3EI/a^3 in series, conve
     if (out.tip_deflection_m > 1e-4) CHECK(pc.marker == states::Marker::kConvex);
   }
 }
+
+namespace {
+
+// A 20 mm cube turned 45 degrees about y, so that one edge (along y) points at the tube's axis
+// from the side `side` (+1: +x, -1: -x), at height z_m, its edge d0_m from the tube's surface.
+scene::BoxPart EdgeBlock(const std::string& name, double side, double z_m, double r1, double d0_m) {
+  scene::BoxPart block =
+      Box(name, {0.02, 0.02, 0.02}, {side * (r1 + d0_m + 0.01 * std::sqrt(2.0)), 0.0, z_m});
+  block.X_WP.linear() = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  return block;
+}
+
+struct TwoPcClosedForm {
+  double p = 0.0, N1 = 0.0, N2 = 0.0;
+};
+
+// Fig. 6 with the loads lateral: an edge at arc position s1 on the -x side pushes the tube by N1
+// (+x), a second edge near the tip at s2 on the +x side by N2 (-x). With the hand at h (x), the
+// coupling K_c, the contacts K (eps - d), and the lateral compliances c_ij of the rule, the three
+// unknowns (held-end x, N1, N2) satisfy, written out here by hand and solved by Cramer's rule:
+//   x1 = p + c11 N1 - c12 N2,  x2 = p + c21 N1 - c22 N2        (centreline x at s1, s2)
+//   N1 = K (eps - (x1 - r1 + e1)),  N2 = K (eps - (e2 - x2 - r1))   (e: edges' |x|)
+//   K_c (h - p) + N1 - N2 = 0.
+TwoPcClosedForm SolveTwoPc(double h, double K, double Kc, double eps, double r1, double e1,
+                           double e2, double c11, double c12, double c21, double c22) {
+  // Unknowns (p, N1, N2): rows from the three equations after substituting x1, x2.
+  // N1 (1 + K c11) - K c12 N2 + K p = K (eps + r1 - e1)
+  // -K c21 N1 + N2 (1 + K c22) - K p = K (eps + r1 - e2)
+  // -Kc p + N1 - N2 = -Kc h
+  const double A[3][3] = {{K, 1.0 + K * c11, -K * c12},
+                          {-K, -K * c21, 1.0 + K * c22},
+                          {-Kc, 1.0, -1.0}};
+  const double b[3] = {K * (eps + r1 - e1), K * (eps + r1 - e2), -Kc * h};
+  const auto det3 = [](const double m[3][3]) {
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+           m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+  };
+  const double D = det3(A);
+  double sol[3];
+  for (int c = 0; c < 3; ++c) {
+    double Ac[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) Ac[r][k] = k == c ? b[r] : A[r][k];
+    sol[c] = det3(Ac) / D;
+  }
+  return {sol[0], sol[1], sol[2]};
+}
+
+}  // namespace
+
+TEST_CASE("Two PCs (Fig. 6): the segmented and the coupled rule against their closed forms",
+          "[core]") {
+  for (const auto rule : {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
+    scene::Scene s = TubeScene();
+    s.model.multi_contact = rule;
+    const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = 1e-3;
+    // Both edges start beyond epsilon: the hand's motion to -x presses the side onto `under`, and
+    // the tube pivots there so that its tip swings onto `over`.
+    const double s1 = 0.15, s2 = l - 0.004, d1 = 1.1e-3, d2 = 1.3e-3;
+    s.parts.push_back(EdgeBlock("under", -1.0, s1, r1, d1));
+    s.parts.push_back(EdgeBlock("over", +1.0, s2, r1, d2));
+    core::Core c(s);
+    const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
+    const auto infl = [EI](double a, double b) {  // point at a, load at b, from the clamp
+      return a <= b ? a * a * (3 * b - a) / (6 * EI) : b * b * (3 * a - b) / (6 * EI);
+    };
+    double t = 0.0;
+    for (const double h : {-11.0e-3, -15.0e-3}) {
+      const core::StepOutput& out = Hold(c, At({h, 0.0, 0.0}), 400, t);
+      INFO((rule == scene::MultiContactRule::kCoupled ? "coupled" : "segmented")
+           << ", hand " << h << ": " << c.FormationText());
+      REQUIRE(out.contact_count == 2);
+      const core::ContactState* under = nullptr;
+      const core::ContactState* over = nullptr;
+      for (const core::ContactState& pc : out.Contacts())
+        (c.elements()[std::size_t(pc.part_element)].name.rfind("under", 0) == 0 ? under : over) = &pc;
+      REQUIRE(under != nullptr);
+      REQUIRE(over != nullptr);
+      const double a = under->s_m, b = over->s_m;
+      const bool coupled = rule == scene::MultiContactRule::kCoupled;
+      // The segmented rule: the first segment carries its own load only (c12 = 0) and the second
+      // is a cantilever of length b - a from the cross-section at a, carried along by the first.
+      const double c11 = infl(a, a);
+      const double c12 = coupled ? infl(a, b) : 0.0;
+      const double c21 = infl(b, a);
+      const double c22 = coupled ? infl(b, b) : (b - a) * (b - a) * (b - a) / (3 * EI);
+      const TwoPcClosedForm expected =
+          SolveTwoPc(h, 1e4, 400.0, eps, r1, r1 + d1, r1 + d2, c11, c12, c21, c22);
+      // The closed form takes the loads as lateral; in the core the normals turn with the tube's
+      // slope, at most theta = (N1 a^2 + N2 b^2) / (2 E I) (~1e-2 rad here), which changes the
+      // forces by ~theta^2 of the larger one: the tolerance is 3 theta^2 max(N1, N2).
+      const double theta = (expected.N1 * a * a + expected.N2 * b * b) / (2 * EI);
+      const double tolerance_N = 3 * theta * theta * std::max(expected.N1, expected.N2);
+      CHECK(under->normal_force_N == Approx(expected.N1).margin(tolerance_N));
+      CHECK(over->normal_force_N == Approx(expected.N2).margin(tolerance_N));
+      CHECK(out.X_WH.translation().x() ==
+            Approx(expected.p).epsilon(3 * theta * theta).margin(1e-9));
+      // Markers: the segmented rule bends the first segment by its own load only, so the side
+      // resting on `under` is convex; coupled, the tip's opposite load can curve it the other way,
+      // which is what the sign of the closed form's moment at a/2 says.
+      const double bend_mid = expected.N1 * (a / 2) - expected.N2 * (b - a / 2);
+      const states::Marker expected_marker =
+          coupled && bend_mid < 0.0 ? states::Marker::kConcave : states::Marker::kConvex;
+      if (out.tip_deflection_m > s.contact.bend_threshold_m) CHECK(under->marker == expected_marker);
+    }
+  }
+}
