@@ -408,7 +408,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
   };
   build_compliance();
-  if (want_elastica && load_count > 0 && !use_elastica) out.flags |= kLinearFallback;
 
   // 6. Solve contacts, coupling and beam together. Unknowns: the load forces F_i (W) and the
   // held-end position p. Load i: F_i = K n (eps - d_i - n.(x_i - x0_i)) + Kt T (a_i - x_i) when
@@ -423,7 +422,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   std::array<int, kMaxLoads> slot{};
   Eigen::Vector3d p_W = p_start_W;
   bool solved = false, saturated = false;
-  for (int pass = 0; pass < kMaxPasses; ++pass) {
+  // Assembles and solves the tick's system for the current decisions; false if not finite.
+  const auto solve_system = [&]() {
     int n_active = 0;
     for (int i = 0; i < load_count; ++i)
       slot[std::size_t(i)] = m.loads[std::size_t(i)].active ? n_active++ : -1;
@@ -456,8 +456,14 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     m.rhs.segment<3>(n - 3) = A;
     m.lu.compute(m.M);
     m.z = m.lu.solve(m.rhs);
-    if (!m.z.allFinite()) break;
+    if (!m.z.allFinite()) return false;
     p_W = m.z.segment<3>(n - 3);
+    return true;
+  };
+  bool finite = true;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    finite = solve_system();
+    if (!finite) break;
 
     // Decisions: release a load that pulls, slide one beyond its friction limit, saturate the
     // coupling at the device's force. Each changes the system: solve again.
@@ -535,6 +541,10 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       break;
     }
   }
+  // Decisions that keep changing (a contact cycling between open and closed within one tick,
+  // which only pinched, stiff states do) stop after kMaxPasses: the last decisions stand and the
+  // system is solved once more for them.
+  if (!solved && finite) solved = solve_system();
   if (saturated) out.flags |= kProxySeparated;
   if (!solved) {
     // Singular, not finite or undecided: nothing moves and nothing is sent this tick.
@@ -590,6 +600,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       pc.normal_force_N += normal_N;
       pc.friction_W_N += Ft;
       pc.force_W_N += ld.force_W;
+      pc.moment_W_Nm += (ld.x_W - p_W).cross(ld.force_W);
       pc.sliding = pc.sliding || ld.sliding;
       if (ld.friction) {
         const double limit = FrictionLimit(*ld.friction, ld.friction->static_coefficient, normal_N);
@@ -684,6 +695,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
     }
   }
+  if (want_elastica && beam_count > 0 && !m.elastica_shape) out.flags |= kLinearFallback;
   out.energy_J = energy_J;
   out.max_strain = strain;
   out.tip_deflection_m = m.nodes_H[std::size_t(N)].head<2>().norm();
@@ -726,9 +738,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   out.torque_W_Nm = torque_W;
   if (force_W.norm() > max_force * (1.0 + 1e-9) || torque_W.norm() > scene_.device.max_torque_Nm)
     out.flags |= kForceClamped;
-  const bool finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
+  const bool all_finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
                       std::isfinite(energy_J) && std::isfinite(strain);
-  if (!finite) {
+  if (!all_finite) {
     Reset(X_W_hand);
     out.flags |= kSolverFault;
     return out;

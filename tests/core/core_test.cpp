@@ -259,3 +259,32 @@ TEST_CASE("Two PCs (Fig. 6): the segmented and the coupled rule against their cl
     }
   }
 }
+
+TEST_CASE("Over an edge like a rope over a pulley: concave (coupled), convex (segmented)",
+          "[core]") {
+  // The hand turns the tube about y so that it pivots on `under` (at a = l/3, on -x) and its tip
+  // presses on `over` (+x): the two loads are nearly equal and opposite, so by statics the moment
+  // at a/2 is N1 a/2 - N2 (b - a/2) < 0 and the coupled tube curves away from the normal at the
+  // edge: its concave side rests on it. The segmented rule bends the first segment by N1 only.
+  for (const auto rule : {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
+    scene::Scene s = TubeScene();
+    s.model.multi_contact = rule;
+    const double r1 = s.tube.outer_radius_m, l = s.tube.length_m;
+    s.parts.push_back(EdgeBlock("under", -1.0, l / 3, r1, 0.8e-3));
+    s.parts.push_back(EdgeBlock("over", +1.0, l - 0.004, r1, 1.5e-3));
+    core::Core c(s);
+    double t = 0.0;
+    // Turn by phi about the point at a, and push it 0.5 mm further onto the edge.
+    const double phi = 0.015;
+    Eigen::Isometry3d X = At({-phi * l / 3 - 0.5e-3, 0.0, 0.0});
+    X.linear() = Eigen::AngleAxisd(phi, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const core::StepOutput& out = Hold(c, X, 400, t);
+    INFO(c.FormationText());
+    REQUIRE(out.contact_count == 2);
+    for (const core::ContactState& pc : out.Contacts()) {
+      if (c.elements()[std::size_t(pc.part_element)].name.rfind("under", 0) != 0) continue;
+      CHECK(pc.marker == (rule == scene::MultiContactRule::kCoupled ? states::Marker::kConcave
+                                                                    : states::Marker::kConvex));
+    }
+  }
+}

@@ -71,6 +71,7 @@ struct ContactState {
   double normal_force_N = 0.0;                          ///< sum over its load points, >= 0
   Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< tangential force on the tube
   Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();     ///< total force on the tube
+  Eigen::Vector3d moment_W_Nm = Eigen::Vector3d::Zero();   ///< its moment about the held end
   /// Largest |friction| / f_max(mu_s, N) over its load points (<= 1 always; 1 when sliding
   /// with mu_k = mu_s) and f_max of the total normal force.
   double friction_ratio = 0.0;

@@ -1,0 +1,249 @@
+// Invariants of the core on many states, its allocation-free tick, its determinism and its
+// degenerate inputs.
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <random>
+#include <thread>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/core/coupling.hpp>
+#include <tubeplan/core/friction.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+
+using namespace tubeplan;
+
+// Every allocation of this test program goes through here; the count is per thread so that a
+// test measuring one thread's ticks is not disturbed by another thread.
+namespace {
+thread_local std::int64_t g_allocations = 0;
+}  // namespace
+
+void* operator new(std::size_t size) {
+  ++g_allocations;
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace {
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+scene::Scene LoadScene(const std::string& relative) {
+  io::SceneLoadResult loaded = io::LoadSceneFile(SourcePath(relative));
+  REQUIRE(loaded.scene.has_value());
+  return *loaded.scene;
+}
+
+std::vector<plan::HandSample> DemoTicks() {
+  io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(SourcePath("plans/groove-insert.csv"));
+  REQUIRE(loaded.trajectory.has_value());
+  return plan::Resample(*loaded.trajectory, 1e-3);
+}
+
+Eigen::Isometry3d Pose(const plan::HandSample& s) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = s.q_WH.toRotationMatrix();
+  X.translation() = s.p_WH_m;
+  return X;
+}
+
+// FNV-1a over the bytes of every double the tick returns and of the CF's compact form.
+struct Hash {
+  std::uint64_t h = 1469598103934665603ull;
+  void Add(const void* data, std::size_t n) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ bytes[i]) * 1099511628211ull;
+  }
+  void Add(double v) { Add(&v, sizeof v); }
+  void Add(const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) Add(v[i]);
+  }
+};
+
+std::uint64_t RunDemo(const scene::Scene& s, const std::vector<plan::HandSample>& ticks) {
+  core::Core c(s);
+  c.Reset(Pose(ticks.front()));
+  Hash hash;
+  for (const plan::HandSample& sample : ticks) {
+    const core::StepOutput& out = c.Step(sample.t_s, Pose(sample));
+    hash.Add(out.force_W_N);
+    hash.Add(out.torque_W_Nm);
+    hash.Add(out.X_WH.translation());
+    hash.Add(out.energy_J);
+    hash.Add(out.max_strain);
+    hash.Add(&out.flags, sizeof out.flags);
+    for (const core::ContactState& pc : out.Contacts()) {
+      const int code[3] = {int(pc.tube), int(pc.marker), pc.part_element};
+      hash.Add(code, sizeof code);
+      hash.Add(pc.force_W_N);
+    }
+  }
+  return hash.h;
+}
+
+}  // namespace
+
+TEST_CASE("A tick allocates nothing, with or without the shape", "[core][alloc]") {
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  const std::vector<plan::HandSample> ticks = DemoTicks();
+  core::Core c(s);
+  c.Reset(Pose(ticks.front()));
+  std::array<Eigen::Vector3d, 21> centreline;
+  // The demo passes through free motion, an end contact stuck and sliding, the side landing and
+  // the tube lying in the groove, with the elastica and its linear fallback.
+  const std::int64_t before = g_allocations;
+  for (const plan::HandSample& sample : ticks) {
+    c.Step(sample.t_s, Pose(sample));
+    c.Centreline(centreline);
+  }
+  CHECK(g_allocations - before == 0);
+  // The counter does count: the cold path (the CF as text) allocates.
+  const std::int64_t cold = g_allocations;
+  CHECK(!c.FormationText().empty());
+  CHECK(g_allocations > cold);
+}
+
+TEST_CASE("The same inputs give the same bits, in any thread", "[core][determinism]") {
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  const std::vector<plan::HandSample> ticks = DemoTicks();
+  const std::uint64_t first = RunDemo(s, ticks);
+  CHECK(RunDemo(s, ticks) == first);
+  std::uint64_t a = 0, b = 0;
+  std::thread ta([&] { a = RunDemo(s, ticks); });
+  std::thread tb([&] { b = RunDemo(s, ticks); });
+  ta.join();
+  tb.join();
+  CHECK(a == first);
+  CHECK(b == first);
+}
+
+TEST_CASE("Invariants on random states of both shipped scenes", "[core][invariants]") {
+  std::mt19937_64 rng(20261122);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (const char* file : {"scenes/groove.yaml", "scenes/groove-steel.yaml"}) {
+    for (const auto rule : {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
+      scene::Scene s = LoadScene(file);
+      s.model.multi_contact = rule;
+      core::Core c(s);
+      const core::Coupling coupling = core::ResolveCoupling(s.device, s.model.time_step_s);
+      const Eigen::Isometry3d start = s.X_WH_start;
+      const double l = s.tube.length_m;
+      double t = 0.0;
+      int contacts_seen = 0;
+      for (int trial = 0; trial < 40; ++trial) {
+        // A random pose of the held end over and in the groove: lowered by up to its height,
+        // tipped down up to 25 degrees, turned up to 5 degrees, shifted sideways a few mm.
+        Eigen::Isometry3d X = start;
+        X.translation() += Eigen::Vector3d(4e-3 * u(rng), 0.2 * l * u(rng),
+                                           -start.translation().z() * (0.6 + 0.45 * u(rng)));
+        X.linear() = Eigen::AngleAxisd(0.09 * u(rng), Eigen::Vector3d::UnitZ()) *
+                     Eigen::AngleAxisd(-0.22 * (1.0 + u(rng)), Eigen::Vector3d::UnitX()) *
+                     start.linear();
+        Eigen::Isometry3d from = c.last().X_W_hand;
+        for (int k = 1; k <= 300; ++k) {  // move there over 0.2 s, then hold
+          const double w = std::min(1.0, k / 200.0);
+          Eigen::Isometry3d Y = X;
+          Y.translation() = (1 - w) * from.translation() + w * X.translation();
+          Y.linear() = Eigen::Quaterniond(from.linear())
+                           .slerp(w, Eigen::Quaterniond(X.linear()))
+                           .toRotationMatrix();
+          c.Step(t += 1e-3, Y);
+        }
+        const core::StepOutput& out = c.last();
+        INFO(file << " trial " << trial << ": " << c.FormationText() << " flags " << out.flags);
+        REQUIRE(out.force_W_N.allFinite());
+        REQUIRE(out.torque_W_Nm.allFinite());
+        REQUIRE(std::isfinite(out.energy_J));
+        CHECK((out.flags & core::kSolverFault) == 0);
+        contacts_seen += out.contact_count;
+        // The operator's wrench is the sum of the contact wrenches about the held end.
+        Eigen::Vector3d force = Eigen::Vector3d::Zero(), moment = Eigen::Vector3d::Zero();
+        for (const core::ContactState& pc : out.Contacts()) {
+          force += pc.force_W_N;
+          moment += pc.moment_W_Nm;
+          // Friction never exceeds the static limit at any load point, nor for the PC.
+          CHECK(pc.friction_ratio <= 1.0 + 1e-9);
+          if (pc.loads == 1) CHECK(pc.friction_W_N.norm() <= pc.friction_limit_N * (1 + 1e-9) + 1e-15);
+          CHECK(pc.normal_force_N >= 0.0);
+        }
+        CHECK((force - out.force_W_N).norm() <= 1e-12 * (1.0 + force.norm()));
+        CHECK((moment - out.torque_W_Nm).norm() <= 1e-12 * (1.0 + moment.norm()));
+        // And it is what the coupling spring carries: the hand held still, its damper relaxed
+        // (2 N s/m over 100 ticks: (B/T / (K_c + B/T))^100 ~ 1e-8), unless the spring is
+        // saturated at the device's force.
+        const Eigen::Vector3d spring =
+            coupling.stiffness_N_per_m * (out.X_WH.translation() - X.translation());
+        if (out.flags & core::kProxySeparated) {
+          CHECK(out.force_W_N.norm() == Approx(s.device.max_force_N).epsilon(1e-6));
+        } else {
+          CHECK((out.force_W_N - spring).norm() <= 1e-6 * (1.0 + spring.norm()));
+        }
+        // The CF's text round-trips.
+        const states::ParseResult parsed = states::ParseContactFormation(c.FormationText());
+        REQUIRE(parsed.cf.has_value());
+        CHECK(*parsed.cf == c.Formation());
+      }
+      CHECK(contacts_seen > 20);  // the poses do reach the parts
+    }
+  }
+}
+
+TEST_CASE("Degenerate inputs never make NaN leave the core", "[core][degenerate]") {
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  core::Core c(s);
+  double t = 0.0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(nan, 0, 0), Eigen::Vector3d(0, inf, 0),
+                                  Eigen::Vector3d(1e300, -1e300, 1e300)}) {
+    Eigen::Isometry3d X = s.X_WH_start;
+    X.translation() = p;
+    const core::StepOutput& out = c.Step(t += 1e-3, X);
+    CHECK(out.force_W_N.allFinite());
+    CHECK(out.torque_W_Nm.allFinite());
+    CHECK(out.X_WH.translation().allFinite());
+    CHECK(std::isfinite(out.energy_J));
+    if (!p.allFinite()) CHECK((out.flags & core::kSolverFault) != 0);
+  }
+  // A rotation that is not one (NaN) is refused the same way.
+  Eigen::Isometry3d X = s.X_WH_start;
+  X.linear()(0, 0) = nan;
+  CHECK((c.Step(t += 1e-3, X).flags & core::kSolverFault) != 0);
+  CHECK(c.last().force_W_N.isZero(0.0));
+  // And the core carries on from a valid pose afterwards.
+  c.Reset(s.X_WH_start);
+  const core::StepOutput& after = c.Step(t += 1e-3, s.X_WH_start);
+  CHECK(after.flags == 0);
+  CHECK(after.contact_count == 0);
+}
+
+TEST_CASE("Free motion: the held end follows the hand and nothing is felt", "[core]") {
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  core::Core c(s);
+  double t = 0.0;
+  Eigen::Isometry3d X = s.X_WH_start;
+  for (int k = 0; k < 200; ++k) {
+    X.translation().x() = 0.01 * std::sin(0.01 * k);
+    const core::StepOutput& out = c.Step(t += 1e-3, X);
+    REQUIRE(out.contact_count == 0);
+    // With no contact the coupling balances nothing: the proxy sits on the hand exactly.
+    CHECK((out.X_WH.translation() - X.translation()).norm() <= 1e-15);
+    CHECK(out.force_W_N.isZero(0.0));
+    CHECK(out.energy_J == 0.0);
+    CHECK(c.narrow_phase_calls() == 0);  // far from every part: the broad phase stops it all
+  }
+}
