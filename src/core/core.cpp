@@ -17,13 +17,19 @@ namespace tubeplan::core {
 
 namespace {
 
-constexpr int kMaxUnknowns = 3 * kMaxLoads + 3;
+constexpr int kMaxUnknowns = 3 * kMaxLoads + 6;
 using SystemMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns,
                                    kMaxUnknowns>;
 using SystemVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
 // Friction, release and saturation decisions re-solve the tick's system; each pass settles at
 // least one contact, so kMaxContacts + 2 passes always suffice (the rest is a safety bound).
 constexpr int kMaxPasses = 3 * kMaxLoads + 4;
+
+Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
 
 bool IsBoundaryOf(states::TubeElement a, states::TubeElement b) {
   // The rim bounds both the end face and the side surface.
@@ -81,6 +87,7 @@ struct Core::Impl {
   Eigen::Vector3d tip_tangent_H = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_held_prev_W = Eigen::Matrix3d::Identity();
   std::array<Load, kMaxLoads> prev{};
   int prev_count = 0;
   // The loads of the last tick as the beam saw them (the shape, and Centreline on request).
@@ -155,6 +162,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.tip_tangent_H = Eigen::Vector3d::UnitZ();
   m.p_hand_prev_W = X_WH.translation();
   m.p_held_prev_W = X_WH.translation();
+  m.R_held_prev_W = X_WH.linear();
   m.prev_count = 0;
   m.beam_count = m.segment_count = 0;
   m.elastica_shape = false;
@@ -188,9 +196,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   out.t_s = t_s;
   out.X_W_hand = X_W_hand;
   out.flags = 0;
-  const Eigen::Matrix3d R_WH = X_W_hand.linear();
+  const Eigen::Matrix3d R_W_hand = X_W_hand.linear();
   const Eigen::Vector3d p_hand_W = X_W_hand.translation();
-  if (!p_hand_W.allFinite() || !R_WH.allFinite()) {
+  if (!p_hand_W.allFinite() || !R_W_hand.allFinite()) {
     // A non-finite hand pose: hold everything where it was and send nothing.
     out.flags |= kSolverFault;
     out.force_W_N.setZero();
@@ -198,8 +206,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return out;
   }
 
-  // 1. The tube where it is: last tick's held position and shape, this tick's orientation.
+  // 1. The tube where it is: last tick's held-end pose and shape.
   const Eigen::Vector3d p_start_W = m.p_held_prev_W;
+  const Eigen::Matrix3d R_WH = m.R_held_prev_W;
   for (int k = 0; k <= N; ++k)
     m.nodes_W[std::size_t(k)] = p_start_W + R_WH * m.nodes_H[std::size_t(k)];
   const Eigen::Vector3d tip_tangent_W = R_WH * m.tip_tangent_H;
@@ -419,15 +428,26 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
                                  (coupling_damping_ / T) * m.p_held_prev_W;
   Eigen::Vector3d A = A_free;
   const double max_force = scene_.device.max_force_N;
+  // The grip is rigid (the paper's held end turns with the device) up to the device's torque:
+  // omega turns the held end onto the hand's orientation, e = log(R_hand R_held^T) (W), unless
+  // the contacts' moment about the held end would exceed the maximum torque; then the grip
+  // carries exactly that torque and the contacts decide omega.
+  const double max_torque = scene_.device.max_torque_Nm;
+  const Eigen::AngleAxisd error(R_W_hand * R_WH.transpose());
+  const Eigen::Vector3d e_hand = error.angle() * error.axis();
+  bool torque_saturated = false;
+  Eigen::Vector3d torque_sat_W = Eigen::Vector3d::Zero();  // the grip's torque on the tube
   std::array<int, kMaxLoads> slot{};
   Eigen::Vector3d p_W = p_start_W;
+  Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
   bool solved = false, saturated = false;
   // Assembles and solves the tick's system for the current decisions; false if not finite.
   const auto solve_system = [&]() {
     int n_active = 0;
     for (int i = 0; i < load_count; ++i)
       slot[std::size_t(i)] = m.loads[std::size_t(i)].active ? n_active++ : -1;
-    const int n = 3 * n_active + 3;
+    const int n = 3 * n_active + 6;
+    const int ip = n - 6, iw = n - 3;  // columns of p and omega
     m.M.setZero(n, n);
     m.rhs.setZero(n);
     for (int i = 0; i < load_count; ++i) {
@@ -448,16 +468,32 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         const int sj = slot[std::size_t(j)];
         if (sj >= 0) m.M.block<3, 3>(r, 3 * sj) += G * m.W[std::size_t(i)][std::size_t(j)];
       }
-      m.M.block<3, 3>(r, n - 3) = G;
+      // The held end's turn omega moves the point by omega x r, r from the held end.
+      const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
+      m.M.block<3, 3>(r, ip) = G;
+      m.M.block<3, 3>(r, iw) = -G * Rx;
       m.rhs.segment<3>(r) = b - G * ld.base_W;
-      m.M.block<3, 3>(n - 3, r) = -Eigen::Matrix3d::Identity();
+      m.M.block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
+      if (torque_saturated) m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
     }
-    m.M.block<3, 3>(n - 3, n - 3) = Kc_eff * Eigen::Matrix3d::Identity();
-    m.rhs.segment<3>(n - 3) = A;
+    m.M.block<3, 3>(ip, ip) = Kc_eff * Eigen::Matrix3d::Identity();
+    m.rhs.segment<3>(ip) = A;
+    if (torque_saturated) {
+      // Torque balance: sum r x F + tau = 0 with the grip's tau = tau_sat + k_reg (e - omega);
+      // the weak k_reg (1e-3 of the full torque per radian) keeps omega defined about axes the
+      // contacts do not hold, and adds at most k_reg times the lag to the torque.
+      const double k_reg = 1e-3 * max_torque;
+      m.M.block<3, 3>(iw, iw) = -k_reg * Eigen::Matrix3d::Identity();
+      m.rhs.segment<3>(iw) = -torque_sat_W - k_reg * e_hand;
+    } else {
+      m.M.block<3, 3>(iw, iw) = Eigen::Matrix3d::Identity();
+      m.rhs.segment<3>(iw) = e_hand;
+    }
     m.lu.compute(m.M);
     m.z = m.lu.solve(m.rhs);
     if (!m.z.allFinite()) return false;
-    p_W = m.z.segment<3>(n - 3);
+    p_W = m.z.segment<3>(ip);
+    omega_W = m.z.segment<3>(iw);
     return true;
   };
   bool finite = true;
@@ -474,7 +510,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       if (si < 0) {
         if (ld.released) continue;
         // An open load: does this tick's motion bring it within epsilon?
-        Eigen::Vector3d x = ld.base_W + p_W;
+        Eigen::Vector3d x = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
         for (int j = 0; j < load_count; ++j) {
           const int sj = slot[std::size_t(j)];
           if (sj >= 0) x += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
@@ -524,8 +560,25 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (changed) {
       // The contact set changed: saturation is decided again on the new solution.
       A = A_free;
+      torque_saturated = false;
       saturated = false;
-    } else {
+    } else if (!torque_saturated) {
+      Eigen::Vector3d moment_W = Eigen::Vector3d::Zero();
+      for (int i = 0; i < load_count; ++i) {
+        const int si = slot[std::size_t(i)];
+        if (si >= 0)
+          moment_W += (m.loads[std::size_t(i)].x0_W - p_start_W).cross(m.z.segment<3>(3 * si));
+      }
+      if (moment_W.norm() > max_torque * (1.0 + 1e-12)) {
+        // The grip cannot hold more than the device's torque: the held end turns until the
+        // contacts' moment is exactly that.
+        torque_sat_W = -moment_W * (max_torque / moment_W.norm());
+        torque_saturated = true;
+        saturated = true;
+        changed = true;
+      }
+    }
+    if (!changed) {
       const Eigen::Vector3d coupling_W = A - Kc_eff * p_W;
       const double magnitude = coupling_W.norm();
       if (magnitude > max_force * (1.0 + 1e-12)) {
@@ -553,6 +606,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     out.torque_W_Nm.setZero();
     out.contact_count = 0;
     m.p_hand_prev_W = p_hand_W;
+    m.prev_count = 0;  // start the next tick afresh rather than repeat this one
     return out;
   }
 
@@ -562,7 +616,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   for (int i = 0; i < load_count; ++i) {
     Load& ld = m.loads[std::size_t(i)];
     const int si = slot[std::size_t(i)];
-    ld.x_W = ld.base_W + p_W;
+    ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
     for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
       if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
@@ -732,7 +786,15 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
 
   // 9. The operator's wrench, and the state for the next tick.
-  out.X_WH = X_W_hand;
+  const double turn = omega_W.norm();
+  const Eigen::Matrix3d R_WH_new =
+      Eigen::Quaterniond((turn > 0.0 ? Eigen::AngleAxisd(turn, omega_W / turn).toRotationMatrix()
+                                     : Eigen::Matrix3d::Identity()) *
+                         R_WH)
+          .normalized()
+          .toRotationMatrix();
+  out.X_WH = Eigen::Isometry3d::Identity();
+  out.X_WH.linear() = R_WH_new;
   out.X_WH.translation() = p_W;
   out.force_W_N = force_W;
   out.torque_W_Nm = torque_W;
@@ -747,6 +809,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
   m.p_hand_prev_W = p_hand_W;
   m.p_held_prev_W = p_W;
+  m.R_held_prev_W = R_WH_new;
   // Ghosts have done their work; the next tick continues this tick's real loads.
   m.prev_count = 0;
   for (int i = 0; i < load_count; ++i)

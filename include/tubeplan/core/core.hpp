@@ -6,9 +6,11 @@
 // construction, never NaN or Inf in what it returns.
 //
 // Model, in the order of one tick (docs/core.md has the derivations and every choice):
-//  1. The held end H is a proxy coupled to the hand by the scene's spring K_c and damper B. Its
-//     orientation is the hand's (the rotational coupling is rigid); its position is where the
-//     coupling force balances the contact forces on the massless tube.
+//  1. The held end H is a proxy coupled to the hand by the scene's spring K_c and damper B; it
+//     turns with the hand (a rigid grip, as in the paper). Its position is where the coupling
+//     force balances the contact forces on the massless tube. The spring saturates at the
+//     device's force and the grip at its torque (then the held end lags the hand's turn), so
+//     however hard the hand pushes or turns, the tube is not driven through a part.
 //  2. The deformed tube is a chain of FCL capsules along its centreline, ending in an FCL
 //     cylinder so that the free end has a flat end face and a rim; parts are FCL boxes. A broad
 //     phase in each box's frame passes only the pairs that can be closer than epsilon to FCL's
