@@ -234,7 +234,7 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
                              end_pose, slide));
   out.push_back(CoreScenario(scene, "core.two_pcs",
                              "the tip on the floor and the side along the left wall",
-                             HandPose(-1.6e-3, -0.090, 0.0455, 15.0, 0.0), dither));
+                             HandPose(-2.5e-3, -0.090, 0.0455, 15.0, 0.0), dither));
   out.push_back(CoreScenario(
       scene, "core.three_pcs",
       "lying in the groove, turned to touch both walls: floor, left wall, right wall",

@@ -25,6 +25,15 @@ using SystemVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1
 // least one contact, so kMaxContacts + 2 passes always suffice (the rest is a safety bound).
 constexpr int kMaxPasses = 3 * kMaxLoads + 4;
 
+// f_k(N) = a + b N, tangent to mu_k N0 (N/N0)^beta at N (exact for beta = 1). At N = 0 with
+// beta < 1 the slope is infinite: the chord to N = 1e-9 N0 stands in for it.
+void LineariseKinetic(const scene::Friction& friction, double normal_N, double& a, double& b) {
+  const double N = std::max(normal_N, 1e-9 * friction.reference_load_N);
+  const double fk = FrictionLimit(friction, friction.kinetic_coefficient, N);
+  b = friction.exponent * fk / N;
+  a = fk - b * N;
+}
+
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
@@ -67,7 +76,10 @@ struct Core::Impl {
     Eigen::Vector3d base_W = Eigen::Vector3d::Zero();       // x = base + p + R W R^T F
     Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();     // stuck: held here tangentially
     Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();      // last tick's force (linearisation)
-    Eigen::Vector3d f_slide_W = Eigen::Vector3d::Zero();    // imposed friction while sliding
+    // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
+    // exact for beta = 1, where a = 0 and b = mu_k).
+    Eigen::Vector3d slide_dir_W = Eigen::Vector3d::Zero();
+    double slide_a = 0.0, slide_b = 0.0;
     Eigen::Vector3d force_W = Eigen::Vector3d::Zero();      // result
     Eigen::Vector3d x_W = Eigen::Vector3d::Zero();          // result
     const scene::Friction* friction = nullptr;              // null: frictionless here
@@ -458,10 +470,14 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Eigen::Matrix3d NN = nrm * nrm.transpose();
       const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
       const bool stuck = ld.friction && !ld.sliding;
-      const Eigen::Matrix3d G = K * NN + (stuck ? Kt : 0.0) * Tp;
-      Eigen::Vector3d b = K * nrm * (eps - ld.distance_m + nrm.dot(ld.x0_W));
+      // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
+      // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
+      const Eigen::Vector3d n_eff = ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W)
+                                               : nrm;
+      const Eigen::Matrix3d G = K * n_eff * nrm.transpose() + (stuck ? Kt : 0.0) * Tp;
+      Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
       if (stuck) b += Kt * (Tp * ld.anchor_W);
-      if (ld.sliding) b += ld.f_slide_W;
+      if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
       const int r = 3 * si;
       m.M.block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
       for (int j = 0; j < load_count; ++j) {
@@ -543,16 +559,15 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
           ld.shifted = true;
         } else {
           ld.sliding = true;
-          ld.f_slide_W = fr.force_N;
+          ld.slide_dir_W = Ft / Ft.norm();  // |Ft| > f_s >= 0
+          LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
         }
         changed = true;
       } else {
-        // Keep the kinetic force consistent with the normal force it now presses with.
-        const double fk =
-            FrictionLimit(*ld.friction, ld.friction->kinetic_coefficient, normal_N);
-        const double now = ld.f_slide_W.norm();
-        if (now > 0.0 && std::abs(fk - now) > 1e-9 * (1.0 + fk)) {
-          ld.f_slide_W *= fk / now;
+        // Newton on the kinetic law: relinearise f_k where the normal force now is.
+        const double fk = FrictionLimit(*ld.friction, ld.friction->kinetic_coefficient, normal_N);
+        if (std::abs(fk - (ld.slide_a + ld.slide_b * normal_N)) > 1e-9 * (1.0 + fk)) {
+          LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
           changed = true;
         }
       }

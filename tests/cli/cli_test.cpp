@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <numbers>
 #include <sstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -176,17 +177,26 @@ TEST_CASE("check: a broken scene is exit code 2 with file:line:col diagnostics",
 TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   // Only the shape of the report is tested: speed is measured by running `tubeplan bench`,
   // never asserted in a test.
-  const Outcome r = RunTool({"bench", "--samples", "10", "--json"});
+  const Outcome r = RunTool(
+      {"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(r.exit_code == 0);
   const auto doc = nlohmann::json::parse(r.out);
-  REQUIRE(doc["scenarios"].size() == 4);
+  REQUIRE(doc["scenarios"].size() == 13);
+  std::map<std::string, int> pcs;
   for (const auto& s : doc["scenarios"]) {
     const double median = s["median_us"].get<double>();
     CHECK(std::isfinite(median));
     CHECK(median > 0.0);
     CHECK(s["p99_us"].get<double>() >= median);
     CHECK(s["max_us"].get<double>() >= s["p99_us"].get<double>());
+    if (s.contains("state")) pcs[s["name"].get<std::string>()] = s["state"]["pcs"].get<int>();
   }
+  // Each core scenario measures the state its name says.
+  CHECK(pcs["core.free"] == 0);
+  CHECK(pcs["core.end_stuck"] == 1);
+  CHECK(pcs["core.end_sliding"] == 1);
+  CHECK(pcs["core.two_pcs"] == 2);
+  CHECK(pcs["core.three_pcs"] == 3);
 }
 
 TEST_CASE("usage: no subcommand and --version", "[cli]") {

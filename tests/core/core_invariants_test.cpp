@@ -143,8 +143,8 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
       const Eigen::Isometry3d start = s.X_WH_start;
       const double l = s.tube.length_m;
       double t = 0.0;
-      int contacts_seen = 0;
-      for (int trial = 0; trial < 40; ++trial) {
+      int contacts_seen = 0, at_rest = 0;
+      for (int trial = 0; trial < 60; ++trial) {
         // A random pose of the held end over and in the groove, each trial from the start: the
         // held end between the walls' tops and the floor (its centre at least a radius above the
         // floor), tipped down up to 20 degrees, turned up to 1 degree, shifted sideways 2 mm.
@@ -158,6 +158,8 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
                      Eigen::AngleAxisd(-tip_down, Eigen::Vector3d::UnitX()) * start.linear();
         c.Reset(start);
         const Eigen::Isometry3d from = start;
+        double settling_m = 0.0;  // how far the held end still moves over the last 20 ticks
+        Eigen::Vector3d held_before = Eigen::Vector3d::Zero();
         for (int k = 1; k <= 300; ++k) {  // move there over 0.2 s, then hold
           const double w = std::min(1.0, k / 200.0);
           Eigen::Isometry3d Y = X;
@@ -165,7 +167,9 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
           Y.linear() = Eigen::Quaterniond(from.linear())
                            .slerp(w, Eigen::Quaterniond(X.linear()))
                            .toRotationMatrix();
-          c.Step(t += 1e-3, Y);
+          const Eigen::Vector3d held = c.Step(t += 1e-3, Y).X_WH.translation();
+          if (k > 280) settling_m = std::max(settling_m, (held - held_before).norm());
+          held_before = held;
         }
         const core::StepOutput& out = c.last();
         INFO(file << " trial " << trial << ": " << c.FormationText() << " flags " << out.flags);
@@ -186,22 +190,35 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
         }
         CHECK((force - out.force_W_N).norm() <= 1e-12 * (1.0 + force.norm()));
         CHECK((moment - out.torque_W_Nm).norm() <= 1e-12 * (1.0 + moment.norm()));
-        // And it is what the coupling spring carries: the hand held still, its damper relaxed
-        // (2 N s/m over 100 ticks: (B/T / (K_c + B/T))^100 ~ 1e-8), unless the spring is
-        // saturated at the device's force.
-        const Eigen::Vector3d spring =
-            coupling.stiffness_N_per_m * (out.X_WH.translation() - X.translation());
-        if (out.flags & core::kProxySeparated) {
-          CHECK(out.force_W_N.norm() == Approx(s.device.max_force_N).epsilon(1e-6));
-        } else {
-          CHECK((out.force_W_N - spring).norm() <= 1e-6 * (1.0 + spring.norm()));
-        }
         // The CF's text round-trips.
         const states::ParseResult parsed = states::ParseContactFormation(c.FormationText());
         REQUIRE(parsed.cf.has_value());
         CHECK(*parsed.cf == c.Formation());
+        // And at rest it is what the coupling spring carries: the hand held still, its damper
+        // relaxed (2 N s/m over 100 ticks: (B/T / (K_c + B/T))^100 ~ 1e-8), unless the spring is
+        // saturated at the device's force. (Not every state comes to rest: a soft tube bent hard
+        // along a face can keep changing its contacts from tick to tick; see docs/core.md.)
+        if (settling_m > 1e-9) continue;
+        ++at_rest;
+        const Eigen::Vector3d spring =
+            coupling.stiffness_N_per_m * (out.X_WH.translation() - X.translation());
+        if (out.flags & core::kProxySeparated) {
+          // The spring or the grip is saturated at the device's force or torque.
+          const bool at_force = std::abs(out.force_W_N.norm() - s.device.max_force_N) <= 1e-6;
+          // (the grip's weak regularising spring adds at most 1e-3 of the torque per radian)
+          const bool at_torque =
+              std::abs(out.torque_W_Nm.norm() - s.device.max_torque_Nm) <=
+              1e-2 * s.device.max_torque_Nm;
+          CHECK((at_force || at_torque));
+        } else {
+          // What the damper still carries: B times the held end's last speed (settling / T).
+          const double damper_N = coupling.damping_Ns_per_m * settling_m / s.model.time_step_s;
+          CHECK((out.force_W_N - spring).norm() <= 2.0 * damper_N + 1e-9 * (1.0 + spring.norm()));
+        }
       }
       CHECK(contacts_seen > 20);  // the poses do reach the parts
+      INFO(file << ": " << at_rest << " of 60 states came to rest");
+      CHECK(at_rest >= 10);  // and the equilibrium check is not vacuous
     }
   }
 }
