@@ -238,7 +238,7 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   out.push_back(CoreScenario(
       scene, "core.three_pcs",
       "lying in the groove, turned to touch both walls: floor, left wall, right wall",
-      HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -1.2), dither));
+      HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
   // The leave-out effect: the same stuck tip without friction, and with the shape asked for.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
@@ -254,7 +254,7 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
                              "core.end_stuck with the linear beam model", end_pose, dither));
   out.push_back(CoreScenario(linear, "core.three_pcs.linear",
                              "core.three_pcs with the linear beam model",
-                             HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -1.2), dither));
+                             HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
   return out;
 }
 

@@ -229,6 +229,44 @@ Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxL
   return tip_H + (s_m - last.clamp_m - L) * tangent_H;
 }
 
+void BeamChain::ElasticaNodes(const std::array<ElasticaSegment, kMaxLoads>& segments,
+                              int segment_count, std::span<Eigen::Vector3d> nodes) const {
+  const std::size_t count = nodes.size();
+  const double step_m = length_m_ / double(count - 1);
+  std::size_t k = 0;
+  for (int g = 0; g < segment_count; ++g) {
+    const ElasticaSegment& seg = segments[std::size_t(g)];
+    const double L = seg.length_m;
+    if (!(L > 0.0)) continue;
+    constexpr int n = kElasticaSamples;
+    std::array<double, n> s_unit{};
+    std::array<Eigen::Vector2d, n> xz{};
+    std::array<double, n> theta{};
+    for (int j = 0; j < n; ++j) s_unit[std::size_t(j)] = double(j) / (n - 1);
+    model::ElasticaCentreline(seg.solution, s_unit, xz, theta);
+    const Eigen::Vector3d x_H = seg.R_HS * seg.bend_x_S;
+    const Eigen::Vector3d z_H = seg.R_HS.col(2);
+    const auto point = [&](int j) {
+      return Eigen::Vector3d(seg.origin_H + L * (xz[std::size_t(j)].x() * x_H +
+                                                 xz[std::size_t(j)].y() * z_H));
+    };
+    const auto tangent = [&](int j) {  // d/ds of the position, unit length
+      return Eigen::Vector3d(std::sin(theta[std::size_t(j)]) * x_H +
+                             std::cos(theta[std::size_t(j)]) * z_H);
+    };
+    const double h = L / (n - 1);
+    for (; k < count && step_m * double(k) <= seg.clamp_m + L; ++k) {
+      const double u = std::clamp((step_m * double(k) - seg.clamp_m) / h, 0.0, double(n - 1));
+      const int j = std::min(static_cast<int>(u), n - 2);
+      const double t = u - j, t2 = t * t, t3 = t2 * t;
+      nodes[k] = (2 * t3 - 3 * t2 + 1) * point(j) + (t3 - 2 * t2 + t) * h * tangent(j) +
+                 (-2 * t3 + 3 * t2) * point(j + 1) + (t3 - t2) * h * tangent(j + 1);
+    }
+  }
+  // Beyond the last load (or with none): straight along the last tangent.
+  for (; k < count; ++k) nodes[k] = ElasticaPoint(segments, segment_count, step_m * double(k));
+}
+
 Eigen::Vector3d BeamChain::ElasticaTipTangent(
     const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count) const {
   if (segment_count == 0) return Eigen::Vector3d::UnitZ();

@@ -108,6 +108,11 @@ struct Core::Impl {
   std::array<ElasticaSegment, kMaxLoads> segments{};
   int beam_count = 0, segment_count = 0;
   bool elastica_shape = false;
+  // The elastica's tangent compliance per segment and the loads it was computed for.
+  std::array<Eigen::Matrix3d, kMaxLoads> tangent{};
+  std::array<Eigen::Vector3d, kMaxLoads> tangent_force{};
+  std::array<double, kMaxLoads> tangent_length{};
+  int tangent_count = 0, tangent_age = 0;
 
   // Per-tick scratch (kept here so that Step allocates nothing).
   std::array<RawContact, kMaxRawContacts> raw{};
@@ -177,6 +182,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.R_held_prev_W = X_WH.linear();
   m.prev_count = 0;
   m.beam_count = m.segment_count = 0;
+  m.tangent_count = 0;
   m.elastica_shape = false;
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
@@ -397,14 +403,38 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (use_elastica) {
       // Within a segment the elastica's own tangent replaces the linear force compliance; the
       // rotation terms and the loads of earlier segments keep their linear values.
-      const int segment_count = m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
-      for (int g = 0; g < segment_count; ++g) {
-        Eigen::Vector3d f_group = Eigen::Vector3d::Zero();
-        for (int k = 0; k < members; ++k) {
-          const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
-          if (b.group == g) f_group += b.f_H_N;
+      // The tangent costs three elastica solves a segment. It only steers this tick's Newton
+      // step (the solution is where the elastica's shape and the contacts agree, whatever the
+      // tangent), so one computed for loads within 10 % and lengths within 1 % of these, in the
+      // last 50 ticks, is used again.
+      std::array<Eigen::Vector3d, kMaxLoads> f_group{};
+      std::array<double, kMaxLoads> length_m{};
+      for (int k = 0; k < members; ++k) {
+        const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
+        f_group[std::size_t(b.group)] += b.f_H_N;
+        length_m[std::size_t(b.group)] = b.s_m - b.clamp_m;  // the group's last load: its end
+      }
+      const double scale_N = m.beam.bending_stiffness_Nm2() / (l * l);
+      bool reuse = m.tangent_count == groups && m.tangent_age < 50;
+      for (int g = 0; g < groups && reuse; ++g) {
+        const std::size_t gi = std::size_t(g);
+        reuse = (f_group[gi] - m.tangent_force[gi]).norm() <=
+                    0.1 * m.tangent_force[gi].norm() + 1e-3 * scale_N &&
+                std::abs(length_m[gi] - m.tangent_length[gi]) <= 0.01 * l;
+      }
+      if (!reuse) {
+        m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
+        for (int g = 0; g < groups; ++g) {
+          const std::size_t gi = std::size_t(g);
+          m.tangent[gi] = m.beam.ElasticaCompliance(m.segments[gi], f_group[gi]);
+          m.tangent_force[gi] = f_group[gi];
+          m.tangent_length[gi] = length_m[gi];
         }
-        const Eigen::Matrix3d J = m.beam.ElasticaCompliance(m.segments[std::size_t(g)], f_group);
+        m.tangent_count = groups;
+        m.tangent_age = 0;
+      }
+      for (int g = 0; g < groups; ++g) {
+        const Eigen::Matrix3d& J = m.tangent[std::size_t(g)];
         for (int ki = 0; ki < members; ++ki) {
           const int i = m.order[std::size_t(ki)];
           if (m.beam_loads[std::size_t(i)].group != g) continue;
@@ -699,6 +729,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
   out.contact_count = kept;
 
+  ++m.tangent_age;
+
   // 8. The shape under the solved loads: the next tick's capsules, energy, strain, markers.
   m.beam_count = beam_count;
   std::array<bool, kMaxLoads> all{};
@@ -724,8 +756,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   };
   if (m.elastica_shape) {
     m.segment_count = m.beam.SolveElasticaChain(m.beam_loads, beam_count, m.order, m.segments);
-    for (int k = 0; k <= N; ++k)
-      m.nodes_H[std::size_t(k)] = m.beam.ElasticaPoint(m.segments, m.segment_count, l * k / N);
+    m.beam.ElasticaNodes(m.segments, m.segment_count,
+                         std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
     m.tip_tangent_H = m.beam.ElasticaTipTangent(m.segments, m.segment_count);
     for (int g = 0; g < m.segment_count; ++g) {
       const ElasticaSegment& seg = m.segments[std::size_t(g)];
