@@ -1,6 +1,6 @@
-#include <tubeplan/cli/app.hpp>
-
 #include <exception>
+
+#include <tubeplan/cli/app.hpp>
 
 #include "commands.hpp"
 
@@ -13,8 +13,8 @@ std::optional<std::vector<double>> ParseQuantityList(std::string_view option, st
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = text.find(',', start);
-    const std::string_view item =
-        text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
+    const std::string_view item = text.substr(
+        start, comma == std::string_view::npos ? std::string_view::npos : comma - start);
     const io::QuantityResult parsed = io::ParseQuantityAs(item, dimension);
     if (!parsed.quantity) {
       error = std::string(option) + ": \"" + std::string(item) + "\": " + parsed.error->message;
@@ -25,10 +25,11 @@ std::optional<std::vector<double>> ParseQuantityList(std::string_view option, st
     start = comma + 1;
   }
   if (values.size() < min_count || values.size() > max_count) {
-    error = std::string(option) + ": expected " +
-            (min_count == max_count ? std::to_string(min_count)
-                                    : std::to_string(min_count) + " to " + std::to_string(max_count)) +
-            " comma-separated values, got " + std::to_string(values.size());
+    error =
+        std::string(option) + ": expected " +
+        (min_count == max_count ? std::to_string(min_count)
+                                : std::to_string(min_count) + " to " + std::to_string(max_count)) +
+        " comma-separated values, got " + std::to_string(values.size());
     return std::nullopt;
   }
   return values;
@@ -42,10 +43,9 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   app.set_version_flag("--version", "tubeplan 0.1.0");
   app.require_subcommand(1);
   const Streams streams{out, err};
-  const std::vector<Command> commands = {AddCheckCommand(app, streams),
-                                         AddBeamCommand(app, streams),
-                                         AddBenchCommand(app, streams),
-                                         AddSimulateCommand(app, streams)};
+  const std::vector<Command> commands = {
+      AddCheckCommand(app, streams), AddBeamCommand(app, streams), AddBenchCommand(app, streams),
+      AddSimulateCommand(app, streams)};
 
   // CLI11 wants argv order reversed when given a vector.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

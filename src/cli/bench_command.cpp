@@ -230,15 +230,15 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
                              }));
   out.push_back(CoreScenario(scene, "core.end_stuck", "the tip pressed on the floor, stuck",
                              end_pose, dither));
-  out.push_back(CoreScenario(scene, "core.end_sliding", "the tip sliding along the floor",
-                             end_pose, slide));
+  out.push_back(
+      CoreScenario(scene, "core.end_sliding", "the tip sliding along the floor", end_pose, slide));
   out.push_back(CoreScenario(scene, "core.two_pcs",
                              "the tip on the floor and the side along the left wall",
                              HandPose(-2.5e-3, -0.090, 0.0455, 15.0, 0.0), dither));
-  out.push_back(CoreScenario(
-      scene, "core.three_pcs",
-      "lying in the groove, turned to touch both walls: floor, left wall, right wall",
-      HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
+  out.push_back(
+      CoreScenario(scene, "core.three_pcs",
+                   "lying in the groove, turned to touch both walls: floor, left wall, right wall",
+                   HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
   // The leave-out effect: the same stuck tip without friction, and with the shape asked for.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};

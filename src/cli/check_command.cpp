@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/scene/elements.hpp>
@@ -29,7 +30,14 @@ std::string Summary(const scene::Scene& s) {
       << t.inner_radius_m * 2e3 << " mm x " << t.length_m * 1e3 << " mm, E "
       << (t.youngs_modulus_Pa >= 1e9 ? t.youngs_modulus_Pa / 1e9 : t.youngs_modulus_Pa / 1e6)
       << (t.youngs_modulus_Pa >= 1e9 ? " GPa; " : " MPa; ") << s.parts.size() << " parts, "
-      << scene::EnumerateElements(s).size() << " elements; ";
+      << scene::EnumerateElements(s).size() << " elements";
+  {
+    // What the core keeps of it: parts beyond the tube's reach from the workspace are left out.
+    const core::Core core(s);
+    out << " (" << core.reachable_parts().size() << " parts, " << core.elements().size()
+        << " elements within reach; the tube as " << core.capsule_count() << " capsules)";
+  }
+  out << "; ";
   if (s.friction.IsFrictionless()) {
     out << "frictionless";
   } else {

@@ -44,13 +44,20 @@ void AppendPose(std::string& s, const Eigen::Isometry3d& X) {
 
 std::string_view FlagName(std::uint32_t bit) {
   switch (bit) {
-    case core::kForceClamped: return "clamped";
-    case core::kPenetration: return "penetration";
-    case core::kProxySeparated: return "separated";
-    case core::kContactsTruncated: return "truncated";
-    case core::kLinearFallback: return "linear_fallback";
-    case core::kSolverFault: return "fault";
-    default: return "unknown";
+    case core::kForceClamped:
+      return "clamped";
+    case core::kPenetration:
+      return "penetration";
+    case core::kProxySeparated:
+      return "separated";
+    case core::kContactsTruncated:
+      return "truncated";
+    case core::kLinearFallback:
+      return "linear_fallback";
+    case core::kSolverFault:
+      return "fault";
+    default:
+      return "unknown";
   }
 }
 

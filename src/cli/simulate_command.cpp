@@ -185,8 +185,9 @@ Command AddSimulateCommand(CLI::App& app, Streams streams) {
       "peaks and timing; --out writes the per-tick series (.csv or .jsonl).");
   sub->add_option("scene", options->scene_path, "scene file (.yaml)")->required();
   sub->add_option("trajectory", options->trajectory_path, "hand trajectory (.csv)")->required();
-  sub->add_option("--out", options->out_path,
-                  "write the per-tick series to FILE (.csv or .jsonl; see docs/simulate-output.md)");
+  sub->add_option(
+      "--out", options->out_path,
+      "write the per-tick series to FILE (.csv or .jsonl; see docs/simulate-output.md)");
   sub->add_flag("--json", options->json, "print the summary as one JSON document");
   sub->add_flag("--mesh", options->mesh,
                 "add the deformed centreline (21 points) to every tick of the series");

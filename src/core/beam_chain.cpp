@@ -30,8 +30,8 @@ BeamChain::BeamChain(const scene::Scene& scene)
       rule_(scene.model.multi_contact) {}
 
 int BeamChain::Assign(std::array<BeamLoad, kMaxLoads>& loads, int total,
-                      const std::array<bool, kMaxLoads>& member,
-                      std::array<int, kMaxLoads>& order, int& members) const {
+                      const std::array<bool, kMaxLoads>& member, std::array<int, kMaxLoads>& order,
+                      int& members) const {
   int count = 0;
   for (int i = 0; i < total; ++i)
     if (member[std::size_t(i)]) order[std::size_t(count++)] = i;
@@ -180,8 +180,8 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     const Eigen::Vector3d f_S = R_HS.transpose() * f_H;
     const double fx = std::hypot(f_S.x(), f_S.y());
     // The bending direction: along the lateral load; with none (axial load), the clamp's x.
-    seg.bend_x_S = fx > 0.0 ? Eigen::Vector3d(f_S.x() / fx, f_S.y() / fx, 0.0)
-                            : Eigen::Vector3d::UnitX();
+    seg.bend_x_S =
+        fx > 0.0 ? Eigen::Vector3d(f_S.x() / fx, f_S.y() / fx, 0.0) : Eigen::Vector3d::UnitX();
     const double f = std::hypot(fx, f_S.z());
     const double L = seg.length_m;
     if (L > 0.0) {
@@ -247,8 +247,8 @@ void BeamChain::ElasticaNodes(const std::array<ElasticaSegment, kMaxLoads>& segm
     const Eigen::Vector3d x_H = seg.R_HS * seg.bend_x_S;
     const Eigen::Vector3d z_H = seg.R_HS.col(2);
     const auto point = [&](int j) {
-      return Eigen::Vector3d(seg.origin_H + L * (xz[std::size_t(j)].x() * x_H +
-                                                 xz[std::size_t(j)].y() * z_H));
+      return Eigen::Vector3d(seg.origin_H +
+                             L * (xz[std::size_t(j)].x() * x_H + xz[std::size_t(j)].y() * z_H));
     };
     const auto tangent = [&](int j) {  // d/ds of the position, unit length
       return Eigen::Vector3d(std::sin(theta[std::size_t(j)]) * x_H +
@@ -294,7 +294,7 @@ Eigen::Matrix3d BeamChain::ElasticaCompliance(const ElasticaSegment& segment,
   // Across the bending plane the response is the in-plane one turned about the axis: a small
   // turn phi of the load turns the deflection X by the same phi, so the compliance is X / fx.
   const double across = fx > 1e-9 * scale ? base.x() / fx : dx.x();
-  Eigen::Matrix3d J_local;  // in the basis (bend x, bend y, z) of S
+  Eigen::Matrix3d J_local;         // in the basis (bend x, bend y, z) of S
   J_local << dx.x(), 0.0, dz.x(),  //
       0.0, across, 0.0,            //
       dx.y(), 0.0, dz.y();

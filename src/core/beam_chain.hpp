@@ -40,20 +40,20 @@
 namespace tubeplan::core {
 
 struct BeamLoad {
-  double s_m = 0.0;                                    ///< arc position of the load point
-  Eigen::Vector3d f_H_N = Eigen::Vector3d::Zero();     ///< force on the tube, frame H
-  Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();     ///< surface point minus centre, frame H
-  double clamp_m = 0.0;                                ///< c_j (set by BeamChain::Assign)
-  int group = 0;                                       ///< cut group (set by Assign)
+  double s_m = 0.0;                                 ///< arc position of the load point
+  Eigen::Vector3d f_H_N = Eigen::Vector3d::Zero();  ///< force on the tube, frame H
+  Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();  ///< surface point minus centre, frame H
+  double clamp_m = 0.0;                             ///< c_j (set by BeamChain::Assign)
+  int group = 0;                                    ///< cut group (set by Assign)
   int pc = -1;  ///< loads of one PC (the two ends of a line contact) are never cut apart
 };
 
 /// The solved shape of one elastica segment (a group's cantilever).
 struct ElasticaSegment {
   model::ElasticaSolution solution;
-  Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();  ///< clamp cross-section centre
-  Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();  ///< clamp frame S (z along the tangent)
-  Eigen::Vector3d bend_x_S = Eigen::Vector3d::UnitX(); ///< bending direction in S
+  Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();   ///< clamp cross-section centre
+  Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();   ///< clamp frame S (z along the tangent)
+  Eigen::Vector3d bend_x_S = Eigen::Vector3d::UnitX();  ///< bending direction in S
   double clamp_m = 0.0, length_m = 0.0;
 };
 

@@ -17,7 +17,8 @@ Eigen::Isometry3d SegmentPose(const Eigen::Vector3d& a_W, const Eigen::Vector3d&
   X.translation() = 0.5 * (a_W + b_W);
   const Eigen::Vector3d axis = b_W - a_W;
   // Pieces have the tube's length over N, far from zero; FromTwoVectors handles antiparallel.
-  X.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
+  X.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
   return X;
 }
 
@@ -175,9 +176,8 @@ void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
   c.overlap = true;
 }
 
-int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
-                     const Eigen::Vector3d& tip_tangent_W, double band_m,
-                     std::span<RawContact> out) const {
+int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
+                     double band_m, std::span<RawContact> out) const {
   // Capsules 0 .. pieces - 2, then the end cylinder as piece pieces - 1.
   const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
   int count = 0;
@@ -219,10 +219,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W,
       double d = 0.0;
       Eigen::Vector3d p_tube_W, q_part_W;
       ++narrow_calls_;
-      const bool separated =
-          is_end ? solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box, part.X_WP, &d,
-                                         &p_tube_W, &q_part_W)
-                 : CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
+      const bool separated = is_end ? solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box,
+                                                            part.X_WP, &d, &p_tube_W, &q_part_W)
+                                    : CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
       RawContact c;
       c.part = part.index;
       if (separated && d >= band_m) continue;

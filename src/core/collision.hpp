@@ -22,11 +22,11 @@ namespace tubeplan::core {
 /// One close pair: a piece of the tube (capsule or end cylinder) and a part.
 struct RawContact {
   states::TubeElement tube = states::TubeElement::kSide;
-  int part_element = -1;      ///< index into the core's element list
+  int part_element = -1;  ///< index into the core's element list
   std::uint8_t face_mask = 0;
-  std::uint32_t part = 0;     ///< index into scene.parts
-  double s_m = 0.0;           ///< arc position of the centreline point under the contact
-  double distance_m = 0.0;    ///< >= 0; 0 when the shapes overlap (then `overlap` is set)
+  std::uint32_t part = 0;   ///< index into scene.parts
+  double s_m = 0.0;         ///< arc position of the centreline point under the contact
+  double distance_m = 0.0;  ///< >= 0; 0 when the shapes overlap (then `overlap` is set)
   bool overlap = false;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
@@ -93,9 +93,9 @@ class Collision {
   mutable fcl::detail::GJKSolver_indep<double> solver_;
   double radius_m_ = 0.0;
   double length_m_ = 0.0;
-  double piece_m_ = 0.0;        // arc length of one capsule, l / N
-  int end_pieces_ = 1;          // node intervals the end cylinder covers
-  double end_m_ = 0.0;          // its length, end_pieces_ * piece_m_ >= r1
+  double piece_m_ = 0.0;  // arc length of one capsule, l / N
+  int end_pieces_ = 1;    // node intervals the end cylinder covers
+  double end_m_ = 0.0;    // its length, end_pieces_ * piece_m_ >= r1
   double part_tolerance_m_ = 0.0;
   double tube_tolerance_m_ = 0.0;
   mutable int narrow_calls_ = 0;

@@ -1,11 +1,10 @@
-#include <tubeplan/core/core.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/LU>
 
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/core/coupling.hpp>
 #include <tubeplan/core/friction.hpp>
 #include <tubeplan/model/tube.hpp>
@@ -18,8 +17,8 @@ namespace tubeplan::core {
 namespace {
 
 constexpr int kMaxUnknowns = 3 * kMaxLoads + 6;
-using SystemMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns,
-                                   kMaxUnknowns>;
+using SystemMatrix =
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
 using SystemVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
 // Friction, release and saturation decisions re-solve the tick's system; each pass settles at
 // least one contact, so kMaxContacts + 2 passes always suffice (the rest is a safety bound).
@@ -65,25 +64,25 @@ struct Core::Impl {
 
   // One load point of a PC in a tick.
   struct Load {
-    int pc = 0;       // index into the tick's PCs
-    int end = 0;      // 0, or 1 for the far end of an extended contact
+    int pc = 0;   // index into the tick's PCs
+    int end = 0;  // 0, or 1 for the far end of an extended contact
     states::TubeElement tube = states::TubeElement::kSide;
     int part_element = -1;
     double s_m = 0.0;
-    double distance_m = 0.0;                                // d where x0 is
+    double distance_m = 0.0;  // d where x0 is
     Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
-    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();         // surface point at the tick's start
-    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();       // x = base + p + R W R^T F
-    Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();     // stuck: held here tangentially
-    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();      // last tick's force (linearisation)
+    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();      // surface point at the tick's start
+    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();    // x = base + p + R W R^T F
+    Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  // stuck: held here tangentially
+    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();   // last tick's force (linearisation)
     // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
     // exact for beta = 1, where a = 0 and b = mu_k).
     Eigen::Vector3d slide_dir_W = Eigen::Vector3d::Zero();
     double slide_a = 0.0, slide_b = 0.0;
-    Eigen::Vector3d force_W = Eigen::Vector3d::Zero();      // result
-    Eigen::Vector3d x_W = Eigen::Vector3d::Zero();          // result
-    const scene::Friction* friction = nullptr;              // null: frictionless here
-    Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();        // surface point - centre, frame H
+    Eigen::Vector3d force_W = Eigen::Vector3d::Zero();  // result
+    Eigen::Vector3d x_W = Eigen::Vector3d::Zero();      // result
+    const scene::Friction* friction = nullptr;          // null: frictionless here
+    Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();    // surface point - centre, frame H
     bool active = true, released = false, sliding = false, shifted = false;
     bool matched = false, ghost = false;
     bool SameKey(const Load& o) const {
@@ -502,8 +501,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const bool stuck = ld.friction && !ld.sliding;
       // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
       // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
-      const Eigen::Vector3d n_eff = ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W)
-                                               : nrm;
+      const Eigen::Vector3d n_eff =
+          ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
       const Eigen::Matrix3d G = K * n_eff * nrm.transpose() + (stuck ? Kt : 0.0) * Tp;
       Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
       if (stuck) b += Kt * (Tp * ld.anchor_W);
@@ -719,8 +718,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     int at = kept++;
     while (at > 0) {
       const ContactState& before = out.contacts[std::size_t(at - 1)];
-      const bool in_order = before.tube != pc.tube ? before.tube < pc.tube
-                                                   : before.part_element < pc.part_element;
+      const bool in_order =
+          before.tube != pc.tube ? before.tube < pc.tube : before.part_element < pc.part_element;
       if (in_order) break;
       out.contacts[std::size_t(at)] = before;
       --at;
@@ -777,13 +776,15 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
     for (int j = 0; j < beam_count; ++j)
       rotation += m.beam.SectionRotation(l, m.beam_loads[std::size_t(j)]);
-    m.tip_tangent_H = (Eigen::Vector3d::UnitZ() + rotation.cross(Eigen::Vector3d::UnitZ())).normalized();
+    m.tip_tangent_H =
+        (Eigen::Vector3d::UnitZ() + rotation.cross(Eigen::Vector3d::UnitZ())).normalized();
     // U = 1/2 sum over loads on one cantilever of F_i . W_ij F_j: the work of the loads.
     for (int i = 0; i < beam_count; ++i)
       for (int j = 0; j < beam_count; ++j) {
         const BeamLoad& a = m.beam_loads[std::size_t(i)];
         const BeamLoad& b = m.beam_loads[std::size_t(j)];
-        if (a.clamp_m == b.clamp_m) energy_J += 0.5 * a.f_H_N.dot(m.beam.Compliance(a, b) * b.f_H_N);
+        if (a.clamp_m == b.clamp_m)
+          energy_J += 0.5 * a.f_H_N.dot(m.beam.Compliance(a, b) * b.f_H_N);
       }
     // The bending moment is piecewise linear between clamps and load points (with jumps at the
     // offset moments): its largest value is at one of them, from either side.
@@ -848,7 +849,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   if (force_W.norm() > max_force * (1.0 + 1e-9) || torque_W.norm() > scene_.device.max_torque_Nm)
     out.flags |= kForceClamped;
   const bool all_finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
-                      std::isfinite(energy_J) && std::isfinite(strain);
+                          std::isfinite(energy_J) && std::isfinite(strain);
   if (!all_finite) {
     Reset(X_W_hand);
     out.flags |= kSolverFault;
@@ -860,7 +861,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // Ghosts have done their work; the next tick continues this tick's real loads.
   m.prev_count = 0;
   for (int i = 0; i < load_count; ++i)
-    if (!m.loads[std::size_t(i)].ghost) m.prev[std::size_t(m.prev_count++)] = m.loads[std::size_t(i)];
+    if (!m.loads[std::size_t(i)].ghost)
+      m.prev[std::size_t(m.prev_count++)] = m.loads[std::size_t(i)];
   return out;
 }
 

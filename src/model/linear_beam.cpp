@@ -1,6 +1,6 @@
-#include <tubeplan/model/linear_beam.hpp>
-
 #include <cmath>
+
+#include <tubeplan/model/linear_beam.hpp>
 
 namespace tubeplan::model {
 

@@ -1,5 +1,3 @@
-#include <tubeplan/model/tip_response.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -7,6 +5,7 @@
 
 #include <tubeplan/model/elastica.hpp>
 #include <tubeplan/model/linear_beam.hpp>
+#include <tubeplan/model/tip_response.hpp>
 
 namespace tubeplan::model {
 namespace {
@@ -63,8 +62,7 @@ TipLoadResponse TipResponse(BeamModel model, const TubeSpec& spec,
 }
 
 Eigen::Vector3d PointDisplacement(BeamModel model, const TubeSpec& spec,
-                                  const Eigen::Vector3d& f_tip_O_N,
-                                  const Eigen::Vector3d& p_OP_O) {
+                                  const Eigen::Vector3d& f_tip_O_N, const Eigen::Vector3d& p_OP_O) {
   if (model == BeamModel::kLinear) {
     return LinearBeam(spec).Displacement(p_OP_O, f_tip_O_N.head<2>());
   }

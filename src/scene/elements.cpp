@@ -1,6 +1,6 @@
-#include <tubeplan/scene/elements.hpp>
-
 #include <bit>
+
+#include <tubeplan/scene/elements.hpp>
 
 namespace tubeplan::scene {
 namespace {

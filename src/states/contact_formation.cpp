@@ -1,8 +1,8 @@
-#include <tubeplan/states/contact_formation.hpp>
-
 #include <algorithm>
 #include <array>
 #include <cctype>
+
+#include <tubeplan/states/contact_formation.hpp>
 
 namespace tubeplan::states {
 namespace {
@@ -121,7 +121,8 @@ ParseResult ParseContactFormation(std::string_view text) {
   Cursor cursor(text);
   cursor.SkipSpace();
   if (!cursor.Consume('{'))
-    return Fail(cursor.pos(), "expected '{' to open a contact formation, e.g. \"{Fe ~ left.inner}\"");
+    return Fail(cursor.pos(),
+                "expected '{' to open a contact formation, e.g. \"{Fe ~ left.inner}\"");
   ContactFormation cf;
   cursor.SkipSpace();
   if (!cursor.Consume('}')) {
@@ -146,10 +147,11 @@ ParseResult ParseContactFormation(std::string_view text) {
       const std::size_t part_at = cursor.pos();
       const std::string_view part_word = cursor.Word();
       if (!IsPartElementName(part_word))
-        return Fail(part_at, "expected a part element \"part.element\" (e.g. left.top_inner), got " +
-                                 Quote(part_word));
-      PrincipalContact pc{static_cast<TubeElement>(tube->value),
-                          static_cast<Marker>(marker->value), std::string(part_word)};
+        return Fail(part_at,
+                    "expected a part element \"part.element\" (e.g. left.top_inner), got " +
+                        Quote(part_word));
+      PrincipalContact pc{static_cast<TubeElement>(tube->value), static_cast<Marker>(marker->value),
+                          std::string(part_word)};
       if (!MarkerAllowed(pc.tube, pc.marker))
         return Fail(marker_at, std::string(ToString(pc.tube)) +
                                    " never deforms, so it cannot carry marker " +
@@ -167,8 +169,7 @@ ParseResult ParseContactFormation(std::string_view text) {
     }
   }
   cursor.SkipSpace();
-  if (!cursor.AtEnd())
-    return Fail(cursor.pos(), "unexpected text after the closing '}'");
+  if (!cursor.AtEnd()) return Fail(cursor.pos(), "unexpected text after the closing '}'");
   Canonicalize(cf);
   return ParseResult{std::move(cf), std::nullopt};
 }

@@ -1,9 +1,9 @@
 // The command line as a user drives it: argument strings in, exit code and text out.
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <numbers>
 #include <sstream>
-#include <map>
 #include <string>
 #include <vector>
 
@@ -177,8 +177,8 @@ TEST_CASE("check: a broken scene is exit code 2 with file:line:col diagnostics",
 TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   // Only the shape of the report is tested: speed is measured by running `tubeplan bench`,
   // never asserted in a test.
-  const Outcome r = RunTool(
-      {"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
+  const Outcome r =
+      RunTool({"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(r.exit_code == 0);
   const auto doc = nlohmann::json::parse(r.out);
   REQUIRE(doc["scenarios"].size() == 13);

@@ -1,9 +1,9 @@
 // The beam chain's internals against independent evaluations.
+#include "core/beam_chain.hpp"  // private to the core (src/)
+
 #include <cmath>
 
 #include <catch2/catch.hpp>
-
-#include "core/beam_chain.hpp"  // private to the core (src/)
 
 using namespace tubeplan;
 
@@ -25,8 +25,12 @@ TEST_CASE("Elastica nodes by Hermite interpolation stay within 2 um of the exact
       std::array<core::BeamLoad, core::kMaxLoads> loads{};
       // A tip load at 30 degrees to the lateral direction, alpha measured on the loaded length.
       const double F = alpha * EI / (s_load * s_load);
-      loads[0] = {s_load, F * Eigen::Vector3d(std::cos(0.5), std::sin(0.5) * 0.0, -std::sin(0.5)),
-                  Eigen::Vector3d::Zero(), 0.0, 0, 0};
+      loads[0] = {s_load,
+                  F * Eigen::Vector3d(std::cos(0.5), std::sin(0.5) * 0.0, -std::sin(0.5)),
+                  Eigen::Vector3d::Zero(),
+                  0.0,
+                  0,
+                  0};
       std::array<bool, core::kMaxLoads> member{};
       member[0] = true;
       std::array<int, core::kMaxLoads> order{};

@@ -135,7 +135,8 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
   std::mt19937_64 rng(20261122);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (const char* file : {"scenes/groove.yaml", "scenes/groove-steel.yaml"}) {
-    for (const auto rule : {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
+    for (const auto rule :
+         {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
       scene::Scene s = LoadScene(file);
       s.model.multi_contact = rule;
       core::Core c(s);
@@ -185,7 +186,8 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
           moment += pc.moment_W_Nm;
           // Friction never exceeds the static limit at any load point, nor for the PC.
           CHECK(pc.friction_ratio <= 1.0 + 1e-9);
-          if (pc.loads == 1) CHECK(pc.friction_W_N.norm() <= pc.friction_limit_N * (1 + 1e-9) + 1e-15);
+          if (pc.loads == 1)
+            CHECK(pc.friction_W_N.norm() <= pc.friction_limit_N * (1 + 1e-9) + 1e-15);
           CHECK(pc.normal_force_N >= 0.0);
         }
         CHECK((force - out.force_W_N).norm() <= 1e-12 * (1.0 + force.norm()));
@@ -206,9 +208,8 @@ TEST_CASE("Invariants on random states of both shipped scenes", "[core][invarian
           // The spring or the grip is saturated at the device's force or torque.
           const bool at_force = std::abs(out.force_W_N.norm() - s.device.max_force_N) <= 1e-6;
           // (the grip's weak regularising spring adds at most 1e-3 of the torque per radian)
-          const bool at_torque =
-              std::abs(out.torque_W_Nm.norm() - s.device.max_torque_Nm) <=
-              1e-2 * s.device.max_torque_Nm;
+          const bool at_torque = std::abs(out.torque_W_Nm.norm() - s.device.max_torque_Nm) <=
+                                 1e-2 * s.device.max_torque_Nm;
           CHECK((at_force || at_torque));
         } else {
           // What the damper still carries: B times the held end's last speed (settling / T).
@@ -230,7 +231,7 @@ TEST_CASE("Degenerate inputs never make NaN leave the core", "[core][degenerate]
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   for (const Eigen::Vector3d& p : {Eigen::Vector3d(nan, 0, 0), Eigen::Vector3d(0, inf, 0),
-                                  Eigen::Vector3d(1e300, -1e300, 1e300)}) {
+                                   Eigen::Vector3d(1e300, -1e300, 1e300)}) {
     Eigen::Isometry3d X = s.X_WH_start;
     X.translation() = p;
     const core::StepOutput& out = c.Step(t += 1e-3, X);

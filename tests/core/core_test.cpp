@@ -78,7 +78,8 @@ TEST_CASE("A frictionless wall facing the tip: normal force K (eps - d), no bend
   }
 }
 
-TEST_CASE("Tip stuck on a wall, the hand moves sideways: 3EI/l^3 in series, then kinetic", "[core]") {
+TEST_CASE("Tip stuck on a wall, the hand moves sideways: 3EI/l^3 in series, then kinetic",
+          "[core]") {
   scene::Scene s = TubeScene();
   const double l = s.tube.length_m;
   s.friction = {0.5, 0.2, 1.0, 1.0};
@@ -128,7 +129,8 @@ TEST_CASE("The side on an edge at distance a: stiffness 3EI/a^3 in series, conve
   const double a = 0.2;
   const double d0 = 0.5e-3;
   // A 20 mm cube turned 45 degrees about y: one edge (along y) points at the tube, at height a.
-  scene::BoxPart block = Box("block", {0.02, 0.02, 0.02}, {r1 + d0 + 0.01 * std::sqrt(2.0), 0.0, a});
+  scene::BoxPart block =
+      Box("block", {0.02, 0.02, 0.02}, {r1 + d0 + 0.01 * std::sqrt(2.0), 0.0, a});
   block.X_WP.linear() = Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitY()).toRotationMatrix();
   s.parts.push_back(block);
   core::Core c(s);
@@ -148,9 +150,8 @@ TEST_CASE("The side on an edge at distance a: stiffness 3EI/a^3 in series, conve
     const double theta = std::abs(out.force_W_N.x()) * a * a / (2.0 * EI);
     CHECK(pc.s_m == Approx(a).margin(1.01 * r1 * theta + 1e-9));
     // Plus K times GJK's distance error for an edge (measured below 1e-9 m): 1e-5 N.
-    CHECK(-out.force_W_N.x() == Approx((delta_m + 1e-3 - d0) * k_series)
-                                    .epsilon(2.0 * theta * theta)
-                                    .margin(1e-5));
+    CHECK(-out.force_W_N.x() ==
+          Approx((delta_m + 1e-3 - d0) * k_series).epsilon(2.0 * theta * theta).margin(1e-5));
     if (out.tip_deflection_m > 1e-4) CHECK(pc.marker == states::Marker::kConvex);
   }
 }
@@ -183,9 +184,8 @@ TwoPcClosedForm SolveTwoPc(double h, double K, double Kc, double eps, double r1,
   // N1 (1 + K c11) - K c12 N2 + K p = K (eps + r1 - e1)
   // -K c21 N1 + N2 (1 + K c22) - K p = K (eps + r1 - e2)
   // -Kc p + N1 - N2 = -Kc h
-  const double A[3][3] = {{K, 1.0 + K * c11, -K * c12},
-                          {-K, -K * c21, 1.0 + K * c22},
-                          {-Kc, 1.0, -1.0}};
+  const double A[3][3] = {
+      {K, 1.0 + K * c11, -K * c12}, {-K, -K * c21, 1.0 + K * c22}, {-Kc, 1.0, -1.0}};
   const double b[3] = {K * (eps + r1 - e1), K * (eps + r1 - e2), -Kc * h};
   const auto det3 = [](const double m[3][3]) {
     return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
@@ -230,7 +230,8 @@ TEST_CASE("Two PCs (Fig. 6): the segmented and the coupled rule against their cl
       const core::ContactState* under = nullptr;
       const core::ContactState* over = nullptr;
       for (const core::ContactState& pc : out.Contacts())
-        (c.elements()[std::size_t(pc.part_element)].name.rfind("under", 0) == 0 ? under : over) = &pc;
+        (c.elements()[std::size_t(pc.part_element)].name.rfind("under", 0) == 0 ? under : over) =
+            &pc;
       REQUIRE(under != nullptr);
       REQUIRE(over != nullptr);
       const double a = under->s_m, b = over->s_m;
@@ -258,7 +259,8 @@ TEST_CASE("Two PCs (Fig. 6): the segmented and the coupled rule against their cl
       const double bend_mid = expected.N1 * (a / 2) - expected.N2 * (b - a / 2);
       const states::Marker expected_marker =
           coupled && bend_mid < 0.0 ? states::Marker::kConcave : states::Marker::kConvex;
-      if (out.tip_deflection_m > s.contact.bend_threshold_m) CHECK(under->marker == expected_marker);
+      if (out.tip_deflection_m > s.contact.bend_threshold_m)
+        CHECK(under->marker == expected_marker);
     }
   }
 }

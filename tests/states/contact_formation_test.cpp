@@ -34,8 +34,7 @@ TEST_CASE("PCs are printed as three words and sorted by their text", "[states]")
   const ContactFormation cf = MustParse("{Fs u left.top_inner, Fe ~ left.inner}");
   REQUIRE(cf.contacts.size() == 2);
   CHECK(cf.contacts[0] == PrincipalContact{TubeElement::kEndFace, Marker::kBent, "left.inner"});
-  CHECK(cf.contacts[1] ==
-        PrincipalContact{TubeElement::kSide, Marker::kConcave, "left.top_inner"});
+  CHECK(cf.contacts[1] == PrincipalContact{TubeElement::kSide, Marker::kConcave, "left.top_inner"});
   CHECK(ToString(cf) == "{Fe ~ left.inner, Fs u left.top_inner}");
   // The same set written in another order is the same CF.
   CHECK(MustParse("{Fe ~ left.inner,Fs u left.top_inner}") == cf);
@@ -49,7 +48,7 @@ TEST_CASE("The paper's arc symbols and plain words parse to the canonical marker
 }
 
 TEST_CASE("Random contact formations round-trip print -> parse -> equal", "[states]") {
-  const std::vector<std::string> elements = {"left.top", "left.top_inner", "right.inner",
+  const std::vector<std::string> elements = {"left.top",  "left.top_inner",      "right.inner",
                                              "floor.top", "floor.top_xpos_ypos", "b2.xneg"};
   std::mt19937 rng(12345);
   int checked = 0;

@@ -64,13 +64,13 @@ enum StepFlag : std::uint32_t {
 struct ContactState {
   states::TubeElement tube = states::TubeElement::kSide;
   states::Marker marker = states::Marker::kNone;
-  int part_element = -1;  ///< index into Core::elements()
-  int loads = 0;          ///< load points carrying it (1 or 2)
-  double s_m = 0.0;       ///< arc position of its (deepest) load point on the centreline [m]
+  int part_element = -1;    ///< index into Core::elements()
+  int loads = 0;            ///< load points carrying it (1 or 2)
+  double s_m = 0.0;         ///< arc position of its (deepest) load point on the centreline [m]
   double distance_m = 0.0;  ///< smallest distance d between the two elements [m]
-  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< unit, from the part into the tube
-  Eigen::Vector3d p_WC_m = Eigen::Vector3d::Zero();     ///< deepest contact point on the tube
-  double normal_force_N = 0.0;                          ///< sum over its load points, >= 0
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();     ///< unit, from the part into the tube
+  Eigen::Vector3d p_WC_m = Eigen::Vector3d::Zero();        ///< deepest contact point on the tube
+  double normal_force_N = 0.0;                             ///< sum over its load points, >= 0
   Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< tangential force on the tube
   Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();     ///< total force on the tube
   Eigen::Vector3d moment_W_Nm = Eigen::Vector3d::Zero();   ///< its moment about the held end
@@ -78,7 +78,7 @@ struct ContactState {
   /// with mu_k = mu_s) and f_max of the total normal force.
   double friction_ratio = 0.0;
   double friction_limit_N = 0.0;
-  bool sliding = false;   ///< any of its load points slides
+  bool sliding = false;  ///< any of its load points slides
 };
 
 /// What one tick returns. Plain data; valid until the next Step.
@@ -86,14 +86,14 @@ struct StepOutput {
   double t_s = 0.0;
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();  ///< hand pose given
   Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();      ///< held end (proxy)
-  Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();    ///< on the operator, at the held end
-  Eigen::Vector3d torque_W_Nm = Eigen::Vector3d::Zero();  ///< on the operator, about H
-  std::array<ContactState, kMaxContacts> contacts{};      ///< sorted by (tube, part element)
+  Eigen::Vector3d force_W_N = Eigen::Vector3d::Zero();         ///< on the operator, at the held end
+  Eigen::Vector3d torque_W_Nm = Eigen::Vector3d::Zero();       ///< on the operator, about H
+  std::array<ContactState, kMaxContacts> contacts{};           ///< sorted by (tube, part element)
   int contact_count = 0;
-  double energy_J = 0.0;     ///< bending energy
-  double max_strain = 0.0;   ///< largest bending strain (outer fibre at a clamp) [-]
+  double energy_J = 0.0;          ///< bending energy
+  double max_strain = 0.0;        ///< largest bending strain (outer fibre at a clamp) [-]
   double tip_deflection_m = 0.0;  ///< lateral deflection of the free end from the straight tube
-  std::uint32_t flags = 0;   ///< StepFlag bits
+  std::uint32_t flags = 0;        ///< StepFlag bits
   std::span<const ContactState> Contacts() const {
     return {contacts.data(), static_cast<std::size_t>(contact_count)};
   }

@@ -28,9 +28,9 @@ inline constexpr Dimension kTime{0, 0, 1, 0};
 inline constexpr Dimension kAngle{0, 0, 0, 1};
 inline constexpr Dimension kForce{1, 1, -2, 0};
 inline constexpr Dimension kPressure{-1, 1, -2, 0};
-inline constexpr Dimension kStiffness{0, 1, -2, 0};   // N/m
-inline constexpr Dimension kDamping{0, 1, -1, 0};     // N s/m
-inline constexpr Dimension kTorque{2, 1, -2, 0};      // N m (also energy, J)
+inline constexpr Dimension kStiffness{0, 1, -2, 0};  // N/m
+inline constexpr Dimension kDamping{0, 1, -1, 0};    // N s/m
+inline constexpr Dimension kTorque{2, 1, -2, 0};     // N m (also energy, J)
 inline constexpr Dimension kFrequency{0, 0, -1, 0};
 inline constexpr Dimension kVelocity{1, 0, -1, 0};
 }  // namespace dim

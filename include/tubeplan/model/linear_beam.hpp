@@ -24,8 +24,7 @@ class LinearBeam {
   /// position in the bending frame is p_OP_B [m], under a tip force force_x_N [N] along +x.
   /// On the axis (x^2 + y^2 -> 0) the r1^2 r2^2 x / rho^2 term is taken as its value along x = 0,
   /// zero, rather than evaluated as 0/0.
-  Eigen::Vector3d DisplacementInBendingFrame(const Eigen::Vector3d& p_OP_B,
-                                             double force_x_N) const;
+  Eigen::Vector3d DisplacementInBendingFrame(const Eigen::Vector3d& p_OP_B, double force_x_N) const;
 
   /// Displacement [m], expressed in the tube frame, of the material point p_OP_O [m] (tube frame)
   /// under a lateral tip force f_lateral_O_N = (fx, fy) [N]. A zero force gives zero displacement
@@ -51,9 +50,9 @@ class LinearBeam {
  private:
   TubeSpec spec_;
   TubeSection section_;
-  double inv_EI_ = 0.0;          // 1 / (E I) [1/(N m^2)]
-  double warp_r_ = 0.0;          // kappa (r1^2 + r2^2) [m^2], kappa = (3 + 2 nu) / 4
-  double warp_r1r2_ = 0.0;       // kappa r1^2 r2^2 [m^4]
+  double inv_EI_ = 0.0;     // 1 / (E I) [1/(N m^2)]
+  double warp_r_ = 0.0;     // kappa (r1^2 + r2^2) [m^2], kappa = (3 + 2 nu) / 4
+  double warp_r1r2_ = 0.0;  // kappa r1^2 r2^2 [m^4]
 };
 
 }  // namespace tubeplan::model

@@ -38,7 +38,6 @@ TipLoadResponse TipResponse(BeamModel model, const TubeSpec& spec,
 /// load. Linear: corrected eq. (1). Elastica: the centreline moves as solved and the cross-section
 /// stays plane and normal to it (Euler-Bernoulli kinematics; no warping).
 Eigen::Vector3d PointDisplacement(BeamModel model, const TubeSpec& spec,
-                                  const Eigen::Vector3d& f_tip_O_N,
-                                  const Eigen::Vector3d& p_OP_O);
+                                  const Eigen::Vector3d& f_tip_O_N, const Eigen::Vector3d& p_OP_O);
 
 }  // namespace tubeplan::model

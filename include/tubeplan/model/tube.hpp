@@ -22,9 +22,9 @@ std::vector<std::string> ValidateTubeSpec(const TubeSpec& spec);
 
 /// Section quantities computed once from a valid spec.
 struct TubeSection {
-  double second_moment_m4 = 0.0;         ///< I = pi (r1^4 - r2^4) / 4 [m^4]
-  double bending_stiffness_Nm2 = 0.0;    ///< EI [N m^2]
-  double tip_stiffness_N_per_m = 0.0;    ///< k = 3 E I / l^3 [N/m] (paper eq. 2)
+  double second_moment_m4 = 0.0;       ///< I = pi (r1^4 - r2^4) / 4 [m^4]
+  double bending_stiffness_Nm2 = 0.0;  ///< EI [N m^2]
+  double tip_stiffness_N_per_m = 0.0;  ///< k = 3 E I / l^3 [N/m] (paper eq. 2)
 };
 
 /// Throws std::invalid_argument listing every problem when the spec is not valid.

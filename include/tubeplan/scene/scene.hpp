@@ -42,7 +42,7 @@ struct BoxPart {
   std::string name;                                  ///< [A-Za-z][A-Za-z0-9_]*
   Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  ///< full extents along the box's x, y, z [m]
   Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();  ///< box centre frame P in world W
-  std::optional<Friction> friction;                  ///< overrides the scene's friction if set
+  std::optional<Friction> friction;  ///< overrides the scene's friction if set
   /// Name of each face, indexed by BoxFace: the ids of kBoxFaceIds unless the scene renames them.
   std::array<std::string, 6> face_names = {"top", "bottom", "xpos", "xneg", "ypos", "yneg"};
 };
@@ -60,10 +60,10 @@ struct ModelOptions {
 
 /// The haptic device and the virtual coupling of the hand to the held end (physics.md).
 struct Device {
-  double max_force_N = 8.5;               ///< PHANToM Premium 1.5/6DOF
+  double max_force_N = 8.5;  ///< PHANToM Premium 1.5/6DOF
   double max_torque_Nm = 0.188;
   double max_stiffness_N_per_m = 800.0;
-  double damping_Ns_per_m = 5.0;          ///< the device's own physical damping b
+  double damping_Ns_per_m = 5.0;                     ///< the device's own physical damping b
   std::optional<double> coupling_stiffness_N_per_m;  ///< K_c; unset: a passive default
   std::optional<double> coupling_damping_Ns_per_m;   ///< unset: a default from the device
 };
