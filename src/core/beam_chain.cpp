@@ -12,7 +12,9 @@ namespace {
 // the bending direction and axial part fz.
 Eigen::Vector2d ElasticaTipXZ(double fx, double fz, double length_m, double EI) {
   const double f = std::hypot(fx, fz);
-  const double alpha = f * length_m * length_m / EI;
+  // The callers stay within the solver's range (ElasticaCovers allows half of it); the clamp
+  // only guarantees that a tick can never throw.
+  const double alpha = std::min(f * length_m * length_m / EI, model::kMaxElasticaAlpha);
   const double psi = f > 0.0 ? std::atan2(fz, fx) : 0.0;
   const model::ElasticaSolution solution = model::SolveElastica(alpha, psi);
   return {length_m * solution.tip.deflection, length_m * (1.0 - solution.tip.shortening)};
@@ -185,7 +187,8 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     const double f = std::hypot(fx, f_S.z());
     const double L = seg.length_m;
     if (L > 0.0) {
-      seg.solution = model::SolveElastica(f * L * L / EI_, f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0);
+      seg.solution = model::SolveElastica(std::min(f * L * L / EI_, model::kMaxElasticaAlpha),
+                                          f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0);
     } else {
       seg.solution = model::ElasticaSolution{};
     }

@@ -406,7 +406,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       // step (the solution is where the elastica's shape and the contacts agree, whatever the
       // tangent), so one computed for loads within 10 % and lengths within 1 % of these, in the
       // last 50 ticks, is used again.
-      std::array<Eigen::Vector3d, kMaxLoads> f_group{};
+      // (Eigen's vectors are not zeroed by {}: fill them.)
+      std::array<Eigen::Vector3d, kMaxLoads> f_group;
+      f_group.fill(Eigen::Vector3d::Zero());
       std::array<double, kMaxLoads> length_m{};
       for (int k = 0; k < members; ++k) {
         const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
@@ -870,8 +872,6 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
   const Impl& m = *impl_;
   const double l = scene_.tube.length_m;
   const std::size_t count = p_W_m.size();
-  const Eigen::Matrix3d R_WH = out_.X_WH.linear();
-  const Eigen::Vector3d p_WH = out_.X_WH.translation();
   for (std::size_t k = 0; k < count; ++k) {
     const double s = count > 1 ? l * double(k) / double(count - 1) : l;
     Eigen::Vector3d x_H(0.0, 0.0, s);
@@ -881,7 +881,7 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
       for (int j = 0; j < m.beam_count; ++j)
         x_H += m.beam.CentreDisplacement(s, m.beam_loads[std::size_t(j)]);
     }
-    p_W_m[k] = p_WH + R_WH * x_H;
+    p_W_m[k] = out_.X_WH * x_H;
   }
 }
 
