@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <memory>
+#include <numbers>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -71,7 +72,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
       Eigen::AngleAxisd(s.X_WH_start.linear().transpose() * X_W_hand0.linear()).angle();
   if (start_offset_m > 1e-3 || start_turn_rad > 1e-2) {
     io.err << o.trajectory_path << ": warning: the trajectory starts " << start_offset_m * 1e3
-           << " mm and " << start_turn_rad * 180.0 / M_PI
+           << " mm and " << start_turn_rad * 180.0 / std::numbers::pi
            << " deg away from the scene's start pose; the held end starts at the trajectory's\n";
   }
   core.Reset(X_W_hand0);

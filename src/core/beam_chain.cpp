@@ -78,11 +78,6 @@ double BeamChain::InfluenceSlope(double s_m, const BeamLoad& load) const {
 }
 
 namespace {
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
 const Eigen::Matrix3d kLateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
 const Eigen::Matrix3d kZ = Skew(Eigen::Vector3d::UnitZ());
 

@@ -39,6 +39,13 @@
 
 namespace tubeplan::core {
 
+/// The cross-product matrix: Skew(v) w = v x w.
+inline Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
 struct BeamLoad {
   double s_m = 0.0;                                 ///< arc position of the load point
   Eigen::Vector3d f_H_N = Eigen::Vector3d::Zero();  ///< force on the tube, frame H

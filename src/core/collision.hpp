@@ -48,17 +48,16 @@ class Collision {
 
   /// Close pairs of the tube whose centreline nodes (capsule_count + 1 of them, equally spaced
   /// in arc length from the held end) are `nodes_W`, with the free end's axis `tip_tangent_W`.
-  /// The last EndPieces() intervals are one straight cylinder along the tip tangent, so that no
-  /// capsule's round cap reaches past the flat end face.
-  /// Writes at most out.size() contacts and returns how many; no allocation.
-  /// Pairs closer than `band_m` are returned (the core asks for more than epsilon so that a
-  /// contact about to close this tick is in its system, and one releasing leaves smoothly).
+  /// The last intervals (at least r1 of tube) are one straight cylinder along the tip tangent, so
+  /// that no capsule's round cap reaches past the flat end face. Writes at most out.size() contacts
+  /// and returns how many; no allocation. Pairs closer than `band_m` are returned (the core asks
+  /// for more than epsilon so that a contact about to close this tick is in its system, and one
+  /// releasing leaves smoothly).
   int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
             double band_m, std::span<RawContact> out) const;
 
   /// GJK calls of the last Query (for the benchmarks' leave-out figures).
   int last_narrow_phase_calls() const { return narrow_calls_; }
-  int EndPieces() const { return end_pieces_; }
 
  private:
   struct Part {

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -31,12 +32,6 @@ void LineariseKinetic(const scene::Friction& friction, double normal_N, double& 
   const double fk = FrictionLimit(friction, friction.kinetic_coefficient, N);
   b = friction.exponent * fk / N;
   a = fk - b * N;
-}
-
-Eigen::Matrix3d Skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
 }
 
 bool IsBoundaryOf(states::TubeElement a, states::TubeElement b) {
@@ -241,6 +236,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   for (int i = 0; i < raw_count; ++i) {
     RawContact& a = m.raw[std::size_t(i)];
     for (int j = 0; j < raw_count; ++j) {
+      // Only an edge, a vertex or the rim bounds another element: a face touched by the end
+      // face or the side joins nothing (most pairs of a tube lying in a groove; this loop is
+      // quadratic in them).
+      if (std::popcount(unsigned(a.face_mask)) == 1 && a.tube != states::TubeElement::kEndRim)
+        break;
       const RawContact& b = m.raw[std::size_t(j)];
       if (i == j || a.part != b.part) continue;
       const bool part_bounds = (a.face_mask & b.face_mask) == b.face_mask;
