@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include <yaml-cpp/yaml.h>
 
@@ -485,10 +486,23 @@ void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
             "model.time_step must be in (0, 10 ms], expected e.g. \"1 ms\" (1 kHz)");
 }
 
+void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {
+  const std::string w = "heuristics";
+  if (!r.ExpectMap(node, w, {"friction", "energy", "distance", "tolerance"})) return;
+  for (auto [key, target] : {std::pair<const char*, double*>{"friction", &h.friction},
+                             {"energy", &h.energy},
+                             {"distance", &h.distance},
+                             {"tolerance", &h.tolerance}}) {
+    if (r.Field(node, key, w, dim::kNone, false, *target) && !(*target >= 0.0 && *target <= 1e6))
+      r.Error(r.Get(node, key, w, false),
+              w + "." + key + " must be a weight between 0 and 1e6, expected e.g. 1");
+  }
+}
+
 void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   const std::vector<std::string> top = {"tubeplan", "name",  "tube",     "contact",
                                         "friction", "parts", "start",    "goal",
-                                        "device",   "model", "workspace"};
+                                        "device",   "model", "workspace", "heuristics"};
   if (!root.IsMap()) {
     r.Error(root, std::string("a scene file must be a map, found ") + KindName(root) +
                       ", expected keys such as tubeplan, name, tube, parts");
@@ -585,6 +599,8 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
     ReadDevice(r, d, s.device);
   if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
     ReadModel(r, m, s.model);
+  if (const YAML::Node h = r.Get(root, "heuristics", "scene", false); h.IsDefined())
+    ReadHeuristics(r, h, s.heuristics);
   // The coupling a scene asks for must be passive on its device at its step (physics.md): an
   // active coupling makes the device oscillate in the operator's hand.
   if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsMap()) {

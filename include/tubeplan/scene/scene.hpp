@@ -74,6 +74,14 @@ struct Workspace {
   Eigen::Vector3d max_W_m = Eigen::Vector3d::Zero();
 };
 
+/// Weights of the graph's pruning heuristics (paper V-B; graph::PruneWeights has the meaning).
+struct Heuristics {
+  double friction = 1.0;   ///< [-], >= 0
+  double energy = 1.0;     ///< [-], >= 0
+  double distance = 1.0;   ///< [-], >= 0
+  double tolerance = 0.25; ///< [-], >= 0: how far above the best score an arc is still kept
+};
+
 struct Scene {
   std::string name;
   model::TubeSpec tube;
@@ -85,6 +93,7 @@ struct Scene {
   Device device;
   ModelOptions model;
   std::optional<Workspace> workspace;  ///< unset: the parts' bounding box grown by the tube length
+  Heuristics heuristics;
 };
 
 /// Friction that applies at a part: its own if set, the scene's otherwise.

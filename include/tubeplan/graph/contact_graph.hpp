@@ -1,0 +1,94 @@
+#pragma once
+// The extended contact-state graph (paper section V-A, contact-states.md): nodes are contact
+// formations the core produced, each with a witness (a tick of an exploration motion that the
+// core classifies as that CF, replayable with graph::ReplayTo); arcs are transitions the core
+// produced between them. Plain data; built by graph::Explore, pruned by graph::Prune.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/graph/motion.hpp>
+
+namespace tubeplan::graph {
+
+struct Node {
+  std::string cf;  ///< canonical text
+  int pcs = 0;     ///< number of PCs
+  /// The witness: the middle tick of the longest stay in this CF over all motions (the earliest
+  /// motion on ties), so it is a settled state rather than the tick of first touch.
+  TickRef witness;
+  Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();  ///< hand at the witness
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();      ///< held end at the witness
+  double energy_J = 0.0;          ///< bending energy at the witness
+  double friction_N = 0.0;        ///< sum of |friction force| over the PCs at the witness
+  double friction_limit_N = 0.0;  ///< sum of f_max over the PCs: the friction they can resist with
+  double force_N = 0.0;           ///< operator force at the witness
+  /// Motion of the held end still needed to reach the goal: |p_H - p_H,goal| + (l/2) angle
+  /// (R_H, R_H,goal) between the witnesses (the tube's middle moves by about l/2 per radian).
+  /// Negative when the goal was never reached.
+  double distance_m = -1.0;
+  long ticks = 0;  ///< ticks spent in this CF over all motions
+  bool start = false, goal = false;
+};
+
+struct Arc {
+  int from = 0, to = 0;  ///< node indices
+  long count = 0;        ///< how often the core produced it
+  /// The core changed more than one PC in one tick and refining the step (sub-stepping the hand
+  /// motion) did not split the change: e.g. a side landing flat on a face at two places at once.
+  bool simultaneous = false;
+  TickRef witness;  ///< first tick at which it was produced (the tick in the new CF)
+  bool kept = true;
+  std::string reason;  ///< why pruning dropped it (empty when kept)
+};
+
+struct SaturationPoint {
+  int motions = 0;
+  int nodes = 0;
+  int arcs = 0;
+};
+
+struct ContactGraph {
+  std::vector<Node> nodes;
+  std::vector<Arc> arcs;
+  int start = -1;  ///< node of the start pose
+  int goal = -1;   ///< node of the scene's goal CF, -1 when exploration never reached it
+  std::vector<Motion> motions;               ///< every motion explored, in order (witnesses index it)
+  std::vector<SaturationPoint> saturation;   ///< after each motion
+  std::vector<std::string> reached_elements;    ///< part elements seen in some PC
+  std::vector<std::string> unreached_elements;  ///< reachable parts' elements never seen
+  long ticks = 0;                            ///< core ticks run, refinements included
+  int refinements = 0;                       ///< multi-PC steps that were sub-stepped
+  double seconds = 0.0;                      ///< wall time of the exploration
+
+  int FindNode(const std::string& cf) const;
+};
+
+/// Weights of the paper's heuristics (V-B), each criterion scaled by its largest magnitude in the
+/// graph so that the weights are dimensionless.
+struct PruneWeights {
+  double friction = 1.0;
+  double energy = 1.0;
+  double distance = 1.0;
+  /// An arc that no other arc dominates is still dropped when its weighted score is more than
+  /// this above the best arc's of the same node.
+  double tolerance = 0.25;
+};
+
+/// Marks every arc kept or dropped (with its reason). For each node u other than the goal, an
+/// arc u -> v is kept when
+///  1. it leads towards the goal: the goal can be reached from v in the unpruned graph, and v is
+///     the goal or nearer to it than u (distance_m), so kept arcs never form a cycle;
+///  2. no other such arc u -> w dominates it on (friction limit of w, bending energy change,
+///     distance of w to the goal), lower being better on each;
+///  3. its weighted score  w_f f/f* + w_e dE/E* + w_d d/d*  is within `tolerance` of the best.
+/// Arcs out of the goal are dropped ("leaves the goal"). Without a goal every arc is dropped.
+void Prune(ContactGraph& graph, const PruneWeights& weights);
+
+/// The weighted score of an arc (criterion 3 above) under `weights`.
+double ArcScore(const ContactGraph& graph, const Arc& arc, const PruneWeights& weights);
+
+}  // namespace tubeplan::graph

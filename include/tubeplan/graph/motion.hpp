@@ -1,0 +1,82 @@
+#pragma once
+// Motions of the operator's hand used to explore a scene with the core: a list of guarded moves,
+// each a straight line in position and a slerp in orientation at a set speed, that ends early
+// when the force the operator feels along a direction exceeds a set value (the way a person
+// probes: "go down until it pushes back"). A motion starts at the scene's start pose. Running a
+// motion is deterministic, so a tick of a motion is a reproducible witness of the state the core
+// was in: MotionRunner replays it exactly.
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/core/core.hpp>
+
+namespace tubeplan::graph {
+
+/// One guarded move: from wherever the hand is to (p_W_m, q_W), at `speed_m_per_s` along the
+/// line (and at most `turn_rad_per_s` in rotation), stopping early once the operator force
+/// projected on `guard_dir_W` exceeds `guard_N` (guard_N <= 0: unguarded).
+struct Move {
+  Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond q_W = Eigen::Quaterniond::Identity();
+  double speed_m_per_s = 0.1;
+  double turn_rad_per_s = 1.0;
+  Eigen::Vector3d guard_dir_W = Eigen::Vector3d::Zero();
+  double guard_N = 0.0;
+};
+
+struct Motion {
+  std::string kind;  ///< "sweep", "aim", "random": how the explorer made it
+  std::vector<Move> moves;
+};
+
+/// Where a motion is refined: between ticks tick-1 and tick the hand's step is split into
+/// `substeps` equal parts, each run as a core tick, from the state the core was in at tick-1.
+/// substeps == 0: the motion as it is.
+struct TickRef {
+  int motion = 0;  ///< index into the explorer's motion list
+  int tick = 0;    ///< ticks of the motion run (1 = after the first Step)
+  int substeps = 0;
+  int substep = 0;  ///< with substeps > 0: how many of the sub-ticks were run (1 .. substeps)
+};
+
+/// Feeds a Motion to a core tick by tick. The hand starts at the core's reset pose.
+class MotionRunner {
+ public:
+  MotionRunner(const Motion& motion, const Eigen::Isometry3d& X_W_start, double time_step_s);
+
+  bool Done() const { return move_ >= moves_.size(); }
+  /// The hand pose for the next tick, given the core's last output (its force drives the guards).
+  Eigen::Isometry3d Next(const core::StepOutput& last);
+
+ private:
+  std::vector<Move> moves_;
+  std::size_t move_ = 0;
+  double step_s_;
+  Eigen::Vector3d p_W_m_;
+  Eigen::Quaterniond q_W_;
+  Eigen::Vector3d p_from_W_m_;
+  Eigen::Quaterniond q_from_W_;
+  int move_tick_ = 0;
+  int move_ticks_ = 0;
+};
+
+/// The held-end pose a motion's start puts the hand at (the scene's start pose).
+Eigen::Isometry3d MotionStart(const scene::Scene& scene);
+
+/// Runs `motion` through `core` (reset to the scene's start) up to and including `ref`, and
+/// returns the last step's output. The core is left in that state.
+const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const TickRef& ref);
+
+/// Runs ticks 1 .. tick-1 of `motion`, then splits the hand's step of `tick` into `substeps`
+/// sub-ticks and runs them, calling on_substep(j, output) after sub-tick j; stops when it
+/// returns false. ReplayTo uses it, so a refined witness replays bit for bit.
+void ReplaySubsteps(core::Core& core, const Motion& motion, int tick, int substeps,
+                    const std::function<bool(int, const core::StepOutput&)>& on_substep);
+
+}  // namespace tubeplan::graph

@@ -1,0 +1,200 @@
+// `tubeplan graph SCENE [--dot FILE] [--json FILE] [--unpruned] [--seed N] [--effort N]
+// [--jobs N] [--weights friction=1,energy=1,distance=1] [--tolerance T]`: explores the scene with
+// the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
+// JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
+#include <algorithm>
+#include <iomanip>
+#include <map>
+#include <optional>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+#include <tubeplan/graph/dot.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
+
+#include "commands.hpp"
+#include "graph_json.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+struct GraphOptions {
+  std::string scene_path;
+  std::string dot_path;
+  std::string json_path;
+  bool unpruned = false;
+  std::uint64_t seed = 1;
+  int effort = 40;
+  int budget = 300;
+  int jobs = 0;  // 0: the machine's cores
+  std::string weights;
+  std::optional<double> tolerance;
+};
+
+// "friction=1,energy=0.5,distance=2" over the scene's weights.
+bool ParseWeights(const std::string& text, graph::PruneWeights& w, std::string& error) {
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    const std::size_t eq = item.find('=');
+    double* target = nullptr;
+    const std::string key = item.substr(0, eq);
+    if (key == "friction") target = &w.friction;
+    if (key == "energy") target = &w.energy;
+    if (key == "distance") target = &w.distance;
+    char* end = nullptr;
+    const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
+    const double v = value.empty() ? -1.0 : std::strtod(value.c_str(), &end);
+    if (target == nullptr || value.empty() || *end != '\0' || !(v >= 0.0 && v <= 1e6)) {
+      error = "--weights: \"" + item +
+              "\" is not a weight, expected name=value with name friction, energy or distance "
+              "and a value between 0 and 1e6, e.g. friction=1,energy=1,distance=1";
+      return false;
+    }
+    *target = v;
+    start = comma + 1;
+  }
+  return true;
+}
+
+int RunGraph(const GraphOptions& o, Streams io) {
+  io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
+  io.err << loaded.diagnostics.FormatAll();
+  if (!loaded.scene) return kExitBadInput;
+  const scene::Scene& s = *loaded.scene;
+
+  graph::PruneWeights weights{s.heuristics.friction, s.heuristics.energy, s.heuristics.distance,
+                              s.heuristics.tolerance};
+  std::string error;
+  if (!o.weights.empty() && !ParseWeights(o.weights, weights, error)) {
+    io.err << "tubeplan graph: error: " << error << "\n";
+    return kExitBadInput;
+  }
+  if (o.tolerance) {
+    if (!(*o.tolerance >= 0.0)) {
+      io.err << "tubeplan graph: error: --tolerance must be zero or more\n";
+      return kExitBadInput;
+    }
+    weights.tolerance = *o.tolerance;
+  }
+  graph::ExploreOptions explore;
+  explore.seed = o.seed;
+  explore.effort = o.effort;
+  explore.max_motions = o.budget;
+  explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  graph::ContactGraph g = graph::Explore(s, explore);
+  graph::Prune(g, weights);
+
+  if (!o.dot_path.empty()) {
+    graph::DotOptions dot;
+    dot.dropped_arcs = o.unpruned;
+    dot.title = "tubeplan: contact-state graph of " + s.name + (o.unpruned ? " (unpruned)" : "");
+    if (const std::string e = io::WriteTextFileAtomically(o.dot_path, graph::ToDot(g, dot));
+        !e.empty()) {
+      io.err << o.dot_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
+  if (!o.json_path.empty()) {
+    const nlohmann::json j = GraphToJson(g, s, o.scene_path, explore, weights);
+    if (const std::string e = io::WriteTextFileAtomically(o.json_path, j.dump(1) + "\n");
+        !e.empty()) {
+      io.err << o.json_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
+
+  const long kept = std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; });
+  const long simultaneous =
+      std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.simultaneous; });
+  std::map<std::string, int> kinds;
+  for (const graph::Motion& m : g.motions) ++kinds[m.kind.substr(0, m.kind.find(' '))];
+  std::ostringstream t;
+  t << std::setprecision(3);
+  t << o.scene_path << ": " << g.nodes.size() << " contact formations, " << g.arcs.size()
+    << " transitions (" << kept << " kept by pruning, " << simultaneous
+    << " simultaneous) from " << g.motions.size() << " motions (";
+  bool first = true;
+  for (const auto& [kind, n] : kinds) t << (first ? "" : ", ") << n << " " << kind, first = false;
+  t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined; " << g.seconds
+    << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
+  t << "saturation (motions: nodes/arcs):";
+  const std::size_t every = std::max<std::size_t>(1, g.saturation.size() / 12);
+  for (std::size_t i = 0; i < g.saturation.size(); ++i) {
+    if (i % every != 0 && i + 1 != g.saturation.size()) continue;
+    const graph::SaturationPoint& p = g.saturation[i];
+    t << " " << p.motions << ": " << p.nodes << "/" << p.arcs;
+  }
+  int quiet = 0;  // motions at the end that found nothing new
+  for (std::size_t i = g.saturation.size(); i-- > 1;) {
+    if (g.saturation[i].nodes != g.saturation[i - 1].nodes ||
+        g.saturation[i].arcs != g.saturation[i - 1].arcs)
+      break;
+    ++quiet;
+  }
+  if (quiet >= explore.effort) {
+    t << "  (saturated: " << quiet << " motions in a row found nothing new)\n";
+  } else {
+    const std::size_t back = std::min<std::size_t>(100, g.saturation.size() - 1);
+    const graph::SaturationPoint& a = g.saturation[g.saturation.size() - 1 - back];
+    const graph::SaturationPoint& b = g.saturation.back();
+    t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out; the last "
+      << back << " motions still found " << b.nodes - a.nodes << " nodes and " << b.arcs - a.arcs
+      << " arcs)\n";
+  }
+  t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
+    << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
+  t << "part elements touched: " << g.reached_elements.size() << "; never touched: "
+    << g.unreached_elements.size();
+  for (std::size_t i = 0; i < g.unreached_elements.size() && i < 8; ++i)
+    t << (i == 0 ? " (" : ", ") << g.unreached_elements[i];
+  if (!g.unreached_elements.empty())
+    t << (g.unreached_elements.size() > 8 ? ", ...)" : ")");
+  t << "\n";
+  if (!o.dot_path.empty()) t << "DOT written to " << o.dot_path << "\n";
+  if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";
+  io.out << t.str();
+  return g.goal >= 0 ? kExitOk : kExitNegative;
+}
+
+}  // namespace
+
+Command AddGraphCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<GraphOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "graph",
+      "Build the contact-state graph of a scene by exploring it with the core, prune it with the "
+      "friction, bending-energy and distance heuristics, and write DOT and JSON.");
+  sub->add_option("scene", options->scene_path, "scene file (.yaml)")->required();
+  sub->add_option("--dot", options->dot_path, "write the graph in Graphviz DOT to FILE");
+  sub->add_option("--json", options->json_path, "write the graph as JSON to FILE (docs/graph.md)");
+  sub->add_flag("--unpruned", options->unpruned,
+                "DOT: draw every arc, the dropped ones dashed with their reason (default: the "
+                "pruned graph only)");
+  sub->add_option("--seed", options->seed, "seed of the random motions")->capture_default_str();
+  sub->add_option("--effort", options->effort,
+                  "stop after this many random motions in a row found no new state or "
+                  "transition")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  sub->add_option("--budget", options->budget,
+                  "stop after this many motions in all, saturated or not (said in the output)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  sub->add_option("--jobs", options->jobs, "threads (default: the machine's cores)")
+      ->check(CLI::Range(1, 256));
+  sub->add_option("--weights", options->weights,
+                  "heuristic weights over the scene's, e.g. friction=1,energy=1,distance=1");
+  sub->add_option("--tolerance", options->tolerance,
+                  "keep arcs whose weighted score is within this of the best (scene's default)");
+  return {sub, [options, streams] { return RunGraph(*options, streams); }};
+}
+
+}  // namespace tubeplan::cli

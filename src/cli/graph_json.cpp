@@ -1,0 +1,95 @@
+#include "graph_json.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+nlohmann::json Pose(const Eigen::Isometry3d& X) {
+  const Eigen::Quaterniond q(X.linear());
+  const Eigen::Vector3d p = X.translation();
+  return {{"p", {p.x(), p.y(), p.z()}}, {"q", {q.w(), q.x(), q.y(), q.z()}}};
+}
+
+nlohmann::json Ref(const graph::TickRef& r, double step_s) {
+  nlohmann::json j = {{"motion", r.motion}, {"tick", r.tick}};
+  if (r.substeps > 0) j["substeps"] = r.substeps, j["substep"] = r.substep;
+  j["t_s"] = step_s * (r.substeps > 0 ? r.tick - 1 + r.substep : r.tick);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
+                           const std::string& scene_path, const graph::ExploreOptions& explore,
+                           const graph::PruneWeights& weights) {
+  const double T = s.model.time_step_s;
+  nlohmann::json j;
+  j["tubeplan_graph"] = kGraphJsonVersion;
+  j["scene"] = scene_path;
+  j["parameters"] = {{"seed", explore.seed},
+                     {"effort", explore.effort},
+                     {"push_N", explore.push_N},
+                     {"speed_m_per_s", explore.speed_m_per_s},
+                     {"substeps", explore.substeps},
+                     {"weights",
+                      {{"friction", weights.friction},
+                       {"energy", weights.energy},
+                       {"distance", weights.distance}}},
+                     {"tolerance", weights.tolerance}};
+  j["start"] = g.start >= 0 ? nlohmann::json(g.nodes[std::size_t(g.start)].cf) : nullptr;
+  j["goal"] = g.goal >= 0 ? nlohmann::json(g.nodes[std::size_t(g.goal)].cf) : nullptr;
+  nlohmann::json nodes = nlohmann::json::array();
+  for (const graph::Node& n : g.nodes) {
+    nlohmann::json w = Ref(n.witness, T);
+    w["hand"] = Pose(n.X_W_hand);
+    w["held"] = Pose(n.X_WH);
+    nodes.push_back({{"cf", n.cf},
+                     {"pcs", n.pcs},
+                     {"start", n.start},
+                     {"goal", n.goal},
+                     {"energy_J", n.energy_J},
+                     {"friction_N", n.friction_N},
+                     {"friction_limit_N", n.friction_limit_N},
+                     {"force_N", n.force_N},
+                     {"distance_m", n.distance_m >= 0.0 ? nlohmann::json(n.distance_m) : nullptr},
+                     {"ticks", n.ticks},
+                     {"witness", w}});
+  }
+  j["nodes"] = nodes;
+  nlohmann::json arcs = nlohmann::json::array();
+  for (const graph::Arc& a : g.arcs) {
+    arcs.push_back({{"from", g.nodes[std::size_t(a.from)].cf},
+                    {"to", g.nodes[std::size_t(a.to)].cf},
+                    {"kept", a.kept},
+                    {"reason", a.reason},
+                    {"count", a.count},
+                    {"simultaneous", a.simultaneous},
+                    {"witness", Ref(a.witness, T)}});
+  }
+  j["arcs"] = arcs;
+  nlohmann::json curve = nlohmann::json::array();
+  for (const graph::SaturationPoint& p : g.saturation) curve.push_back({p.motions, p.nodes, p.arcs});
+  j["saturation"] = curve;
+  j["elements"] = {{"reached", g.reached_elements}, {"unreached", g.unreached_elements}};
+  nlohmann::json motions = nlohmann::json::array();
+  for (const graph::Motion& m : g.motions) {
+    nlohmann::json moves = nlohmann::json::array();
+    for (const graph::Move& mv : m.moves) {
+      moves.push_back({{"p", {mv.p_W_m.x(), mv.p_W_m.y(), mv.p_W_m.z()}},
+                       {"q", {mv.q_W.w(), mv.q_W.x(), mv.q_W.y(), mv.q_W.z()}},
+                       {"speed_m_per_s", mv.speed_m_per_s},
+                       {"turn_rad_per_s", mv.turn_rad_per_s},
+                       {"guard_dir", {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()}},
+                       {"guard_N", mv.guard_N}});
+    }
+    motions.push_back({{"kind", m.kind}, {"moves", moves}});
+  }
+  j["motions"] = motions;
+  j["stats"] = {{"motions", g.motions.size()},
+                {"ticks", g.ticks},
+                {"refinements", g.refinements},
+                {"seconds", g.seconds},
+                {"jobs", explore.jobs}};
+  return j;
+}
+
+}  // namespace tubeplan::cli

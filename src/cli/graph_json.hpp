@@ -1,0 +1,20 @@
+#pragma once
+// The contact-state graph as JSON (schema in docs/graph.md), private to the cli library.
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/graph/contact_graph.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::cli {
+
+inline constexpr int kGraphJsonVersion = 1;
+
+nlohmann::json GraphToJson(const graph::ContactGraph& graph, const scene::Scene& scene,
+                           const std::string& scene_path, const graph::ExploreOptions& explore,
+                           const graph::PruneWeights& weights);
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,700 @@
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <set>
+#include <thread>
+#include <utility>
+
+#include <tubeplan/graph/explore.hpp>
+
+namespace tubeplan::graph {
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+// A motion that has not ended after this long is cut (a safety bound; motions last seconds).
+constexpr int kMaxTicksPerMotion = 30000;
+// Random motions run in batches of this many, whatever the number of threads, so that where
+// saturation stops does not depend on --jobs.
+constexpr int kBatch = 8;
+
+// The CF of a tick in the core's compact form: PC count, then (part element, tube, marker) per
+// PC in the core's order. Comparing these per tick costs nothing; text is made on change only.
+using CfKey = std::array<std::uint32_t, core::kMaxContacts + 1>;
+
+CfKey KeyOf(const core::StepOutput& out) {
+  CfKey key{};
+  key[0] = static_cast<std::uint32_t>(out.contact_count);
+  for (int i = 0; i < out.contact_count; ++i) {
+    const core::ContactState& c = out.contacts[std::size_t(i)];
+    key[std::size_t(i) + 1] = (static_cast<std::uint32_t>(c.part_element) << 8) |
+                              (static_cast<std::uint32_t>(c.tube) << 4) |
+                              static_cast<std::uint32_t>(c.marker);
+  }
+  return key;
+}
+
+struct Sample {  // what a node keeps of its witness tick
+  Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
+  double energy_J = 0.0, friction_N = 0.0, friction_limit_N = 0.0, force_N = 0.0;
+};
+
+Sample SampleOf(const core::StepOutput& out) {
+  Sample s;
+  s.X_W_hand = out.X_W_hand;
+  s.X_WH = out.X_WH;
+  s.energy_J = out.energy_J;
+  s.force_N = out.force_W_N.norm();
+  for (const core::ContactState& c : out.Contacts()) {
+    s.friction_N += c.friction_W_N.norm();
+    s.friction_limit_N += c.friction_limit_N;
+  }
+  return s;
+}
+
+struct Stay {  // a stretch of ticks in one CF
+  std::string cf;
+  int pcs = 0;
+  TickRef witness;
+  long length = 0;
+  bool refined = false;  // seen while refining a step: a weaker witness
+  Sample sample;
+};
+
+struct Change {
+  std::string from, to;
+  bool simultaneous = false;
+  TickRef at;
+};
+
+struct MotionResult {
+  std::vector<Stay> stays;
+  std::vector<Change> changes;
+  long ticks = 0;
+  int refinements = 0;
+};
+
+// A stretch of ticks [start, end] of a motion in one CF, as the core classified them.
+struct RawRun {
+  std::string text;
+  states::ContactFormation cf;
+  int start = 0, end = 0;
+};
+
+// Sub-steps tick `tick` of the motion and returns the CFs the sub-ticks went through, in order,
+// starting with `from` (the state before the tick), with the sub-tick each was entered at.
+std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Motion& motion,
+                                              int tick, const RawRun& from, int substeps,
+                                              long& ticks) {
+  std::vector<std::pair<RawRun, Sample>> chain = {{from, Sample{}}};
+  ReplaySubsteps(refine_core, motion, tick, substeps, [&](int j, const core::StepOutput& out) {
+    ++ticks;
+    states::ContactFormation c = refine_core.Formation();
+    if (c == chain.back().first.cf) return true;
+    RawRun run;
+    run.text = states::ToString(c);
+    run.cf = std::move(c);
+    run.start = run.end = j;
+    chain.push_back({std::move(run), SampleOf(out)});
+    return true;
+  });
+  ticks += tick - 1;
+  return chain;
+}
+
+// Runs one motion and records its debounced CFs and transitions: a CF counts once the core has
+// kept it for `dwell` (as the plan judge counts states), so a state the core flickers through
+// for a tick or two is not a node. A transition between counted states that changes more than
+// one PC is bridged by a brief state in between when one is a single change from both, else
+// refined by sub-stepping the tick where it happened, else flagged simultaneous.
+MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion,
+                       int index, const ExploreOptions& options) {
+  MotionResult result;
+  const double step_s = core.scene().model.time_step_s;
+  const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
+  const Eigen::Isometry3d X_start = MotionStart(core.scene());
+  core.Reset(X_start);
+  MotionRunner runner(motion, X_start, step_s);
+  std::vector<Sample> samples(1);  // per tick, [0] unused
+  RawRun stable, raw;              // the counted state and the one the core is in
+  std::vector<RawRun> brief;       // states since `stable` that did not last `dwell`
+  auto record_stay = [&](const RawRun& run) {
+    const int mid = run.start + (run.end - run.start) / 2;
+    result.stays.push_back({run.text, static_cast<int>(run.cf.contacts.size()),
+                            TickRef{index, mid, 0, 0}, run.end - run.start + 1, false,
+                            samples[std::size_t(mid)]});
+  };
+  auto add_change = [&](const RawRun& from, const RawRun& to, bool simultaneous, TickRef at) {
+    result.changes.push_back({from.text, to.text, simultaneous, at});
+  };
+  auto commit = [&](const RawRun& to) {
+    if (PcChanges(stable.cf, to.cf) <= 1) {
+      add_change(stable, to, false, {index, to.start});
+      return;
+    }
+    for (auto it = brief.rbegin(); it != brief.rend(); ++it) {
+      if (PcChanges(stable.cf, it->cf) <= 1 && PcChanges(it->cf, to.cf) <= 1) {
+        result.stays.push_back({it->text, static_cast<int>(it->cf.contacts.size()),
+                                TickRef{index, it->start, 0, 0}, it->end - it->start + 1, true,
+                                samples[std::size_t(it->start)]});
+        add_change(stable, *it, false, {index, it->start});
+        add_change(*it, to, false, {index, to.start});
+        return;
+      }
+    }
+    if (brief.empty() && options.substeps > 1) {
+      ++result.refinements;
+      const auto chain =
+          Refine(refine_core, motion, to.start, stable, options.substeps, result.ticks);
+      bool single = chain.back().first.cf == to.cf;
+      for (std::size_t c = 1; c < chain.size(); ++c)
+        single = single && PcChanges(chain[c - 1].first.cf, chain[c].first.cf) <= 1;
+      if (single) {
+        for (std::size_t c = 1; c < chain.size(); ++c) {
+          const TickRef at{index, to.start, options.substeps, chain[c].first.start};
+          if (c + 1 < chain.size()) {
+            result.stays.push_back({chain[c].first.text,
+                                    static_cast<int>(chain[c].first.cf.contacts.size()), at,
+                                    chain[c + 1].first.start - chain[c].first.start, true,
+                                    chain[c].second});
+          }
+          add_change(chain[c - 1].first, chain[c].first, false, at);
+        }
+        return;
+      }
+    }
+    add_change(stable, to, true, {index, to.start});
+  };
+
+  int k = 1;
+  CfKey key{};
+  for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
+    const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
+    samples.push_back(SampleOf(out));
+    const CfKey now = KeyOf(out);
+    if (k == 1 || now != key) {
+      key = now;
+      RawRun next;
+      next.cf = core.Formation();
+      next.text = states::ToString(next.cf);
+      next.start = next.end = k;
+      if (k == 1) {
+        stable = raw = next;
+        continue;
+      }
+      if (raw.end - raw.start + 1 >= dwell || raw.start == 1) {
+        record_stay(raw);  // (the first run is the start state, however brief)
+      } else if (raw.text != stable.text) {
+        brief.push_back(raw);
+      }
+      raw = std::move(next);
+      if (raw.text == stable.text) brief.clear();  // back where it was: the flicker is noise
+    } else {
+      raw.end = k;
+    }
+    if (raw.text != stable.text && raw.end - raw.start + 1 == dwell) {
+      commit(raw);
+      stable = raw;
+      brief.clear();
+    }
+  }
+  result.ticks += k - 1;
+  if (raw.end - raw.start + 1 >= dwell || result.stays.empty()) record_stay(raw);
+  return result;
+}
+
+// --- geometry of the scene for aiming -------------------------------------------------------------
+
+struct Box {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+};
+
+Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts) {
+  Box box;
+  for (std::uint32_t p : parts) {
+    const scene::BoxPart& part = scene.parts[p];
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c_P((corner & 1 ? 0.5 : -0.5) * part.size_m.x(),
+                                (corner & 2 ? 0.5 : -0.5) * part.size_m.y(),
+                                (corner & 4 ? 0.5 : -0.5) * part.size_m.z());
+      box.lo = box.lo.cwiseMin(part.X_WP * c_P);
+      box.hi = box.hi.cwiseMax(part.X_WP * c_P);
+    }
+  }
+  return box;
+}
+
+// Outward normal of box face i (BoxFace order) in the part's frame.
+Eigen::Vector3d FaceNormal_P(int face) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  n[face / 2 == 0 ? 2 : face / 2 - 1] = face % 2 == 0 ? 1.0 : -1.0;
+  return n;
+}
+
+bool InsideAnyPart(const scene::Scene& scene, const Eigen::Vector3d& p_W) {
+  for (const scene::BoxPart& part : scene.parts) {
+    const Eigen::Vector3d p_P = part.X_WP.inverse() * p_W;
+    if ((p_P.cwiseAbs().array() < 0.5 * part.size_m.array()).all()) return true;
+  }
+  return false;
+}
+
+Eigen::Quaterniond TurnAxis(const Eigen::Quaterniond& q0, const Eigen::Vector3d& from,
+                            const Eigen::Vector3d& to) {
+  return (Eigen::Quaterniond::FromTwoVectors(from, to) * q0).normalized();
+}
+
+struct Frame {  // directions of the start pose
+  Eigen::Vector3d p0, axis, up, lateral;
+  Eigen::Quaterniond q0;
+};
+
+Frame StartFrame(const scene::Scene& scene) {
+  Frame f;
+  const Eigen::Isometry3d X0 = MotionStart(scene);
+  f.p0 = X0.translation();
+  f.q0 = Eigen::Quaterniond(X0.linear());
+  f.axis = X0.linear().col(2);
+  // Scenes have world z up (docs/scene-format.md): "down" is where the groove's floor is.
+  f.up = Eigen::Vector3d::UnitZ();
+  f.lateral = f.up.cross(f.axis);
+  if (f.lateral.norm() < 1e-6) f.lateral = X0.linear().col(0);
+  f.lateral.normalize();
+  return f;
+}
+
+Eigen::Vector3d ClampToWorkspace(const scene::Scene& scene, const Eigen::Vector3d& p) {
+  if (!scene.workspace) return p;
+  return p.cwiseMax(scene.workspace->min_W_m).cwiseMin(scene.workspace->max_W_m);
+}
+
+bool InWorkspace(const scene::Scene& scene, const Eigen::Vector3d& p) {
+  return !scene.workspace || ((p.array() >= scene.workspace->min_W_m.array()).all() &&
+                              (p.array() <= scene.workspace->max_W_m.array()).all());
+}
+
+Move MoveTo(const Eigen::Vector3d& p, const Eigen::Quaterniond& q, double speed, double guard_N,
+            const Eigen::Vector3d& from) {
+  Move m;
+  m.p_W_m = p;
+  m.q_W = q;
+  m.speed_m_per_s = speed;
+  m.turn_rad_per_s = 1.0;  // about 60 deg/s, a calm wrist
+  const Eigen::Vector3d d = p - from;
+  if (guard_N > 0.0 && d.norm() > 1e-9) {
+    m.guard_dir_W = -d.normalized();  // the force that pushes back against the move
+    m.guard_N = guard_N;
+  }
+  return m;
+}
+
+std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const ExploreOptions& o) {
+  const Frame f = StartFrame(scene);
+  const double r = scene.tube.outer_radius_m;
+  // Lateral offsets across the parts, a tube radius apart; the tube level and tipped down.
+  const double half = 0.5 * std::abs((box.hi - box.lo).dot(f.lateral.cwiseAbs()));
+  const Eigen::Vector3d centre = 0.5 * (box.lo + box.hi);
+  const double centre_lateral = (centre - f.p0).dot(f.lateral);
+  const int n = std::max(1, static_cast<int>(std::floor(half / r)));
+  std::vector<Motion> motions;
+  for (double tilt_deg : {0.0, 12.0}) {
+    const Eigen::Vector3d tipped =
+        Eigen::AngleAxisd(tilt_deg * kDeg, f.axis.cross(-f.up).normalized()) * f.axis;
+    const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, tipped);
+    for (int i = -n; i <= n; ++i) {
+      Motion m;
+      m.kind = "sweep";
+      Eigen::Vector3d p = ClampToWorkspace(scene, f.p0 + (centre_lateral + i * r) * f.lateral);
+      m.moves.push_back(MoveTo(p, q, o.speed_m_per_s, o.push_N, f.p0));
+      // Down until it pushes back (or to the bottom of the parts).
+      Eigen::Vector3d down = p;
+      down.z() = std::min(p.z(), box.lo.z());
+      down = ClampToWorkspace(scene, down);
+      m.moves.push_back(MoveTo(down, q, 0.5 * o.speed_m_per_s, o.push_N, p));
+      // Sideways both ways, then along the tube's axis: contact moves, at half speed. Each
+      // starts where the last one stopped, which the runner knows and we do not: the guard
+      // direction is set from the nominal path.
+      const double slide = 2.0 * r;
+      const std::array<Eigen::Vector3d, 3> slides = {Eigen::Vector3d(slide * f.lateral),
+                                                     Eigen::Vector3d(-2.0 * slide * f.lateral),
+                                                     Eigen::Vector3d(2.5 * r * f.axis)};
+      for (const Eigen::Vector3d& d : slides) {
+        const Eigen::Vector3d from = m.moves.back().p_W_m;
+        Move move = MoveTo(ClampToWorkspace(scene, from + d), q, 0.5 * o.speed_m_per_s,
+                           o.push_N, from);
+        move.guard_N = 1.5 * o.push_N;  // friction of the pressed tube stays below this
+        m.moves.push_back(move);
+      }
+      m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 5.0 * r * f.up),
+                               f.q0, o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
+      motions.push_back(std::move(m));
+    }
+  }
+  return motions;
+}
+
+// Whether the tube, straight and held at X, touches nothing: a tick of the core with the hand
+// there from a reset there.
+bool FreePose(core::Core& core, const Eigen::Isometry3d& X) {
+  core.Reset(X);
+  const core::StepOutput& out = core.Step(0.0, X);
+  return out.contact_count == 0 && (out.flags & core::kPenetration) == 0;
+}
+
+std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
+                         const std::vector<int>& elements, const ExploreOptions& o) {
+  const Frame f = StartFrame(scene);
+  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
+  const double gap = scene.contact.threshold_m + 3e-3;  // start clear of epsilon
+  std::vector<Motion> motions;
+  for (int e : elements) {
+    const scene::PartElement& element = probe.elements()[std::size_t(e)];
+    const scene::BoxPart& part = scene.parts[element.part_index];
+    Eigen::Vector3d c_P = Eigen::Vector3d::Zero(), n_P = Eigen::Vector3d::Zero();
+    for (int face = 0; face < 6; ++face) {
+      if ((element.face_mask & (1u << face)) == 0) continue;
+      const Eigen::Vector3d nf = FaceNormal_P(face);
+      n_P += nf;
+      c_P += 0.5 * part.size_m.cwiseProduct(nf);
+    }
+    const Eigen::Vector3d c_W = part.X_WP * c_P;
+    const Eigen::Vector3d n_W = (part.X_WP.linear() * n_P).normalized();
+    // An element whose outside is inside another part (a wall's bottom on the floor) cannot be
+    // touched: not aimed at.
+    if (InsideAnyPart(scene, c_W + 0.5 * scene.contact.threshold_m * n_W)) continue;
+    // A direction along the element, leaning down and along the start axis where it can.
+    Eigen::Vector3d t = f.axis - f.up;
+    t -= t.dot(n_W) * n_W;
+    if (t.norm() < 1e-6) t = n_W.cross(f.lateral);
+    t.normalize();
+    struct Aim {
+      Eigen::Vector3d axis, hand, push, slide;
+    };
+    std::vector<Aim> tip_aims, side_aims;
+    for (double phi_deg : {30.0, 60.0, 80.0}) {  // the tip, its axis leaning off the normal
+      const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
+      const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
+      tip_aims.push_back({a, tip - l * a, a, t});
+    }
+    for (const Eigen::Vector3d& a : {t, n_W.cross(t).normalized()}) {  // the side, along it
+      const Eigen::Vector3d mid = c_W + (gap + r) * n_W;
+      side_aims.push_back({a, mid - 0.5 * l * a, -n_W, a});
+    }
+    for (const std::vector<Aim>* aims : {&tip_aims, &side_aims}) {
+      for (const Aim& aim : *aims) {
+        const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, aim.axis);
+        Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+        X.linear() = q.toRotationMatrix();
+        X.translation() = aim.hand;
+        if (!InWorkspace(scene, aim.hand) || !FreePose(probe, X)) continue;
+        Motion m;
+        m.kind = "aim " + element.name;
+        // Over the target at a safe height, down onto it, press, slide, back off.
+        Eigen::Vector3d above = aim.hand;
+        above.z() = std::max(f.p0.z(), aim.hand.z());
+        Eigen::Vector3d lift = f.p0;
+        lift.z() = above.z();
+        m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
+        m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
+        m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+        const Eigen::Vector3d pressed = aim.hand + (gap + 3e-3) * aim.push;
+        m.moves.push_back(MoveTo(pressed, q, 0.5 * o.speed_m_per_s, o.push_N, aim.hand));
+        m.moves.push_back(MoveTo(ClampToWorkspace(scene, pressed + 1.5 * r * aim.slide), q,
+                                 0.5 * o.speed_m_per_s, 1.5 * o.push_N, pressed));
+        m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 2.5 * r * n_W), q,
+                                 o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
+        motions.push_back(std::move(m));
+        break;  // one tip motion and one side motion per element
+      }
+    }
+  }
+  return motions;
+}
+
+// Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each.
+std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Motion>& motions,
+                                 int first, int count, const ExploreOptions& o,
+                                 std::vector<std::unique_ptr<core::Core>>& cores) {
+  std::vector<MotionResult> results(static_cast<std::size_t>(count));
+  const int jobs = std::clamp(o.jobs, 1, std::max(1, count));
+  while (static_cast<int>(cores.size()) < 2 * jobs) cores.push_back(std::make_unique<core::Core>(scene));
+  std::atomic<int> next{0};
+  auto work = [&](int worker) {
+    for (int i = next++; i < count; i = next++) {
+      results[std::size_t(i)] = RunMotion(*cores[std::size_t(2 * worker)],
+                                          *cores[std::size_t(2 * worker + 1)],
+                                          motions[std::size_t(first + i)], first + i, o);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int w = 1; w < jobs; ++w) threads.emplace_back(work, w);
+  work(0);
+  for (std::thread& t : threads) t.join();
+  return results;
+}
+
+class Merger {
+ public:
+  explicit Merger(ContactGraph& graph) : graph_(graph) {}
+
+  // Returns whether the result added a node or an arc.
+  bool Add(const MotionResult& r) {
+    const std::size_t nodes = graph_.nodes.size(), arcs = graph_.arcs.size();
+    for (const Stay& s : r.stays) {
+      const int i = NodeOf(s.cf);
+      Node& n = graph_.nodes[std::size_t(i)];
+      if (!s.refined) n.ticks += s.length;
+      Best& best = best_[std::size_t(i)];
+      const bool better = best.length < 0 || (best.refined && !s.refined) ||
+                          (best.refined == s.refined && s.length > best.length);
+      if (better) {
+        best = {s.length, s.refined};
+        n.pcs = s.pcs;
+        n.witness = s.witness;
+        n.X_W_hand = s.sample.X_W_hand;
+        n.X_WH = s.sample.X_WH;
+        n.energy_J = s.sample.energy_J;
+        n.friction_N = s.sample.friction_N;
+        n.friction_limit_N = s.sample.friction_limit_N;
+        n.force_N = s.sample.force_N;
+      }
+    }
+    for (const Change& c : r.changes) {
+      const int from = NodeOf(c.from), to = NodeOf(c.to);
+      const auto [it, inserted] = arc_of_.try_emplace({from, to}, int(graph_.arcs.size()));
+      if (inserted) {
+        Arc a;
+        a.from = from, a.to = to, a.simultaneous = c.simultaneous, a.witness = c.at;
+        graph_.arcs.push_back(a);
+      }
+      Arc& a = graph_.arcs[std::size_t(it->second)];
+      ++a.count;
+      // Simultaneous only if it was never produced as a single change.
+      a.simultaneous = a.simultaneous && c.simultaneous;
+    }
+    graph_.ticks += r.ticks;
+    graph_.refinements += r.refinements;
+    graph_.saturation.push_back({static_cast<int>(graph_.saturation.size()) + 1,
+                                 static_cast<int>(graph_.nodes.size()),
+                                 static_cast<int>(graph_.arcs.size())});
+    return graph_.nodes.size() > nodes || graph_.arcs.size() > arcs;
+  }
+
+ private:
+  struct Best {
+    long length = -1;
+    bool refined = true;
+  };
+  int NodeOf(const std::string& cf) {
+    const auto [it, inserted] = node_of_.try_emplace(cf, int(graph_.nodes.size()));
+    if (inserted) {
+      Node n;
+      n.cf = cf;
+      graph_.nodes.push_back(std::move(n));
+      best_.push_back({});
+    }
+    return it->second;
+  }
+  ContactGraph& graph_;
+  std::map<std::string, int> node_of_;
+  std::map<std::pair<int, int>, int> arc_of_;
+  std::vector<Best> best_;
+};
+
+std::set<std::string> ReachedElements(const ContactGraph& graph) {
+  std::set<std::string> reached;
+  for (const Node& n : graph.nodes) {
+    const states::ParseResult parsed = states::ParseContactFormation(n.cf);
+    if (!parsed.cf) continue;
+    for (const states::PrincipalContact& pc : parsed.cf->contacts) reached.insert(pc.part_element);
+  }
+  return reached;
+}
+
+std::vector<Motion> RandomMotionsIn(const scene::Scene& scene, const Box& box, std::uint64_t seed,
+                                    int first, int count, const ExploreOptions& o) {
+  const Frame f = StartFrame(scene);
+  const double l = scene.tube.length_m;
+  // The hand roams across the parts (sideways), from their bottom to a quarter tube length above
+  // their top, and along the tube's start axis from the start to a fifth of a tube length
+  // further in: the region of the insertion task. Further along, the tube only meets the far
+  // ends of the parts, which are another task's states.
+  const auto range = [&](const Eigen::Vector3d& d) {
+    double a = std::numeric_limits<double>::infinity(), b = -a;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d c(corner & 1 ? box.hi.x() : box.lo.x(),
+                              corner & 2 ? box.hi.y() : box.lo.y(),
+                              corner & 4 ? box.hi.z() : box.lo.z());
+      a = std::min(a, (c - f.p0).dot(d)), b = std::max(b, (c - f.p0).dot(d));
+    }
+    return std::pair{a, b};
+  };
+  const auto [lateral_lo, lateral_hi] = range(f.lateral);
+  const auto [up_lo, up_hi] = range(f.up);
+  const double along_lo = 0.0, along_hi = 0.2 * l;
+  const double up_top = up_hi + 0.25 * l;
+  const Eigen::Vector3d tip_axis = f.axis.cross(-f.up).normalized();
+  std::vector<Motion> motions;
+  for (int i = first; i < first + count; ++i) {
+    // One generator per motion, seeded by (seed, index): motion i is the same whichever
+    // motions were made before it.
+    std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                           static_cast<std::uint32_t>(i)};
+    std::mt19937_64 rng(sequence);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    auto uniform = [&](double a, double b) { return a + (b - a) * unit(rng); };
+    Motion m;
+    m.kind = "random";
+    Eigen::Vector3d from = f.p0;
+    Eigen::Quaterniond q = f.q0;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector3d p = ClampToWorkspace(
+          scene, f.p0 + uniform(lateral_lo, lateral_hi) * f.lateral +
+                     uniform(along_lo, along_hi) * f.axis + uniform(up_lo, up_top) * f.up);
+      if (unit(rng) < 0.7) {
+        const Eigen::Vector3d tipped =
+            Eigen::AngleAxisd(uniform(-8.0, 8.0) * kDeg, f.up) *
+            (Eigen::AngleAxisd(uniform(-5.0, 30.0) * kDeg, tip_axis) * f.axis);
+        q = TurnAxis(f.q0, f.axis, tipped);
+      }
+      const double guard = unit(rng) < 0.6 ? uniform(1.0, 4.0) : 0.0;
+      m.moves.push_back(MoveTo(p, q, uniform(0.03, 0.12), guard, from));
+      from = p;
+    }
+    m.moves.push_back(MoveTo(from + 0.05 * f.up, q, o.speed_m_per_s, 0.0, from));
+    motions.push_back(std::move(m));
+  }
+  return motions;
+}
+
+}  // namespace
+
+int PcChanges(const states::ContactFormation& a, const states::ContactFormation& b) {
+  std::vector<const states::PrincipalContact*> removed, added;
+  int changes = 0;
+  for (const states::PrincipalContact& pa : a.contacts) {
+    const auto same = std::find_if(b.contacts.begin(), b.contacts.end(), [&](const auto& pb) {
+      return pb.tube == pa.tube && pb.part_element == pa.part_element;
+    });
+    if (same == b.contacts.end()) {
+      removed.push_back(&pa);
+    } else if (same->marker != pa.marker) {
+      ++changes;
+    }
+  }
+  for (const states::PrincipalContact& pb : b.contacts) {
+    const bool kept = std::any_of(a.contacts.begin(), a.contacts.end(), [&](const auto& pa) {
+      return pb.tube == pa.tube && pb.part_element == pa.part_element;
+    });
+    if (!kept) added.push_back(&pb);
+  }
+  // Pair each removed PC with an added one that shares an element: one change between them.
+  std::vector<bool> used(added.size(), false);
+  for (const states::PrincipalContact* r : removed) {
+    ++changes;
+    for (std::size_t i = 0; i < added.size(); ++i) {
+      if (!used[i] && (added[i]->tube == r->tube || added[i]->part_element == r->part_element)) {
+        used[i] = true;
+        break;
+      }
+    }
+  }
+  changes += static_cast<int>(std::count(used.begin(), used.end(), false));
+  return changes;
+}
+
+std::vector<Motion> RandomMotions(const scene::Scene& scene, std::uint64_t seed, int first,
+                                  int count, const ExploreOptions& options) {
+  const core::Core probe(scene);
+  return RandomMotionsIn(scene, PartsBox(scene, probe.reachable_parts()), seed, first, count,
+                         options);
+}
+
+ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
+                     const std::function<void(const SaturationPoint&)>& progress) {
+  const auto clock_start = std::chrono::steady_clock::now();
+  ContactGraph graph;
+  Merger merger(graph);
+  std::vector<std::unique_ptr<core::Core>> cores;
+  cores.push_back(std::make_unique<core::Core>(scene));
+  core::Core& probe = *cores.front();
+  const Box box = PartsBox(scene, probe.reachable_parts());
+  auto run = [&](std::vector<Motion> batch) {
+    const int first = static_cast<int>(graph.motions.size());
+    for (Motion& m : batch) graph.motions.push_back(std::move(m));
+    std::vector<MotionResult> results =
+        RunAll(scene, graph.motions, first, static_cast<int>(batch.size()), o, cores);
+    std::vector<bool> added;
+    for (const MotionResult& r : results) {
+      added.push_back(merger.Add(r));
+      if (progress) progress(graph.saturation.back());
+    }
+    return added;
+  };
+
+  run(Sweeps(scene, box, o));
+  graph.start = 0;  // the first stay of the first motion is at the start pose
+  {
+    // Aim at the elements of reachable parts that no PC has touched yet.
+    const std::set<std::string> reached = ReachedElements(graph);
+    std::vector<int> unseen;
+    for (std::size_t e = 0; e < probe.elements().size(); ++e)
+      if (!reached.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
+    run(Aims(scene, probe, unseen, o));
+  }
+  int quiet = 0;
+  while (quiet < o.effort && static_cast<int>(graph.motions.size()) < o.max_motions) {
+    const int first = static_cast<int>(graph.motions.size());
+    const int count = std::min(kBatch, o.max_motions - first);
+    // Random motions are numbered from 0 whatever came before, so a seed names the same motions.
+    const int random_first = first - static_cast<int>(std::count_if(
+                                         graph.motions.begin(), graph.motions.end(),
+                                         [](const Motion& m) { return m.kind != "random"; }));
+    std::vector<Motion> batch = RandomMotionsIn(scene, box, o.seed, random_first, count, o);
+    graph.motions.insert(graph.motions.end(), batch.begin(), batch.end());
+    std::vector<MotionResult> results = RunAll(scene, graph.motions, first, count, o, cores);
+    // Merge in order and stop at the motion that saturates, so the graph does not depend on how
+    // many threads ran the batch.
+    int merged = 0;
+    for (const MotionResult& r : results) {
+      ++merged;
+      quiet = merger.Add(r) ? 0 : quiet + 1;
+      if (progress) progress(graph.saturation.back());
+      if (quiet >= o.effort) break;
+    }
+    graph.motions.resize(std::size_t(first + merged));
+  }
+
+  graph.goal = graph.FindNode(states::ToString(scene.goal));
+  if (graph.start >= 0 && graph.start < static_cast<int>(graph.nodes.size()))
+    graph.nodes[std::size_t(graph.start)].start = true;
+  if (graph.goal >= 0) {
+    Node& goal = graph.nodes[std::size_t(graph.goal)];
+    goal.goal = true;
+    const double half_length = 0.5 * scene.tube.length_m;
+    for (Node& n : graph.nodes) {
+      n.distance_m = (n.X_WH.translation() - goal.X_WH.translation()).norm() +
+                     half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() *
+                                                     n.X_WH.linear())
+                                       .angle();
+    }
+  }
+  const std::set<std::string> reached = ReachedElements(graph);
+  graph.reached_elements.assign(reached.begin(), reached.end());
+  for (const scene::PartElement& e : probe.elements())
+    if (!reached.contains(e.name)) graph.unreached_elements.push_back(e.name);
+  graph.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  return graph;
+}
+
+}  // namespace tubeplan::graph

@@ -1,0 +1,94 @@
+#include <algorithm>
+#include <cmath>
+
+#include <tubeplan/graph/motion.hpp>
+
+namespace tubeplan::graph {
+
+MotionRunner::MotionRunner(const Motion& motion, const Eigen::Isometry3d& X_W_start,
+                           double time_step_s)
+    : moves_(motion.moves),
+      step_s_(time_step_s),
+      p_W_m_(X_W_start.translation()),
+      q_W_(Eigen::Quaterniond(X_W_start.linear())),
+      p_from_W_m_(p_W_m_),
+      q_from_W_(q_W_) {}
+
+Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
+  while (move_ < moves_.size()) {
+    const Move& move = moves_[move_];
+    if (move_ticks_ == 0) {
+      // Start the move from where the hand is; its duration comes from the slower of the
+      // translation and the rotation, whole ticks, at least one.
+      p_from_W_m_ = p_W_m_;
+      q_from_W_ = q_W_;
+      const double distance_m = (move.p_W_m - p_from_W_m_).norm();
+      const double angle_rad = q_from_W_.angularDistance(move.q_W);
+      const double duration_s = std::max(distance_m / std::max(move.speed_m_per_s, 1e-6),
+                                         angle_rad / std::max(move.turn_rad_per_s, 1e-6));
+      move_ticks_ = std::max(1, static_cast<int>(std::ceil(duration_s / step_s_ - 1e-9)));
+      move_tick_ = 0;
+    }
+    const bool guarded = move.guard_N > 0.0 && move_tick_ > 0;
+    if (move_tick_ == move_ticks_ ||
+        (guarded && last.force_W_N.dot(move.guard_dir_W) > move.guard_N)) {
+      ++move_;
+      move_ticks_ = 0;
+      continue;
+    }
+    ++move_tick_;
+    const double u = static_cast<double>(move_tick_) / move_ticks_;
+    p_W_m_ = p_from_W_m_ + u * (move.p_W_m - p_from_W_m_);
+    q_W_ = q_from_W_.slerp(u, move.q_W);
+    break;
+  }
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = q_W_.normalized().toRotationMatrix();
+  X.translation() = p_W_m_;
+  return X;
+}
+
+Eigen::Isometry3d MotionStart(const scene::Scene& scene) { return scene.X_WH_start; }
+
+void ReplaySubsteps(core::Core& core, const Motion& motion, int tick, int substeps,
+                    const std::function<bool(int, const core::StepOutput&)>& on_substep) {
+  const scene::Scene& scene = core.scene();
+  const double step_s = scene.model.time_step_s;
+  const Eigen::Isometry3d X_start = MotionStart(scene);
+  core.Reset(X_start);
+  MotionRunner runner(motion, X_start, step_s);
+  Eigen::Isometry3d X_prev = X_start;
+  for (int k = 1; k < tick; ++k) {
+    X_prev = runner.Next(core.last());
+    core.Step(k * step_s, X_prev);
+  }
+  const Eigen::Isometry3d X_next = runner.Next(core.last());
+  const Eigen::Quaterniond q_prev(X_prev.linear()), q_next(X_next.linear());
+  for (int j = 1; j <= substeps; ++j) {
+    // The sub-ticks are core ticks of the scene's step: the hand covers the tick's motion more
+    // slowly, which is what refining a motion means here.
+    const double u = static_cast<double>(j) / substeps;
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = q_prev.slerp(u, q_next).normalized().toRotationMatrix();
+    X.translation() = X_prev.translation() + u * (X_next.translation() - X_prev.translation());
+    const core::StepOutput& out = core.Step((tick - 1 + j) * step_s, X);
+    if (!on_substep(j, out)) break;
+  }
+}
+
+const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const TickRef& ref) {
+  if (ref.substeps > 0) {
+    ReplaySubsteps(core, motion, ref.tick, ref.substeps,
+                   [&](int j, const core::StepOutput&) { return j < ref.substep; });
+    return core.last();
+  }
+  const scene::Scene& scene = core.scene();
+  const double step_s = scene.model.time_step_s;
+  const Eigen::Isometry3d X_start = MotionStart(scene);
+  core.Reset(X_start);
+  MotionRunner runner(motion, X_start, step_s);
+  for (int k = 1; k <= ref.tick; ++k) core.Step(k * step_s, runner.Next(core.last()));
+  return core.last();
+}
+
+}  // namespace tubeplan::graph
