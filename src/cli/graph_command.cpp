@@ -5,8 +5,8 @@
 #include <algorithm>
 #include <iomanip>
 #include <map>
-#include <optional>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -111,7 +111,8 @@ int RunGraph(const GraphOptions& o, Streams io) {
     }
   }
 
-  const long kept = std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; });
+  const long kept =
+      std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; });
   const long simultaneous =
       std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.simultaneous; });
   std::map<std::string, int> kinds;
@@ -119,8 +120,8 @@ int RunGraph(const GraphOptions& o, Streams io) {
   std::ostringstream t;
   t << std::setprecision(3);
   t << o.scene_path << ": " << g.nodes.size() << " contact formations, " << g.arcs.size()
-    << " transitions (" << kept << " kept by pruning, " << simultaneous
-    << " simultaneous) from " << g.motions.size() << " motions (";
+    << " transitions (" << kept << " kept by pruning, " << simultaneous << " simultaneous) from "
+    << g.motions.size() << " motions (";
   bool first = true;
   for (const auto& [kind, n] : kinds) t << (first ? "" : ", ") << n << " " << kind, first = false;
   t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined; " << g.seconds
@@ -151,12 +152,11 @@ int RunGraph(const GraphOptions& o, Streams io) {
   }
   t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
-  t << "part elements touched: " << g.reached_elements.size() << "; never touched: "
-    << g.unreached_elements.size();
+  t << "part elements touched: " << g.reached_elements.size()
+    << "; never touched: " << g.unreached_elements.size();
   for (std::size_t i = 0; i < g.unreached_elements.size() && i < 8; ++i)
     t << (i == 0 ? " (" : ", ") << g.unreached_elements[i];
-  if (!g.unreached_elements.empty())
-    t << (g.unreached_elements.size() > 8 ? ", ...)" : ")");
+  if (!g.unreached_elements.empty()) t << (g.unreached_elements.size() > 8 ? ", ...)" : ")");
   t << "\n";
   if (!o.dot_path.empty()) t << "DOT written to " << o.dot_path << "\n";
   if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";

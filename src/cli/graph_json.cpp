@@ -67,7 +67,8 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   }
   j["arcs"] = arcs;
   nlohmann::json curve = nlohmann::json::array();
-  for (const graph::SaturationPoint& p : g.saturation) curve.push_back({p.motions, p.nodes, p.arcs});
+  for (const graph::SaturationPoint& p : g.saturation)
+    curve.push_back({p.motions, p.nodes, p.arcs});
   j["saturation"] = curve;
   j["elements"] = {{"reached", g.reached_elements}, {"unreached", g.unreached_elements}};
   nlohmann::json motions = nlohmann::json::array();

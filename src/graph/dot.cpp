@@ -24,10 +24,14 @@ std::string Quoted(const std::string& text) {
 std::string Html(const std::string& text) {
   std::string out;
   for (char c : text) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else
+      out += c;
   }
   return out;
 }
@@ -41,7 +45,7 @@ std::string TubeElement(states::TubeElement e, bool bent) {
 
 std::string Figures(const Node& n) {
   char buffer[128];
-  std::snprintf(buffer, sizeof buffer, "E %.3g &#181;J &#183; f %.2g N &#183; d %.0f mm",
+  std::snprintf(buffer, sizeof buffer, "E %.4g &#181;J &#183; f %.2g N &#183; d %.0f mm",
                 n.energy_J * 1e6, n.friction_limit_N, std::max(n.distance_m, 0.0) * 1e3);
   return buffer;
 }
@@ -146,8 +150,7 @@ std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
     } else {
       if (!label.empty()) label += ", ";
       label += ShortReason(a.reason);
-      os << "[color=\"grey60\", style=dashed, fontcolor=\"grey40\", tooltip="
-         << Quoted(a.reason);
+      os << "[color=\"grey60\", style=dashed, fontcolor=\"grey40\", tooltip=" << Quoted(a.reason);
     }
     if (!label.empty()) os << ", label=" << Quoted(label);
     os << "]";

@@ -115,8 +115,8 @@ std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Mot
 // for a tick or two is not a node. A transition between counted states that changes more than
 // one PC is bridged by a brief state in between when one is a single change from both, else
 // refined by sub-stepping the tick where it happened, else flagged simultaneous.
-MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion,
-                       int index, const ExploreOptions& options) {
+MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion, int index,
+                       const ExploreOptions& options) {
   MotionResult result;
   const double step_s = core.scene().model.time_step_s;
   const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
@@ -161,10 +161,9 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
         for (std::size_t c = 1; c < chain.size(); ++c) {
           const TickRef at{index, to.start, options.substeps, chain[c].first.start};
           if (c + 1 < chain.size()) {
-            result.stays.push_back({chain[c].first.text,
-                                    static_cast<int>(chain[c].first.cf.contacts.size()), at,
-                                    chain[c + 1].first.start - chain[c].first.start, true,
-                                    chain[c].second});
+            result.stays.push_back(
+                {chain[c].first.text, static_cast<int>(chain[c].first.cf.contacts.size()), at,
+                 chain[c + 1].first.start - chain[c].first.start, true, chain[c].second});
           }
           add_change(chain[c - 1].first, chain[c].first, false, at);
         }
@@ -211,7 +210,8 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   return result;
 }
 
-// --- geometry of the scene for aiming -------------------------------------------------------------
+// --- geometry of the scene for aiming
+// -------------------------------------------------------------
 
 struct Box {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -329,13 +329,13 @@ std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const Expl
                                                      Eigen::Vector3d(2.5 * r * f.axis)};
       for (const Eigen::Vector3d& d : slides) {
         const Eigen::Vector3d from = m.moves.back().p_W_m;
-        Move move = MoveTo(ClampToWorkspace(scene, from + d), q, 0.5 * o.speed_m_per_s,
-                           o.push_N, from);
+        Move move =
+            MoveTo(ClampToWorkspace(scene, from + d), q, 0.5 * o.speed_m_per_s, o.push_N, from);
         move.guard_N = 1.5 * o.push_N;  // friction of the pressed tube stays below this
         m.moves.push_back(move);
       }
-      m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 5.0 * r * f.up),
-                               f.q0, o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
+      m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 5.0 * r * f.up), f.q0,
+                               o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
       motions.push_back(std::move(m));
     }
   }
@@ -426,13 +426,14 @@ std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Mo
                                  std::vector<std::unique_ptr<core::Core>>& cores) {
   std::vector<MotionResult> results(static_cast<std::size_t>(count));
   const int jobs = std::clamp(o.jobs, 1, std::max(1, count));
-  while (static_cast<int>(cores.size()) < 2 * jobs) cores.push_back(std::make_unique<core::Core>(scene));
+  while (static_cast<int>(cores.size()) < 2 * jobs)
+    cores.push_back(std::make_unique<core::Core>(scene));
   std::atomic<int> next{0};
   auto work = [&](int worker) {
     for (int i = next++; i < count; i = next++) {
-      results[std::size_t(i)] = RunMotion(*cores[std::size_t(2 * worker)],
-                                          *cores[std::size_t(2 * worker + 1)],
-                                          motions[std::size_t(first + i)], first + i, o);
+      results[std::size_t(i)] =
+          RunMotion(*cores[std::size_t(2 * worker)], *cores[std::size_t(2 * worker + 1)],
+                    motions[std::size_t(first + i)], first + i, o);
     }
   };
   std::vector<std::thread> threads;
@@ -656,9 +657,9 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     const int first = static_cast<int>(graph.motions.size());
     const int count = std::min(kBatch, o.max_motions - first);
     // Random motions are numbered from 0 whatever came before, so a seed names the same motions.
-    const int random_first = first - static_cast<int>(std::count_if(
-                                         graph.motions.begin(), graph.motions.end(),
-                                         [](const Motion& m) { return m.kind != "random"; }));
+    const int random_first =
+        first - static_cast<int>(std::count_if(graph.motions.begin(), graph.motions.end(),
+                                               [](const Motion& m) { return m.kind != "random"; }));
     std::vector<Motion> batch = RandomMotionsIn(scene, box, o.seed, random_first, count, o);
     graph.motions.insert(graph.motions.end(), batch.begin(), batch.end());
     std::vector<MotionResult> results = RunAll(scene, graph.motions, first, count, o, cores);
@@ -682,10 +683,9 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     goal.goal = true;
     const double half_length = 0.5 * scene.tube.length_m;
     for (Node& n : graph.nodes) {
-      n.distance_m = (n.X_WH.translation() - goal.X_WH.translation()).norm() +
-                     half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() *
-                                                     n.X_WH.linear())
-                                       .angle();
+      n.distance_m =
+          (n.X_WH.translation() - goal.X_WH.translation()).norm() +
+          half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() * n.X_WH.linear()).angle();
     }
   }
   const std::set<std::string> reached = ReachedElements(graph);

@@ -500,8 +500,8 @@ void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {
 }
 
 void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
-  const std::vector<std::string> top = {"tubeplan", "name",  "tube",     "contact",
-                                        "friction", "parts", "start",    "goal",
+  const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
+                                        "friction", "parts", "start",     "goal",
                                         "device",   "model", "workspace", "heuristics"};
   if (!root.IsMap()) {
     r.Error(root, std::string("a scene file must be a map, found ") + KindName(root) +

@@ -134,7 +134,10 @@ TEST_CASE("Broken scenes get exactly the right diagnostics", "[scene]") {
       {"unknown key with a suggestion", WithLine(4, "frction: {static: 0.7, kinetic: 0.08}"),
        "t.yaml:4:1: error: unknown key 'frction' in 'scene', did you mean 'friction'? (expected "
        "one of: tubeplan, name, tube, contact, friction, parts, start, goal, device, model, "
-       "workspace)\n"},
+       "workspace, heuristics)\n"},
+      {"negative heuristic weight", WithLine(4, "heuristics: {friction: -1, energy: 1}"),
+       "t.yaml:4:24: error: heuristics.friction must be a weight between 0 and 1e6, expected "
+       "e.g. 1\n"},
       {"missing key",
        WithLine(3,
                 "tube: {outer_radius: 5 mm, inner_radius: 4 mm, youngs_modulus: 3 MPa, "
@@ -226,7 +229,7 @@ TEST_CASE("Every problem in a file is reported at once", "[scene]") {
         "t.yaml:3:77: error: tube.youngs_modulus (-3e+06) must be a finite number greater than "
         "zero\n"
         "t.yaml:12:1: error: unknown key 'colour' in 'scene' (expected one of: tubeplan, name, "
-        "tube, contact, friction, parts, start, goal, device, model, workspace)\n");
+        "tube, contact, friction, parts, start, goal, device, model, workspace, heuristics)\n");
 }
 
 TEST_CASE("An unreadable file is one error for the whole file", "[scene]") {

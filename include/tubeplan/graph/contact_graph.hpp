@@ -22,7 +22,7 @@ struct Node {
   TickRef witness;
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();  ///< hand at the witness
   Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();      ///< held end at the witness
-  double energy_J = 0.0;          ///< bending energy at the witness
+  double energy_J = 0.0;                                       ///< bending energy at the witness
   double friction_N = 0.0;        ///< sum of |friction force| over the PCs at the witness
   double friction_limit_N = 0.0;  ///< sum of f_max over the PCs: the friction they can resist with
   double force_N = 0.0;           ///< operator force at the witness
@@ -56,13 +56,13 @@ struct ContactGraph {
   std::vector<Arc> arcs;
   int start = -1;  ///< node of the start pose
   int goal = -1;   ///< node of the scene's goal CF, -1 when exploration never reached it
-  std::vector<Motion> motions;               ///< every motion explored, in order (witnesses index it)
-  std::vector<SaturationPoint> saturation;   ///< after each motion
+  std::vector<Motion> motions;  ///< every motion explored, in order (witnesses index it)
+  std::vector<SaturationPoint> saturation;      ///< after each motion
   std::vector<std::string> reached_elements;    ///< part elements seen in some PC
   std::vector<std::string> unreached_elements;  ///< reachable parts' elements never seen
-  long ticks = 0;                            ///< core ticks run, refinements included
-  int refinements = 0;                       ///< multi-PC steps that were sub-stepped
-  double seconds = 0.0;                      ///< wall time of the exploration
+  long ticks = 0;                               ///< core ticks run, refinements included
+  int refinements = 0;                          ///< multi-PC steps that were sub-stepped
+  double seconds = 0.0;                         ///< wall time of the exploration
 
   int FindNode(const std::string& cf) const;
 };

@@ -14,7 +14,7 @@ struct DotOptions {
   /// false: the pruned graph: kept arcs only, between the nodes a plan can pass through (reached
   /// from the start and reaching the goal along kept arcs).
   bool dropped_arcs = true;
-  std::string title;         ///< graph label, e.g. the scene's name
+  std::string title;  ///< graph label, e.g. the scene's name
 };
 
 std::string ToDot(const ContactGraph& graph, const DotOptions& options);

@@ -27,9 +27,9 @@ struct ExploreOptions {
   /// of parts, three-PC wedges) that random motions keep finding one at a time.
   int max_motions = 300;
   int jobs = 1;
-  double push_N = 2.0;        ///< guard force of the probing moves
+  double push_N = 2.0;          ///< guard force of the probing moves
   double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)
-  int substeps = 16;          ///< sub-ticks per tick when refining a multi-PC change
+  int substeps = 16;            ///< sub-ticks per tick when refining a multi-PC change
   /// A CF counts once the core has kept it this long (the plan judge's dwell); briefer states
   /// are flicker, not nodes, unless they bridge a two-PC change.
   double dwell_s = 0.020;

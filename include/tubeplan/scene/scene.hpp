@@ -76,10 +76,10 @@ struct Workspace {
 
 /// Weights of the graph's pruning heuristics (paper V-B; graph::PruneWeights has the meaning).
 struct Heuristics {
-  double friction = 1.0;   ///< [-], >= 0
-  double energy = 1.0;     ///< [-], >= 0
-  double distance = 1.0;   ///< [-], >= 0
-  double tolerance = 0.25; ///< [-], >= 0: how far above the best score an arc is still kept
+  double friction = 1.0;    ///< [-], >= 0
+  double energy = 1.0;      ///< [-], >= 0
+  double distance = 1.0;    ///< [-], >= 0
+  double tolerance = 0.25;  ///< [-], >= 0: how far above the best score an arc is still kept
 };
 
 struct Scene {

@@ -1,0 +1,315 @@
+// The contact-state graph: pruning against a hand-made graph with known dominance, DOT that
+// Graphviz renders and Boost reads back, and exploration of the shipped groove scene checked by
+// replaying every witness, by --jobs independence and by independent random motions.
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <boost/graph/adjacency_list.hpp>
+#include <boost/graph/graphviz.hpp>
+#include <catch2/catch.hpp>
+
+#include <tubeplan/graph/dot.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+
+namespace {
+
+using namespace tubeplan;
+using graph::Arc;
+using graph::ContactGraph;
+using graph::Node;
+
+states::ContactFormation Cf(const char* text) {
+  const states::ParseResult parsed = states::ParseContactFormation(text);
+  REQUIRE(parsed.cf);
+  return *parsed.cf;
+}
+
+TEST_CASE("PC changes: one per PC added, removed, re-marked or with one element changed",
+          "[graph]") {
+  using graph::PcChanges;
+  CHECK(PcChanges(Cf("{}"), Cf("{}")) == 0);
+  CHECK(PcChanges(Cf("{}"), Cf("{Ee - floor.top}")) == 1);
+  CHECK(PcChanges(Cf("{Ee - floor.top}"), Cf("{Ee ~ floor.top}")) == 1);       // re-marked
+  CHECK(PcChanges(Cf("{Ee ~ floor.top}"), Cf("{Fe ~ floor.top}")) == 1);       // rim to face
+  CHECK(PcChanges(Cf("{Ee - floor.top}"), Cf("{Ee - floor.top_xpos}")) == 1);  // onto the edge
+  CHECK(PcChanges(Cf("{}"), Cf("{Fs - floor.top, Fs - left.inner}")) == 2);
+  CHECK(PcChanges(Cf("{Ee - floor.top}"), Cf("{Fs u left.inner}")) == 2);  // nothing shared
+  CHECK(PcChanges(Cf("{Ee - floor.top, Fs - left.inner}"), Cf("{Fs n left.inner}")) == 2);
+}
+
+// A hand-made graph: start A, goal G, and three ways from A with values chosen so that the
+// dominance and the scores are known by hand.
+ContactGraph HandMade() {
+  ContactGraph g;
+  auto node = [&](const char* cf, double friction_limit, double energy, double distance) {
+    Node n;
+    n.cf = cf;
+    n.friction_limit_N = friction_limit;
+    n.energy_J = energy;
+    n.distance_m = distance;
+    g.nodes.push_back(n);
+    return static_cast<int>(g.nodes.size()) - 1;
+  };
+  const int a = node("{}", 0.0, 0.0, 0.10);
+  const int b = node("{Ee - floor.top}", 1.0, 1.0, 0.05);
+  const int c = node("{Ee ~ floor.top}", 2.0, 2.0, 0.06);   // worse than B on every criterion
+  const int d = node("{Fe - floor.top}", 0.5, 4.0, 0.05);   // less friction than B, more energy
+  const int e = node("{Fs - left.inner}", 0.0, 0.0, 0.20);  // further from the goal than A
+  const int f = node("{Fs - left.top}", 0.0, 0.0, 0.01);    // no way on to the goal
+  const int goal = node("{Fs - floor.top}", 1.0, 0.0, 0.0);
+  g.start = a, g.goal = goal;
+  g.nodes[std::size_t(a)].start = g.nodes[std::size_t(goal)].goal = true;
+  for (auto [from, to] : std::array<std::pair<int, int>, 10>{{{a, b},
+                                                              {a, c},
+                                                              {a, d},
+                                                              {a, e},
+                                                              {a, f},
+                                                              {b, goal},
+                                                              {c, goal},
+                                                              {d, goal},
+                                                              {e, goal},
+                                                              {goal, a}}}) {
+    Arc arc;
+    arc.from = from, arc.to = to, arc.count = 1;
+    g.arcs.push_back(arc);
+  }
+  return g;
+}
+
+TEST_CASE("Pruning a hand-made graph keeps the undominated arcs towards the goal", "[graph]") {
+  ContactGraph g = HandMade();
+  graph::PruneWeights w;  // 1, 1, 1
+  w.tolerance = 10.0;     // so only dominance and direction decide here
+  graph::Prune(g, w);
+  auto arc = [&](int from, int to) -> const Arc& {
+    for (const Arc& a : g.arcs)
+      if (a.from == from && a.to == to) return a;
+    FAIL("no such arc");
+    return g.arcs.front();
+  };
+  CHECK(arc(0, 1).kept);        // A -> B
+  CHECK_FALSE(arc(0, 2).kept);  // A -> C: dominated by A -> B
+  CHECK(arc(0, 2).reason.rfind("dominated by -> {Ee - floor.top}", 0) == 0);
+  CHECK(arc(0, 3).kept);        // A -> D: less friction, more energy
+  CHECK_FALSE(arc(0, 4).kept);  // A -> E: further from the goal
+  CHECK(arc(0, 4).reason.rfind("leads away from the goal", 0) == 0);
+  CHECK_FALSE(arc(0, 5).kept);  // A -> F: dead end
+  CHECK(arc(0, 5).reason == "no path from its target to the goal");
+  CHECK_FALSE(arc(6, 0).kept);
+  CHECK(arc(6, 0).reason == "leaves the goal");
+  for (int from : {1, 2, 3, 4}) CHECK(arc(from, 6).kept);  // the only way on from each
+
+  // Scores by hand: scales f* = 2 N, E* = 4 J, d* = 0.2 m (largest magnitudes over the nodes).
+  // A -> B: 1/2 + 1/4 + 0.05/0.2 = 1.0;  A -> D: 0.5/2 + 4/4 + 0.05/0.2 = 1.5.
+  CHECK(graph::ArcScore(g, arc(0, 1), w) == Approx(1.0).epsilon(1e-12));
+  CHECK(graph::ArcScore(g, arc(0, 3), w) == Approx(1.5).epsilon(1e-12));
+  // With a tolerance below their difference, D goes for its score; above it, both stay.
+  w.tolerance = 0.4;
+  graph::Prune(g, w);
+  CHECK(arc(0, 1).kept);
+  CHECK_FALSE(arc(0, 3).kept);
+  CHECK(arc(0, 3).reason.rfind("score 1.500 > best 1.000", 0) == 0);
+  w.tolerance = 0.6;
+  graph::Prune(g, w);
+  CHECK(arc(0, 3).kept);
+  // Weights move the choice: energy weighted 0, friction 4: D (0.5 N) beats B (1 N).
+  w = {4.0, 0.0, 1.0, 0.1};
+  graph::Prune(g, w);
+  CHECK(arc(0, 3).kept);
+  CHECK_FALSE(arc(0, 1).kept);
+}
+
+// Runs a command, returns its exit status and its standard error.
+int Run(const std::string& command, std::string& err) {
+  const std::string err_file = "graph_test_stderr.txt";
+  const int status = std::system((command + " 2> " + err_file).c_str());
+  std::ifstream in(err_file);
+  std::stringstream s;
+  s << in.rdbuf();
+  err = s.str();
+  std::remove(err_file.c_str());
+  return status;
+}
+
+// Boost 1.74's read_graphviz cannot read HTML strings at all (even `label=<a>` fails with
+// "Unclosed HTML string"; Graphviz reads them), so the structure check swaps each HTML label for
+// a quoted placeholder first. The file as written is what the Graphviz check renders.
+std::string WithoutHtmlLabels(const std::string& dot) {
+  std::string out;
+  for (std::size_t i = 0; i < dot.size();) {
+    if (dot.compare(i, 7, "label=<") != 0) {
+      out += dot[i++];
+      continue;
+    }
+    std::size_t j = i + 6;  // at the opening '<'
+    for (int depth = 0; j < dot.size(); ++j) {
+      if (dot[j] == '<') ++depth;
+      if (dot[j] == '>' && --depth == 0) break;
+    }
+    out += "label=\"html\"";
+    i = j + 1;
+  }
+  return out;
+}
+
+TEST_CASE("DOT renders with Graphviz without warnings and reads back into Boost", "[graph]") {
+  ContactGraph g = HandMade();
+  graph::PruneWeights w;
+  w.tolerance = 0.6;  // A -> B and A -> D both kept (scores 1.0 and 1.5, above)
+  graph::Prune(g, w);
+  for (const bool unpruned : {true, false}) {
+    graph::DotOptions options;
+    options.dropped_arcs = unpruned;
+    options.title = "hand-made \"graph\"";
+    const std::string dot = graph::ToDot(g, options);
+    {
+      std::ofstream out("graph_test.dot");
+      out << dot;
+    }
+    std::string err;
+    CHECK(Run("dot -Tsvg graph_test.dot -o graph_test.svg", err) == 0);
+    CHECK(err.empty());
+    std::remove("graph_test.dot");
+    std::remove("graph_test.svg");
+
+    boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS,
+                          boost::property<boost::vertex_name_t, std::string>,
+                          boost::property<boost::edge_name_t, std::string>>
+        read;
+    boost::dynamic_properties dp(boost::ignore_other_properties);
+    dp.property("node_id", boost::get(boost::vertex_name, read));
+    std::istringstream in(WithoutHtmlLabels(dot));
+    REQUIRE(boost::read_graphviz(in, read, dp));
+    // Unpruned: all 7 nodes and 10 arcs. Pruned: the nodes on a kept way from A to G (A, B, D,
+    // G) and the kept arcs among them (A->B, A->D, B->G, D->G).
+    CHECK(boost::num_vertices(read) == (unpruned ? 7u : 4u));
+    CHECK(boost::num_edges(read) == (unpruned ? 10u : 4u));
+  }
+}
+
+TEST_CASE("The paper's notation in DOT labels", "[graph]") {
+  CHECK(graph::PaperNotation("{}") == "&#8709;");
+  CHECK(graph::PaperNotation("{Fe ~ left.inner}") == "F&#771;<SUB>e</SUB> &#8211; left.inner");
+  CHECK(graph::PaperNotation("{Fs u left.top_inner, Fe - floor.top}") ==
+        "F<SUB>e</SUB> &#8211; floor.top<BR/>F<SUB>s</SUB> &#8995; left.top_inner");
+  CHECK(graph::PaperNotation("{Fs n floor.top}") == "F<SUB>s</SUB> &#8994; floor.top");
+}
+
+scene::Scene Groove() {
+  io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene);
+  return *loaded.scene;
+}
+
+// A small exploration of the shipped scene, shared by the tests below (it costs seconds).
+const ContactGraph& SmallGraph(int jobs) {
+  static std::map<int, ContactGraph> graphs;
+  if (!graphs.contains(jobs)) {
+    graph::ExploreOptions o;
+    o.max_motions = 110;  // the sweeps, the aims and some 30 random motions
+    o.jobs = jobs;
+    graphs[jobs] = graph::Explore(Groove(), o);
+  }
+  return graphs[jobs];
+}
+
+TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph]") {
+  const scene::Scene s = Groove();
+  const ContactGraph& g = SmallGraph(2);
+  REQUIRE(g.nodes.size() > 20);
+  CHECK(g.goal >= 0);
+  CHECK(g.nodes[std::size_t(g.start)].cf == "{}");
+  core::Core core(s);
+  for (const Node& n : g.nodes) {
+    INFO(n.cf << " witness motion " << n.witness.motion << " tick " << n.witness.tick);
+    graph::ReplayTo(core, g.motions[std::size_t(n.witness.motion)], n.witness);
+    CHECK(core.FormationText() == n.cf);
+    // The witness data is the core's at that tick (the same bits: the core is deterministic).
+    CHECK(core.last().energy_J == n.energy_J);
+    CHECK(core.last().X_WH.translation() == n.X_WH.translation());
+  }
+  // Every arc's witness tick is in the arc's target CF... except where the core re-entered the
+  // source within the dwell time; the first tick of the target must at least exist.
+  for (const Arc& a : g.arcs) CHECK(a.witness.tick >= 1);
+}
+
+TEST_CASE("The same graph from one thread and from two", "[graph]") {
+  const ContactGraph& one = SmallGraph(1);
+  const ContactGraph& two = SmallGraph(2);
+  REQUIRE(one.nodes.size() == two.nodes.size());
+  REQUIRE(one.arcs.size() == two.arcs.size());
+  for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+    CHECK(one.nodes[i].cf == two.nodes[i].cf);
+    CHECK(one.nodes[i].ticks == two.nodes[i].ticks);
+    CHECK(one.nodes[i].witness.tick == two.nodes[i].witness.tick);
+    CHECK(one.nodes[i].energy_J == two.nodes[i].energy_J);
+  }
+  for (std::size_t i = 0; i < one.arcs.size(); ++i) {
+    CHECK(one.arcs[i].from == two.arcs[i].from);
+    CHECK(one.arcs[i].to == two.arcs[i].to);
+    CHECK(one.arcs[i].count == two.arcs[i].count);
+    CHECK(one.arcs[i].simultaneous == two.arcs[i].simultaneous);
+  }
+  CHECK(one.ticks == two.ticks);
+}
+
+TEST_CASE("Independent random motions mostly stay inside the explored graph", "[graph]") {
+  // Motions from another seed, run through the core and debounced here on their own (a CF
+  // counts after the same 20 ms dwell), against the graph explored with the default budget.
+  const scene::Scene s = Groove();
+  graph::ExploreOptions o;
+  o.jobs = 2;
+  const ContactGraph g = graph::Explore(s, o);
+  std::set<std::string> nodes;
+  std::set<std::pair<std::string, std::string>> arcs;
+  for (const Node& n : g.nodes) nodes.insert(n.cf);
+  for (const Arc& a : g.arcs)
+    arcs.insert({g.nodes[std::size_t(a.from)].cf, g.nodes[std::size_t(a.to)].cf});
+
+  const std::vector<graph::Motion> motions = graph::RandomMotions(s, 1234567, 0, 30, o);
+  core::Core core(s);
+  const int dwell = 20;
+  std::set<std::string> seen_nodes;
+  std::set<std::pair<std::string, std::string>> seen_arcs;
+  for (const graph::Motion& m : motions) {
+    core.Reset(s.X_WH_start);
+    graph::MotionRunner runner(m, s.X_WH_start, s.model.time_step_s);
+    std::string counted, current;
+    int held = 0;
+    for (int k = 1; !runner.Done(); ++k) {
+      core.Step(k * s.model.time_step_s, runner.Next(core.last()));
+      const std::string cf = core.FormationText();
+      held = cf == current ? held + 1 : 1;
+      current = cf;
+      if (k == 1) counted = cf, seen_nodes.insert(cf);
+      if (held == dwell && cf != counted) {
+        seen_nodes.insert(cf);
+        seen_arcs.insert({counted, cf});
+        counted = cf;
+      }
+    }
+  }
+  const auto covered_nodes = std::count_if(seen_nodes.begin(), seen_nodes.end(),
+                                           [&](const auto& n) { return nodes.contains(n); });
+  const auto covered_arcs = std::count_if(seen_arcs.begin(), seen_arcs.end(),
+                                          [&](const auto& a) { return arcs.contains(a); });
+  const double node_coverage = double(covered_nodes) / double(seen_nodes.size());
+  const double arc_coverage = double(covered_arcs) / double(seen_arcs.size());
+  WARN("coverage of 30 independent random motions: CFs "
+       << covered_nodes << "/" << seen_nodes.size() << ", transitions " << covered_arcs << "/"
+       << seen_arcs.size());
+  // The graph is not saturated within its budget (docs/graph.md): the groove has a long tail
+  // of rare CFs. The bounds are what the default budget achieved when measured, less a margin,
+  // so that a change that makes exploration miss common states fails here.
+  CHECK(node_coverage >= 0.85);
+  CHECK(arc_coverage >= 0.60);
+}
+
+}  // namespace
