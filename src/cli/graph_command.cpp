@@ -3,20 +3,26 @@
 // the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
 // JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
 #include <algorithm>
+#include <filesystem>
 #include <iomanip>
 #include <map>
 #include <memory>
 #include <optional>
 #include <sstream>
 #include <thread>
+#include <tuple>
+#include <variant>
 
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/paths.hpp>
+#include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
+#include <tubeplan/plan/synthesize.hpp>
 
 #include "commands.hpp"
 #include "graph_json.hpp"
@@ -64,7 +70,16 @@ bool ParseWeights(const std::string& text, graph::PruneWeights& w, std::string& 
   return true;
 }
 
-int RunGraph(const GraphOptions& o, Streams io) {
+// What `graph` and `plans` share: the scene, the explored and pruned graph, the settings used.
+struct Built {
+  scene::Scene scene;
+  graph::ContactGraph graph;
+  graph::ExploreOptions explore;
+  graph::PruneWeights weights;
+};
+
+// Loads the scene, explores and prunes; on bad input reports and returns the exit code.
+std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
   io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
   io.err << loaded.diagnostics.FormatAll();
   if (!loaded.scene) return kExitBadInput;
@@ -91,6 +106,36 @@ int RunGraph(const GraphOptions& o, Streams io) {
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
   graph::ContactGraph g = graph::Explore(s, explore);
   graph::Prune(g, weights);
+  return Built{s, std::move(g), explore, weights};
+}
+
+void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
+  sub->add_option("--seed", o.seed, "seed of the random motions")->capture_default_str();
+  sub->add_option("--effort", o.effort,
+                  "stop after this many random motions in a row found no new state or "
+                  "transition")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  sub->add_option("--budget", o.budget,
+                  "stop after this many motions in all, saturated or not (said in the output)")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  sub->add_option("--jobs", o.jobs, "threads (default: the machine's cores)")
+      ->check(CLI::Range(1, 256));
+  sub->add_option("--weights", o.weights,
+                  "heuristic weights over the scene's, e.g. friction=1,energy=1,distance=1");
+  sub->add_option("--tolerance", o.tolerance,
+                  "keep arcs whose weighted score is within this of the best (scene's default)");
+}
+
+int RunGraph(const GraphOptions& o, Streams io) {
+  std::variant<Built, int> built = BuildGraph(o, io);
+  if (const int* code = std::get_if<int>(&built)) return *code;
+  const Built& b = std::get<Built>(built);
+  const scene::Scene& s = b.scene;
+  const graph::ContactGraph& g = b.graph;
+  const graph::ExploreOptions& explore = b.explore;
+  const graph::PruneWeights& weights = b.weights;
 
   if (!o.dot_path.empty()) {
     graph::DotOptions dot;
@@ -144,11 +189,11 @@ int RunGraph(const GraphOptions& o, Streams io) {
     t << "  (saturated: " << quiet << " motions in a row found nothing new)\n";
   } else {
     const std::size_t back = std::min<std::size_t>(100, g.saturation.size() - 1);
-    const graph::SaturationPoint& a = g.saturation[g.saturation.size() - 1 - back];
-    const graph::SaturationPoint& b = g.saturation.back();
+    const graph::SaturationPoint& then = g.saturation[g.saturation.size() - 1 - back];
+    const graph::SaturationPoint& now = g.saturation.back();
     t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out; the last "
-      << back << " motions still found " << b.nodes - a.nodes << " nodes and " << b.arcs - a.arcs
-      << " arcs)\n";
+      << back << " motions still found " << now.nodes - then.nodes << " nodes and "
+      << now.arcs - then.arcs << " arcs)\n";
   }
   t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
@@ -162,6 +207,113 @@ int RunGraph(const GraphOptions& o, Streams io) {
   if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";
   io.out << t.str();
   return g.goal >= 0 ? kExitOk : kExitNegative;
+}
+
+struct PlansOptions {
+  GraphOptions graph;
+  int k = 3;
+  std::string out_dir;
+  std::string tremor = "0";
+  std::string quantum = "0";
+  std::string speed = "80 mm/s";
+};
+
+int RunPlans(const PlansOptions& o, Streams io) {
+  // Quantities first: a typo should not cost an exploration.
+  double tremor_m = 0.0, quantum_m = 0.0, speed_m_per_s = 0.0;
+  for (auto [option, text, dimension, target] :
+       {std::tuple{"--tremor", &o.tremor, io::dim::kLength, &tremor_m},
+        std::tuple{"--quantum", &o.quantum, io::dim::kLength, &quantum_m},
+        std::tuple{"--speed", &o.speed, io::dim::kVelocity, &speed_m_per_s}}) {
+    std::string error;
+    const auto values = ParseQuantityList(option, *text, 1, 1, dimension, error);
+    if (!values) {
+      io.err << "tubeplan plans: error: " << error << "\n";
+      return kExitBadInput;
+    }
+    *target = values->front();
+  }
+  if (tremor_m < 0.0 || tremor_m > 0.005 || quantum_m < 0.0 || quantum_m > 0.005 ||
+      !(speed_m_per_s > 0.0 && speed_m_per_s <= 1.0)) {
+    io.err << "tubeplan plans: error: expected --tremor and --quantum between 0 and 5 mm and "
+              "--speed above 0 and at most 1 m/s\n";
+    return kExitBadInput;
+  }
+  std::variant<Built, int> built = BuildGraph(o.graph, io);
+  if (const int* code = std::get_if<int>(&built)) return *code;
+  const Built& b = std::get<Built>(built);
+  const graph::ContactGraph& g = b.graph;
+  if (g.goal < 0) {
+    io.err << o.graph.scene_path << ": error: exploration never reached the goal "
+           << states::ToString(b.scene.goal) << ", so there is no plan to extract; expected a "
+           << "goal the tube can reach (try a larger --budget)\n";
+    return kExitNegative;
+  }
+  const std::vector<graph::Path> paths =
+      graph::KShortestPaths(g, graph::ArcCosts(g, b.weights), o.k);
+
+  namespace fs = std::filesystem;
+  const fs::path out_dir =
+      o.out_dir.empty() ? fs::path(b.scene.name + "-plans") : fs::path(o.out_dir);
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) {
+    io.err << out_dir.string() << ": error: cannot create the directory (" << ec.message()
+           << "), expected a writable place for the plans\n";
+    return kExitBadInput;
+  }
+  const std::string scene_rel =
+      fs::relative(fs::absolute(o.graph.scene_path), fs::absolute(out_dir), ec).generic_string();
+  plan::SynthesisOptions synthesis;
+  synthesis.peak_speed_m_per_s = speed_m_per_s;
+  synthesis.tremor_m = tremor_m;
+  synthesis.quantum_m = quantum_m;
+  std::ostringstream t;
+  t << std::setprecision(3);
+  t << paths.size() << " candidate plan" << (paths.size() == 1 ? "" : "s") << " (of " << o.k
+    << " asked) through the pruned graph of " << b.scene.name << " (" << g.nodes.size() << " CFs, "
+    << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
+    << " kept arcs), written to " << out_dir.string() << ":\n";
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    const graph::Path& path = paths[i];
+    const std::string name = b.scene.name + "-candidate-" + std::to_string(i + 1);
+    // Waypoints: the scene's start pose, then the hand at each later state's witness.
+    std::vector<Eigen::Isometry3d> waypoints = {b.scene.X_WH_start};
+    plan::Plan p;
+    p.name = name;
+    p.scene = scene_rel;
+    p.trajectory = name + ".csv";
+    for (std::size_t j = 0; j < path.nodes.size(); ++j) {
+      const graph::Node& n = g.nodes[std::size_t(path.nodes[j])];
+      p.states.push_back(n.cf);
+      if (j > 0) waypoints.push_back(n.X_W_hand);
+    }
+    p.limits.max_force_N = b.scene.device.max_force_N;
+    p.limits.dwell_s = b.explore.dwell_s;
+    synthesis.seed = o.graph.seed + i;
+    const plan::Trajectory trajectory = plan::SynthesizeTrajectory(waypoints, synthesis);
+    std::ostringstream comment;
+    comment << "Candidate " << i + 1 << " of " << paths.size() << " made by `tubeplan plans "
+            << o.graph.scene_path << "` (seed " << o.graph.seed << "), cost " << path.cost
+            << ": the hand moves by minimum jerk through the witnesses of its states.";
+    p.comment = comment.str();
+    for (const auto& [file, text] :
+         {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(p)},
+          std::pair{out_dir / p.trajectory, io::FormatTrajectoryCsv(trajectory)}}) {
+      if (const std::string e = io::WriteTextFileAtomically(file, text); !e.empty()) {
+        io.err << file.string() << ": error: " << e << "\n";
+        return kExitBadInput;
+      }
+    }
+    t << "  " << name << ": cost " << path.cost << ", " << path.nodes.size() - 1
+      << (path.nodes.size() == 2 ? " transition, " : " transitions, ")
+      << trajectory.samples.back().t_s << " s:";
+    for (const std::string& state : p.states)
+      t << " " << state << (&state == &p.states.back() ? "" : " ->");
+    t << "\n";
+  }
+  io.out << t.str();
+  return kExitOk;
 }
 
 }  // namespace
@@ -178,23 +330,34 @@ Command AddGraphCommand(CLI::App& app, Streams streams) {
   sub->add_flag("--unpruned", options->unpruned,
                 "DOT: draw every arc, the dropped ones dashed with their reason (default: the "
                 "pruned graph only)");
-  sub->add_option("--seed", options->seed, "seed of the random motions")->capture_default_str();
-  sub->add_option("--effort", options->effort,
-                  "stop after this many random motions in a row found no new state or "
-                  "transition")
-      ->check(CLI::Range(1, 10000))
-      ->capture_default_str();
-  sub->add_option("--budget", options->budget,
-                  "stop after this many motions in all, saturated or not (said in the output)")
-      ->check(CLI::Range(1, 100000))
-      ->capture_default_str();
-  sub->add_option("--jobs", options->jobs, "threads (default: the machine's cores)")
-      ->check(CLI::Range(1, 256));
-  sub->add_option("--weights", options->weights,
-                  "heuristic weights over the scene's, e.g. friction=1,energy=1,distance=1");
-  sub->add_option("--tolerance", options->tolerance,
-                  "keep arcs whose weighted score is within this of the best (scene's default)");
+  AddGraphOptions(sub, *options);
   return {sub, [options, streams] { return RunGraph(*options, streams); }};
+}
+
+}  // namespace tubeplan::cli
+
+namespace tubeplan::cli {
+
+Command AddPlansCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<PlansOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "plans",
+      "Build and prune the scene's contact-state graph, then write the k best start -> goal paths "
+      "as plan files, each with a synthesized (minimum-jerk) operator trajectory.");
+  sub->add_option("scene", options->graph.scene_path, "scene file (.yaml)")->required();
+  sub->add_option("--k", options->k, "how many plans")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  sub->add_option("--out-dir", options->out_dir,
+                  "where to write NAME-candidate-I.yaml and .csv (default: SCENE_NAME-plans)");
+  sub->add_option("--speed", options->speed, "peak hand speed, e.g. \"80 mm/s\"")
+      ->capture_default_str();
+  sub->add_option("--tremor", options->tremor,
+                  "amplitude of 8-12 Hz tremor added to the hand, e.g. \"0.1 mm\" (default none)");
+  sub->add_option("--quantum", options->quantum,
+                  "round positions to this device resolution, e.g. \"0.03 mm\" (default none)");
+  AddGraphOptions(sub, options->graph);
+  return {sub, [options, streams] { return RunPlans(*options, streams); }};
 }
 
 }  // namespace tubeplan::cli

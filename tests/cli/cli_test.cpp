@@ -1,6 +1,7 @@
 // The command line as a user drives it: argument strings in, exit code and text out.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <sstream>
@@ -40,6 +41,49 @@ std::vector<std::string> Beam(std::vector<std::string> extra) {
   args.insert(args.end(), kSteelTube.begin(), kSteelTube.end());
   args.insert(args.end(), extra.begin(), extra.end());
   return args;
+}
+
+TEST_CASE("graph: bad weights and options are errors before any exploration", "[cli]") {
+  Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--weights", "friction=-1"});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--weights: \"friction=-1\" is not a weight") != std::string::npos);
+  r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--weights", "speed=1"});
+  CHECK(r.exit_code == 2);
+  r = RunTool({"plans", SourcePath("scenes/groove.yaml"), "--tremor", "3 N"});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--tremor") != std::string::npos);
+  r = RunTool({"graph", SourcePath("scenes/no-such-scene.yaml")});
+  CHECK(r.exit_code == 2);
+}
+
+TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loads", "[cli]") {
+  const std::string dir = "cli_test_plans";
+  std::filesystem::remove_all(dir);
+  const Outcome r = RunTool({"plans", SourcePath("scenes/groove.yaml"), "--k", "2", "--budget",
+                             "100", "--jobs", "2", "--out-dir", dir});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  // Up to k: a small exploration's pruned graph may hold fewer ways to the goal.
+  REQUIRE(r.out.find("groove-candidate-1: cost") != std::string::npos);
+  for (const std::string name : {"groove-candidate-1", "groove-candidate-2"}) {
+    if (r.out.find(name + ": cost") == std::string::npos) continue;
+    const std::string yaml = dir + "/" + name + ".yaml";
+    REQUIRE(std::filesystem::exists(yaml));
+    const Outcome check = RunTool({"check", dir + "/" + name + ".csv"});
+    CHECK(check.exit_code == 0);
+    std::ifstream in(yaml);
+    std::stringstream text;
+    text << in.rdbuf();
+    // The plan names its scene relative to itself, starts at {} and ends at the goal.
+    CHECK(text.str().find("  - \"{}\"\n") != std::string::npos);
+    CHECK(text.str().find("  - \"{Fs - floor.top}\"\nlimits:") != std::string::npos);
+    const std::filesystem::path scene =
+        std::filesystem::path(dir) /
+        text.str().substr(text.str().find("scene: \"") + 8,
+                          text.str().find("\"\ntrajectory") - text.str().find("scene: \"") - 8);
+    CHECK(std::filesystem::equivalent(scene, SourcePath("scenes/groove.yaml")));
+  }
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -1,0 +1,26 @@
+#pragma once
+// Candidate plans: the k cheapest start -> goal paths through the kept arcs of a pruned graph
+// (Yen's algorithm over Boost.Graph's Dijkstra). The cost of an arc is 1 + its heuristic score
+// above the cheapest kept arc's, so every transition costs at least one (shorter plans first)
+// and the heuristics order plans of the same length.
+
+#include <vector>
+
+#include <tubeplan/graph/contact_graph.hpp>
+
+namespace tubeplan::graph {
+
+struct Path {
+  std::vector<int> nodes;  ///< node indices, start first, goal last
+  double cost = 0.0;
+};
+
+/// Cost of each arc (indexed like graph.arcs) as described above; dropped arcs get +infinity.
+std::vector<double> ArcCosts(const ContactGraph& graph, const PruneWeights& weights);
+
+/// Up to k loopless paths from graph.start to graph.goal over arcs of finite cost, cheapest
+/// first (ties: the lexicographically smaller node sequence), none when there is no goal.
+std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<double>& arc_cost,
+                                 int k);
+
+}  // namespace tubeplan::graph
