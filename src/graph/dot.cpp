@@ -52,7 +52,8 @@ std::string Figures(const Node& n) {
 
 // A short label for a dropped arc; the whole reason goes into its tooltip.
 std::string ShortReason(const std::string& reason) {
-  for (const char* prefix : {"dominated", "score", "leads away", "leaves the goal", "no path"})
+  for (const char* prefix :
+       {"dominated", "leads away", "leaves the goal", "returns to the start", "no path"})
     if (reason.rfind(prefix, 0) == 0) return prefix;
   return reason.substr(0, 24);
 }

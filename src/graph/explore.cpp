@@ -568,7 +568,7 @@ std::vector<Motion> RandomMotionsIn(const scene::Scene& scene, const Box& box, s
         q = TurnAxis(f.q0, f.axis, tipped);
       }
       const double guard = unit(rng) < 0.6 ? uniform(1.0, 4.0) : 0.0;
-      m.moves.push_back(MoveTo(p, q, uniform(0.03, 0.12), guard, from));
+      m.moves.push_back(MoveTo(p, q, uniform(0.05, 0.15), guard, from));
       from = p;
     }
     m.moves.push_back(MoveTo(from + 0.05 * f.up, q, o.speed_m_per_s, 0.0, from));

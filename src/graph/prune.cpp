@@ -81,23 +81,34 @@ double ArcScore(const ContactGraph& graph, const Arc& arc, const PruneWeights& w
 
 void Prune(ContactGraph& graph, const PruneWeights& weights) {
   const std::vector<int> hops = HopsToGoal(graph);
+  auto distance = [&](int node) { return graph.nodes[std::size_t(node)].distance_m; };
+  // Towards the goal: nearer to it by distance (the paper's distance heuristic). A node none of
+  // whose arcs gets nearer keeps those that are one transition nearer, so it is no dead end.
+  std::vector<bool> has_nearer(graph.nodes.size(), false);
+  for (const Arc& a : graph.arcs) {
+    if (a.from != graph.goal && a.to != graph.start && hops[std::size_t(a.to)] >= 0 &&
+        (a.to == graph.goal || distance(a.to) < distance(a.from)))
+      has_nearer[std::size_t(a.from)] = true;
+  }
   for (Arc& a : graph.arcs) {
     a.kept = true;
     a.reason.clear();
-    const int hv = hops[std::size_t(a.to)];
+    const int hu = hops[std::size_t(a.from)], hv = hops[std::size_t(a.to)];
+    const bool nearer = a.to == graph.goal || distance(a.to) < distance(a.from);
     if (graph.goal < 0) {
       a.kept = false, a.reason = "the goal was never reached";
     } else if (a.from == graph.goal) {
       a.kept = false, a.reason = "leaves the goal";
+    } else if (a.to == graph.start) {
+      a.kept = false, a.reason = "returns to the start";
     } else if (hv < 0) {
       a.kept = false, a.reason = "no path from its target to the goal";
-    } else if (hv != 0 && !(graph.nodes[std::size_t(a.to)].distance_m <
-                            graph.nodes[std::size_t(a.from)].distance_m)) {
-      char buffer[128];
+    } else if (has_nearer[std::size_t(a.from)] ? !nearer : !(hv < hu)) {
+      char buffer[160];
       std::snprintf(buffer, sizeof buffer,
-                    "leads away from the goal (distance %.1f mm, from %.1f mm)",
-                    graph.nodes[std::size_t(a.to)].distance_m * 1e3,
-                    graph.nodes[std::size_t(a.from)].distance_m * 1e3);
+                    "leads away from the goal (%.1f mm and %d transitions from it, the source "
+                    "%.1f mm and %d)",
+                    distance(a.to) * 1e3, hv, distance(a.from) * 1e3, hu);
       a.kept = false, a.reason = buffer;
     }
   }
@@ -134,25 +145,24 @@ void Prune(ContactGraph& graph, const PruneWeights& weights) {
         }
       }
     }
+    // The best score among the candidates (a dominated arc never scores below the arc that
+    // dominates it when all weights are positive, but weights may be zero).
     double best = std::numeric_limits<double>::infinity();
     std::size_t best_arc = 0;
     for (std::size_t i = 0; i < candidates.size(); ++i) {
-      if (!reasons[i].empty()) continue;
       const double score = ArcScore(graph, graph.arcs[candidates[i]], weights);
       if (score < best) best = score, best_arc = candidates[i];
     }
     for (std::size_t i = 0; i < candidates.size(); ++i) {
+      if (reasons[i].empty()) continue;  // on the Pareto front: kept whatever its score
       Arc& a = graph.arcs[candidates[i]];
-      if (reasons[i].empty()) {
-        const double score = ArcScore(graph, a, weights);
-        if (score > best + weights.tolerance) {
-          char buffer[64];
-          std::snprintf(buffer, sizeof buffer, "score %.3f > best %.3f", score, best);
-          reasons[i] = std::string(buffer) + " + tolerance (-> " +
-                       graph.nodes[std::size_t(graph.arcs[best_arc].to)].cf + ")";
-        }
-      }
-      if (!reasons[i].empty()) a.kept = false, a.reason = reasons[i];
+      const double score = ArcScore(graph, a, weights);
+      if (score <= best + weights.tolerance) continue;  // dominated, but nearly as good
+      char buffer[96];
+      std::snprintf(buffer, sizeof buffer, "; score %.3f > best %.3f + tolerance (-> ", score,
+                    best);
+      a.kept = false;
+      a.reason = reasons[i] + buffer + graph.nodes[std::size_t(graph.arcs[best_arc].to)].cf + ")";
     }
   }
 }

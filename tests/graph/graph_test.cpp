@@ -60,12 +60,13 @@ ContactGraph HandMade() {
   const int b = node("{Ee - floor.top}", 1.0, 1.0, 0.05);
   const int c = node("{Ee ~ floor.top}", 2.0, 2.0, 0.06);   // worse than B on every criterion
   const int d = node("{Fe - floor.top}", 0.5, 4.0, 0.05);   // less friction than B, more energy
-  const int e = node("{Fs - left.inner}", 0.0, 0.0, 0.20);  // further from the goal than A
+  const int e = node("{Fs - left.inner}", 0.0, 0.0, 0.20);  // as many steps as A, and further
   const int f = node("{Fs - left.top}", 0.0, 0.0, 0.01);    // no way on to the goal
   const int goal = node("{Fs - floor.top}", 1.0, 0.0, 0.0);
+  const int h = node("{Fe ~ left.top}", 0.0, 0.0, 0.01);  // its one way on is further
   g.start = a, g.goal = goal;
   g.nodes[std::size_t(a)].start = g.nodes[std::size_t(goal)].goal = true;
-  for (auto [from, to] : std::array<std::pair<int, int>, 10>{{{a, b},
+  for (auto [from, to] : std::array<std::pair<int, int>, 11>{{{a, b},
                                                               {a, c},
                                                               {a, d},
                                                               {a, e},
@@ -73,8 +74,9 @@ ContactGraph HandMade() {
                                                               {b, goal},
                                                               {c, goal},
                                                               {d, goal},
-                                                              {e, goal},
-                                                              {goal, a}}}) {
+                                                              {e, b},
+                                                              {goal, a},
+                                                              {h, b}}}) {
     Arc arc;
     arc.from = from, arc.to = to, arc.count = 1;
     g.arcs.push_back(arc);
@@ -85,7 +87,7 @@ ContactGraph HandMade() {
 TEST_CASE("Pruning a hand-made graph keeps the undominated arcs towards the goal", "[graph]") {
   ContactGraph g = HandMade();
   graph::PruneWeights w;  // 1, 1, 1
-  w.tolerance = 10.0;     // so only dominance and direction decide here
+  w.tolerance = 0.0;      // the Pareto front only
   graph::Prune(g, w);
   auto arc = [&](int from, int to) -> const Arc& {
     for (const Arc& a : g.arcs)
@@ -95,34 +97,43 @@ TEST_CASE("Pruning a hand-made graph keeps the undominated arcs towards the goal
   };
   CHECK(arc(0, 1).kept);        // A -> B
   CHECK_FALSE(arc(0, 2).kept);  // A -> C: dominated by A -> B
-  CHECK(arc(0, 2).reason.rfind("dominated by -> {Ee - floor.top}", 0) == 0);
-  CHECK(arc(0, 3).kept);        // A -> D: less friction, more energy
-  CHECK_FALSE(arc(0, 4).kept);  // A -> E: further from the goal
-  CHECK(arc(0, 4).reason.rfind("leads away from the goal", 0) == 0);
+  CHECK(arc(0, 2).reason ==
+        "dominated by -> {Ee - floor.top}: friction 1 <= 2 N, energy change 1 <= 2 J, distance "
+        "0.05 <= 0.06 m; score 1.800 > best 1.000 + tolerance (-> {Ee - floor.top})");
+  CHECK(arc(0, 3).kept);  // A -> D: less friction than B, more energy: not dominated
+  // A -> E: further from the goal by distance, while A has nearer ways.
+  CHECK_FALSE(arc(0, 4).kept);
+  CHECK(arc(0, 4).reason ==
+        "leads away from the goal (200.0 mm and 2 transitions from it, the source 100.0 mm and 2)");
+  // H -> B: further by distance, but H has no nearer way and B is a transition nearer.
+  CHECK(arc(7, 1).kept);
   CHECK_FALSE(arc(0, 5).kept);  // A -> F: dead end
   CHECK(arc(0, 5).reason == "no path from its target to the goal");
   CHECK_FALSE(arc(6, 0).kept);
   CHECK(arc(6, 0).reason == "leaves the goal");
-  for (int from : {1, 2, 3, 4}) CHECK(arc(from, 6).kept);  // the only way on from each
+  for (int from : {1, 2, 3}) CHECK(arc(from, 6).kept);  // the only way on from each
+  CHECK(arc(4, 1).kept);
 
   // Scores by hand: scales f* = 2 N, E* = 4 J, d* = 0.2 m (largest magnitudes over the nodes).
-  // A -> B: 1/2 + 1/4 + 0.05/0.2 = 1.0;  A -> D: 0.5/2 + 4/4 + 0.05/0.2 = 1.5.
+  // A -> B: 1/2 + 1/4 + 0.05/0.2 = 1.0;  A -> C: 1 + 1/2 + 0.3 = 1.8;  A -> D: 0.25 + 1 + 0.25.
   CHECK(graph::ArcScore(g, arc(0, 1), w) == Approx(1.0).epsilon(1e-12));
+  CHECK(graph::ArcScore(g, arc(0, 2), w) == Approx(1.8).epsilon(1e-12));
   CHECK(graph::ArcScore(g, arc(0, 3), w) == Approx(1.5).epsilon(1e-12));
-  // With a tolerance below their difference, D goes for its score; above it, both stay.
-  w.tolerance = 0.4;
+  // The dominated A -> C stays when its score is within the tolerance of the best, not beyond.
+  w.tolerance = 0.9;
+  graph::Prune(g, w);
+  CHECK(arc(0, 2).kept);
+  w.tolerance = 0.7;
+  graph::Prune(g, w);
+  CHECK_FALSE(arc(0, 2).kept);
+  // Weights move the best: friction 4, energy 0: D scores 4 (0.25) + 0.25 = 1.25, B 2.25, and
+  // the dominated C 4.3 is dropped against D.
+  w = {4.0, 0.0, 1.0, 0.0};
   graph::Prune(g, w);
   CHECK(arc(0, 1).kept);
-  CHECK_FALSE(arc(0, 3).kept);
-  CHECK(arc(0, 3).reason.rfind("score 1.500 > best 1.000", 0) == 0);
-  w.tolerance = 0.6;
-  graph::Prune(g, w);
   CHECK(arc(0, 3).kept);
-  // Weights move the choice: energy weighted 0, friction 4: D (0.5 N) beats B (1 N).
-  w = {4.0, 0.0, 1.0, 0.1};
-  graph::Prune(g, w);
-  CHECK(arc(0, 3).kept);
-  CHECK_FALSE(arc(0, 1).kept);
+  CHECK(arc(0, 2).reason.find("score 4.300 > best 1.250 + tolerance (-> {Fe - floor.top})") !=
+        std::string::npos);
 }
 
 // Runs a command, returns its exit status and its standard error.
@@ -186,10 +197,10 @@ TEST_CASE("DOT renders with Graphviz without warnings and reads back into Boost"
     dp.property("node_id", boost::get(boost::vertex_name, read));
     std::istringstream in(WithoutHtmlLabels(dot));
     REQUIRE(boost::read_graphviz(in, read, dp));
-    // Unpruned: all 7 nodes and 10 arcs. Pruned: the nodes on a kept way from A to G (A, B, D,
+    // Unpruned: all 8 nodes and 11 arcs. Pruned: the nodes on a kept way from A to G (A, B, D,
     // G) and the kept arcs among them (A->B, A->D, B->G, D->G).
-    CHECK(boost::num_vertices(read) == (unpruned ? 7u : 4u));
-    CHECK(boost::num_edges(read) == (unpruned ? 10u : 4u));
+    CHECK(boost::num_vertices(read) == (unpruned ? 8u : 4u));
+    CHECK(boost::num_edges(read) == (unpruned ? 11u : 4u));
   }
 }
 

@@ -73,19 +73,22 @@ struct PruneWeights {
   double friction = 1.0;
   double energy = 1.0;
   double distance = 1.0;
-  /// An arc that no other arc dominates is still dropped when its weighted score is more than
-  /// this above the best arc's of the same node.
-  double tolerance = 0.25;
+  /// A dominated arc is still kept when its weighted score is at most this above the best arc's
+  /// of the same node (0: keep the Pareto front only).
+  double tolerance = 0.05;
 };
 
 /// Marks every arc kept or dropped (with its reason). For each node u other than the goal, an
 /// arc u -> v is kept when
-///  1. it leads towards the goal: the goal can be reached from v in the unpruned graph, and v is
-///     the goal or nearer to it than u (distance_m), so kept arcs never form a cycle;
-///  2. no other such arc u -> w dominates it on (friction limit of w, bending energy change,
-///     distance of w to the goal), lower being better on each;
-///  3. its weighted score  w_f f/f* + w_e dE/E* + w_d d/d*  is within `tolerance` of the best.
-/// Arcs out of the goal are dropped ("leaves the goal"). Without a goal every arc is dropped.
+///  1. it leads towards the goal: the goal can be reached from v in the unpruned graph and v is
+///     nearer to it than u (distance_m), or, for a node none of whose arcs gets nearer, v is
+///     fewer transitions from the goal than u (so no node with a way to the goal is a dead end;
+///     plans are loopless paths, see paths.hpp);
+///  2. and either no other such arc u -> w dominates it on (friction limit of w, bending energy
+///     change, distance of w to the goal), lower being better on each, or its weighted score
+///     w_f f/f* + w_e dE/E* + w_d d/d*  is within `tolerance` of the best such arc's.
+/// Arcs out of the goal ("leaves the goal") and back into the start ("returns to the start") are
+/// dropped. Without a goal every arc is dropped.
 void Prune(ContactGraph& graph, const PruneWeights& weights);
 
 /// The weighted score of an arc (criterion 3 above) under `weights`.

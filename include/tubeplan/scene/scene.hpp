@@ -79,7 +79,7 @@ struct Heuristics {
   double friction = 1.0;    ///< [-], >= 0
   double energy = 1.0;      ///< [-], >= 0
   double distance = 1.0;    ///< [-], >= 0
-  double tolerance = 0.25;  ///< [-], >= 0: how far above the best score an arc is still kept
+  double tolerance = 0.05;  ///< [-], >= 0: how far above the best score an arc is still kept
 };
 
 struct Scene {
