@@ -309,8 +309,16 @@ TEST_CASE("Independent random motions mostly stay inside the explored graph", "[
   }
   const auto covered_nodes = std::count_if(seen_nodes.begin(), seen_nodes.end(),
                                            [&](const auto& n) { return nodes.contains(n); });
-  const auto covered_arcs = std::count_if(seen_arcs.begin(), seen_arcs.end(),
-                                          [&](const auto& a) { return arcs.contains(a); });
+  // A two-PC change the graph records through a brief state in between (A -> C -> B, docs/
+  // graph.md) is covered by those two arcs.
+  const auto covered_arcs = std::count_if(seen_arcs.begin(), seen_arcs.end(), [&](const auto& a) {
+    if (arcs.contains(a)) return true;
+    return std::any_of(nodes.begin(), nodes.end(), [&](const std::string& c) {
+      return arcs.contains({a.first, c}) && arcs.contains({c, a.second});
+    });
+  });
+  for (const std::string& n : seen_nodes)
+    if (!nodes.contains(n)) UNSCOPED_INFO("CF not in the graph: " << n);
   const double node_coverage = double(covered_nodes) / double(seen_nodes.size());
   const double arc_coverage = double(covered_arcs) / double(seen_arcs.size());
   WARN("coverage of 30 independent random motions: CFs "
@@ -320,7 +328,7 @@ TEST_CASE("Independent random motions mostly stay inside the explored graph", "[
   // of rare CFs. The bounds are what the default budget achieved when measured, less a margin,
   // so that a change that makes exploration miss common states fails here.
   CHECK(node_coverage >= 0.85);
-  CHECK(arc_coverage >= 0.60);
+  CHECK(arc_coverage >= 0.75);
 }
 
 }  // namespace
