@@ -25,21 +25,8 @@ constexpr int kMaxTicksPerMotion = 30000;
 // saturation stops does not depend on --jobs.
 constexpr int kBatch = 8;
 
-// The CF of a tick in the core's compact form: PC count, then (part element, tube, marker) per
-// PC in the core's order. Comparing these per tick costs nothing; text is made on change only.
-using CfKey = std::array<std::uint32_t, core::kMaxContacts + 1>;
-
-CfKey KeyOf(const core::StepOutput& out) {
-  CfKey key{};
-  key[0] = static_cast<std::uint32_t>(out.contact_count);
-  for (int i = 0; i < out.contact_count; ++i) {
-    const core::ContactState& c = out.contacts[std::size_t(i)];
-    key[std::size_t(i) + 1] = (static_cast<std::uint32_t>(c.part_element) << 8) |
-                              (static_cast<std::uint32_t>(c.tube) << 4) |
-                              static_cast<std::uint32_t>(c.marker);
-  }
-  return key;
-}
+using core::KeyOf;
+using CfKey = core::FormationKey;
 
 struct Sample {  // what a node keeps of its witness tick
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();

@@ -99,6 +99,22 @@ struct StepOutput {
   }
 };
 
+/// The contact formation of a tick in a compact form: the PC count, then (part element, tube
+/// element, marker) of each PC in the output's order. Equal keys are equal CFs; comparing keys
+/// each tick costs nothing, so drivers make the CF's text only when the key changes.
+using FormationKey = std::array<std::uint32_t, kMaxContacts + 1>;
+inline FormationKey KeyOf(const StepOutput& out) {
+  FormationKey key{};
+  key[0] = static_cast<std::uint32_t>(out.contact_count);
+  for (int i = 0; i < out.contact_count; ++i) {
+    const ContactState& c = out.contacts[std::size_t(i)];
+    key[std::size_t(i) + 1] = (static_cast<std::uint32_t>(c.part_element) << 8) |
+                              (static_cast<std::uint32_t>(c.tube) << 4) |
+                              static_cast<std::uint32_t>(c.marker);
+  }
+  return key;
+}
+
 /// Capsule count of the chain: the chord of a segment of length l/N on an arc of curvature
 /// kappa lies inside the arc by kappa (l/N)^2 / 8; the largest curvature the core can produce is
 /// at the root under the device's largest force, kappa = F_max l / (E I). N is the smallest count

@@ -1,13 +1,36 @@
 #pragma once
-// Writing plan files (docs/plan-format.md). Reading and validating them is the batch
-// evaluation's (tubeplan evaluate).
+// Plan files (docs/plan-format.md): reading them with their scene and trajectory, every problem
+// at once as file:line:col, and writing them.
 
+#include <filesystem>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
+#include <tubeplan/io/diagnostics.hpp>
 #include <tubeplan/plan/plan.hpp>
 #include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/scene/scene.hpp>
+#include <tubeplan/states/contact_formation.hpp>
 
 namespace tubeplan::io {
+
+struct PlanLoadResult {
+  /// All set only when there is no error anywhere (plan, its scene, its trajectory).
+  std::optional<plan::Plan> plan;
+  std::optional<scene::Scene> scene;
+  std::optional<plan::Trajectory> trajectory;
+  std::vector<states::ContactFormation> states;  ///< the planned CFs, parsed
+  Diagnostics diagnostics;
+};
+
+/// Reads a plan, then its scene and trajectory (paths relative to the plan's directory), and
+/// checks each planned CF against the scene: unknown elements are errors naming them; the word
+/// `goal` stands for the scene's goal.
+PlanLoadResult LoadPlanFile(const std::filesystem::path& path);
+PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
+                            const std::filesystem::path& directory);
 
 /// The plan as YAML text, format version 1, units written out.
 std::string FormatPlanYaml(const plan::Plan& plan);

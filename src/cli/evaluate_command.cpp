@@ -1,0 +1,220 @@
+// `tubeplan evaluate PLAN|DIR... [--jobs N] [--json] [--report FILE]`: replays every plan's
+// trajectory through the core and gives each planned transition a verdict (docs/evaluate.md).
+// All plan files are read and checked first; any problem in any of them is reported and nothing
+// is evaluated (exit 2).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <iomanip>
+#include <memory>
+#include <sstream>
+#include <thread>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/io/text_file.hpp>
+#include <tubeplan/plan/judge.hpp>
+
+#include "commands.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+inline constexpr int kEvaluateJsonVersion = 1;
+
+struct EvaluateOptions {
+  std::vector<std::string> inputs;
+  int jobs = 0;
+  bool json = false;
+  std::string report_path;
+};
+
+// The plan files named: files as given, directories' *.yaml files in name order.
+std::vector<std::string> PlanFiles(const std::vector<std::string>& inputs, std::ostream& err,
+                                   bool& ok) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> files;
+  for (const std::string& input : inputs) {
+    std::error_code ec;
+    if (fs::is_directory(input, ec)) {
+      std::vector<std::string> in_dir;
+      for (const fs::directory_entry& e : fs::directory_iterator(input, ec))
+        if (e.is_regular_file() && e.path().extension() == ".yaml")
+          in_dir.push_back(e.path().string());
+      std::sort(in_dir.begin(), in_dir.end());
+      if (in_dir.empty()) {
+        err << input << ": error: no plan files (*.yaml) in this directory, expected plans\n";
+        ok = false;
+      }
+      files.insert(files.end(), in_dir.begin(), in_dir.end());
+    } else {
+      files.push_back(input);
+    }
+  }
+  return files;
+}
+
+struct Evaluated {
+  std::string file;
+  plan::Plan plan;
+  plan::Judgement judgement;
+};
+
+nlohmann::json ToJson(const std::vector<Evaluated>& results) {
+  nlohmann::json plans = nlohmann::json::array();
+  long feasible = 0;
+  for (const Evaluated& e : results) {
+    const plan::Judgement& j = e.judgement;
+    feasible += j.feasible;
+    nlohmann::json transitions = nlohmann::json::array();
+    for (const plan::TransitionVerdict& v : j.transitions) {
+      transitions.push_back({{"from", v.from},
+                             {"to", v.to},
+                             {"verdict", plan::ToString(v.verdict)},
+                             {"reason", v.reason},
+                             {"detour", v.detour},
+                             {"t_start_s", v.t_start_s},
+                             {"t_end_s", v.t_end_s},
+                             {"peak_force_N", v.peak_force_N},
+                             {"friction_work_J", v.friction_work_J},
+                             {"energy_entry_J", v.energy_entry_J},
+                             {"energy_exit_J", v.energy_exit_J}});
+    }
+    nlohmann::json observed = nlohmann::json::array();
+    for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
+    plans.push_back({{"plan", e.plan.name},
+                     {"file", e.file},
+                     {"feasible", j.feasible},
+                     {"transitions", transitions},
+                     {"observed", observed},
+                     {"ticks", j.ticks},
+                     {"replayed_s", j.replayed_s}});
+  }
+  return {{"tubeplan_evaluate", kEvaluateJsonVersion},
+          {"plans", plans},
+          {"summary",
+           {{"plans", results.size()},
+            {"feasible", feasible},
+            {"infeasible", static_cast<long>(results.size()) - feasible}}}};
+}
+
+int RunEvaluate(const EvaluateOptions& o, Streams io) {
+  bool ok = true;
+  const std::vector<std::string> files = PlanFiles(o.inputs, io.err, ok);
+  std::vector<io::PlanLoadResult> loaded;
+  for (const std::string& f : files) {
+    loaded.push_back(io::LoadPlanFile(f));
+    io.err << loaded.back().diagnostics.FormatAll();
+    ok = ok && loaded.back().plan.has_value();
+  }
+  if (!ok) return kExitBadInput;
+
+  std::vector<Evaluated> results(files.size());
+  const int jobs = std::clamp(o.jobs > 0 ? o.jobs : int(std::thread::hardware_concurrency()), 1,
+                              std::max<int>(1, int(files.size())));
+  std::atomic<std::size_t> next{0};
+  const bool progress = isatty(STDERR_FILENO) != 0 && !o.json;
+  std::atomic<std::size_t> done{0};
+  auto work = [&] {
+    for (std::size_t i = next++; i < files.size(); i = next++) {
+      const io::PlanLoadResult& l = loaded[i];
+      results[i] = {files[i], *l.plan,
+                    plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits)};
+      if (progress) {
+        const std::size_t d = ++done;
+        // One short line per plan, on a terminal only (a log stays clean).
+        io.err << "\r[" + std::to_string(d) + "/" + std::to_string(files.size()) + "]"
+               << std::flush;
+      }
+    }
+  };
+  const auto clock_start = std::chrono::steady_clock::now();
+  std::vector<std::thread> threads;
+  for (int w = 1; w < jobs; ++w) threads.emplace_back(work);
+  work();
+  for (std::thread& t : threads) t.join();
+  if (progress) io.err << "\r";
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+
+  const nlohmann::json report = ToJson(results);
+  if (!o.report_path.empty()) {
+    if (const std::string e = io::WriteTextFileAtomically(o.report_path, report.dump(1) + "\n");
+        !e.empty()) {
+      io.err << o.report_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
+  const bool all_feasible = std::all_of(results.begin(), results.end(),
+                                        [](const Evaluated& e) { return e.judgement.feasible; });
+  if (o.json) {
+    io.out << report.dump(2) << "\n";
+    return all_feasible ? kExitOk : kExitNegative;
+  }
+  const bool colour = isatty(STDOUT_FILENO) != 0;
+  auto paint = [&](plan::Verdict v, const std::string& text) {
+    if (!colour) return text;
+    const char* code = v == plan::Verdict::kFeasible             ? "\033[32m"
+                       : v == plan::Verdict::kFeasibleWithDetour ? "\033[33m"
+                                                                 : "\033[31m";
+    return std::string(code) + text + "\033[0m";
+  };
+  std::ostringstream t;
+  t << std::setprecision(3);
+  double replayed_s = 0.0, run_s = 0.0;
+  long feasible = 0;
+  for (const Evaluated& e : results) {
+    const plan::Judgement& j = e.judgement;
+    replayed_s += j.replayed_s;
+    run_s += j.run_s;
+    feasible += j.feasible;
+    t << e.file << " (" << e.plan.name << "): "
+      << paint(j.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible,
+               j.feasible ? "FEASIBLE" : "INFEASIBLE")
+      << ", " << j.transitions.size()
+      << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
+      << " s replayed\n";
+    for (const plan::TransitionVerdict& v : j.transitions) {
+      t << "  " << v.from << " -> " << v.to << ": " << paint(v.verdict, plan::ToString(v.verdict));
+      if (!v.detour.empty()) {
+        t << " via";
+        for (const std::string& d : v.detour) t << " " << d;
+      }
+      if (!v.reason.empty()) t << " (" << v.reason << ")";
+      t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
+        << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
+        << " -> " << v.energy_exit_J << " J\n";
+    }
+  }
+  t << "summary: " << results.size() << " plan" << (results.size() == 1 ? "" : "s") << ", "
+    << feasible << " feasible, " << long(results.size()) - feasible << " infeasible; " << replayed_s
+    << " s of trajectories replayed in " << wall_s << " s on " << jobs << " thread"
+    << (jobs == 1 ? "" : "s") << " (" << (run_s > 0 ? replayed_s / run_s : 0.0)
+    << "x real time per core)\n";
+  if (!o.report_path.empty()) t << "report written to " << o.report_path << "\n";
+  io.out << t.str();
+  return all_feasible ? kExitOk : kExitNegative;
+}
+
+}  // namespace
+
+Command AddEvaluateCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<EvaluateOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "evaluate",
+      "Replay plans through the core and judge every planned transition: feasible, feasible "
+      "with a detour, or infeasible with the reason. Exit 0 if all plans are feasible, 1 if not.");
+  sub->add_option("plans", options->inputs, "plan files (.yaml) or directories of them")
+      ->required();
+  sub->add_option("--jobs", options->jobs, "threads (default: the machine's cores)")
+      ->check(CLI::Range(1, 256));
+  sub->add_flag("--json", options->json, "print the report as one JSON document");
+  sub->add_option("--report", options->report_path, "also write the JSON report to FILE");
+  return {sub, [options, streams] { return RunEvaluate(*options, streams); }};
+}
+
+}  // namespace tubeplan::cli

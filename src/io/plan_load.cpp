@@ -1,0 +1,148 @@
+// Plan files in: YAML, validated like scenes (every problem at once, file:line:col), with the
+// scene and trajectory they name loaded and the planned CFs checked against the scene.
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+
+#include "yaml_reader.hpp"
+
+namespace tubeplan::io {
+namespace {
+
+namespace dim_ = dim;
+
+void ReadLimits(Reader& r, const YAML::Node& node, plan::Limits& l) {
+  const std::string w = "limits";
+  if (!r.ExpectMap(node, w, {"max_force", "max_strain", "max_penetration", "dwell", "stall"}))
+    return;
+  auto check = [&](const char* key, Dimension dimension, double& target, double lo, double hi,
+                   const char* expected) {
+    if (r.Field(node, key, w, dimension, false, target) && !(target >= lo && target <= hi))
+      r.Error(r.Get(node, key, w, false), w + "." + key + " is out of range, expected " + expected);
+  };
+  check("max_force", dim_::kForce, l.max_force_N, 1e-6, 1e4, "a force above 0, e.g. \"8.5 N\"");
+  check("max_strain", dim_::kNone, l.max_strain, 1e-9, 1.0, "a strain in (0, 1], e.g. 0.2");
+  check("max_penetration", dim_::kLength, l.max_penetration_m, 0.0, 0.1,
+        "a length from 0 to 100 mm, e.g. \"0.2 mm\"");
+  check("dwell", dim_::kTime, l.dwell_s, 0.0, 10.0, "a time from 0 to 10 s, e.g. \"20 ms\"");
+  check("stall", dim_::kTime, l.stall_s, 1e-3, 3600.0, "a time above 0, e.g. \"1 s\"");
+}
+
+}  // namespace
+
+PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
+                            const std::filesystem::path& directory) {
+  PlanLoadResult result;
+  Reader r(display_name, result.diagnostics);
+  plan::Plan p;
+  YAML::Node root;
+  try {
+    root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::Exception& e) {
+    r.Error(e.mark, e.msg + ", expected valid YAML");
+    return result;
+  }
+  if (!root.IsMap()) {
+    r.Error(root, std::string("a plan file must be a map, found ") + KindName(root) +
+                      ", expected keys such as tubeplan, plan, scene, trajectory, states");
+    return result;
+  }
+  r.ExpectMap(root, "plan file", {"tubeplan", "plan", "scene", "trajectory", "states", "limits"});
+  if (const YAML::Node n = r.Get(root, "tubeplan", "plan file", true); n.IsDefined()) {
+    if (!n.IsScalar() || n.Scalar() != "1")
+      r.Error(n, "unsupported format version " + (n.IsScalar() ? n.Scalar() : KindName(n)) +
+                     ", expected 1");
+  }
+  if (const YAML::Node n = r.Get(root, "plan", "plan file", true); n.IsDefined())
+    if (auto name = r.String(n, "plan")) p.name = *name;
+  if (const YAML::Node n = r.Get(root, "limits", "plan file", false); n.IsDefined())
+    ReadLimits(r, n, p.limits);
+
+  // The scene first: the states are checked against its elements.
+  std::optional<scene::Scene> scene;
+  if (const YAML::Node n = r.Get(root, "scene", "plan file", true); n.IsDefined()) {
+    if (auto path = r.String(n, "scene")) {
+      p.scene = *path;
+      const std::filesystem::path full = directory / *path;
+      if (!ReadTextFile(full)) {
+        r.Error(n, "scene: cannot read '" + full.string() +
+                       "', expected a scene file path relative to the plan file");
+      } else {
+        SceneLoadResult loaded = LoadSceneFile(full);
+        result.diagnostics.Append(loaded.diagnostics);
+        if (!loaded.scene) r.Error(n, "scene: '" + full.string() + "' has errors (listed)");
+        scene = std::move(loaded.scene);
+      }
+    }
+  }
+  if (const YAML::Node n = r.Get(root, "trajectory", "plan file", true); n.IsDefined()) {
+    if (auto path = r.String(n, "trajectory")) {
+      p.trajectory = *path;
+      const std::filesystem::path full = directory / *path;
+      if (!ReadTextFile(full)) {
+        r.Error(n, "trajectory: cannot read '" + full.string() +
+                       "', expected a trajectory CSV path relative to the plan file");
+      } else {
+        TrajectoryLoadResult loaded = LoadTrajectoryFile(full);
+        result.diagnostics.Append(loaded.diagnostics);
+        if (!loaded.trajectory)
+          r.Error(n, "trajectory: '" + full.string() + "' has errors (listed)");
+        result.trajectory = std::move(loaded.trajectory);
+      }
+    }
+  }
+  if (const YAML::Node n = r.Get(root, "states", "plan file", true); n.IsDefined()) {
+    if (!n.IsSequence() || n.size() < 2) {
+      r.Error(
+          n,
+          "states must be a sequence of at least two contact formations (start first, "
+          "goal last), found " +
+              (n.IsSequence() ? std::to_string(n.size()) + " items" : std::string(KindName(n))));
+    } else {
+      const std::vector<scene::PartElement> elements =
+          scene ? scene::EnumerateElements(*scene) : std::vector<scene::PartElement>{};
+      for (std::size_t i = 0; i < n.size(); ++i) {
+        const std::string what = "states[" + std::to_string(i) + "]";
+        if (n[i].IsScalar() && n[i].Scalar() == "goal" && n[i].Tag() != "!") {
+          if (scene) {
+            result.states.push_back(scene->goal);
+            p.states.push_back(states::ToString(scene->goal));
+          }
+          continue;
+        }
+        if (auto cf = r.Formation(n[i], what, scene ? &elements : nullptr)) {
+          p.states.push_back(states::ToString(*cf));
+          result.states.push_back(std::move(*cf));
+        }
+      }
+      for (std::size_t i = 1; i < p.states.size(); ++i) {
+        if (p.states[i] == p.states[i - 1] && i < n.size())
+          r.Error(n[i], "states[" + std::to_string(i) +
+                            "] repeats the state before it, expected "
+                            "each planned state to differ from the one before");
+      }
+    }
+  }
+  if (!result.diagnostics.HasErrors()) {
+    result.plan = std::move(p);
+    result.scene = std::move(scene);
+  } else {
+    result.trajectory.reset();
+    result.states.clear();
+  }
+  return result;
+}
+
+PlanLoadResult LoadPlanFile(const std::filesystem::path& path) {
+  const std::optional<std::string> text = ReadTextFile(path);
+  if (!text) {
+    PlanLoadResult result;
+    result.diagnostics.Error(path.string(), 0, 0,
+                             "cannot read file, expected a readable YAML plan file");
+    return result;
+  }
+  return LoadPlanText(*text, path.string(), path.parent_path());
+}
+
+}  // namespace tubeplan::io

@@ -1,0 +1,167 @@
+// The batch evaluation: the shipped plans get their expected verdicts, a force limit is reported
+// at the tick an independent replay finds, the report does not depend on --jobs, and bad plan
+// files get exact messages.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+
+namespace {
+
+using namespace tubeplan;
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+Outcome RunTool(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  const int code = cli::Run(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+nlohmann::json EvaluateShipped(const std::string& jobs) {
+  const Outcome r = RunTool({"evaluate", SourcePath("plans"), "--json", "--jobs", jobs});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 1);  // two shipped plans are infeasible by design
+  return nlohmann::json::parse(r.out);
+}
+
+const nlohmann::json& PlanNamed(const nlohmann::json& report, const std::string& name) {
+  for (const nlohmann::json& p : report["plans"])
+    if (p["plan"] == name) return p;
+  FAIL("no plan " << name);
+  return report;
+}
+
+TEST_CASE("The shipped plans get their expected verdicts", "[plan]") {
+  const nlohmann::json report = EvaluateShipped("2");
+  CHECK(report["tubeplan_evaluate"] == 1);
+  CHECK(report["summary"]["plans"] == 5);
+  CHECK(report["summary"]["feasible"] == 3);
+
+  const nlohmann::json& insert = PlanNamed(report, "groove-insert");
+  CHECK(insert["feasible"] == true);
+  for (const nlohmann::json& t : insert["transitions"]) CHECK(t["verdict"] == "feasible");
+
+  const nlohmann::json& coarse = PlanNamed(report, "groove-insert-coarse");
+  CHECK(coarse["feasible"] == true);
+  CHECK(coarse["transitions"][1]["verdict"] == "feasible-with-detour");
+  CHECK(coarse["transitions"][1]["detour"] ==
+        nlohmann::json::array({"{Ee ~ floor.top}", "{Fs n floor.top}"}));
+
+  CHECK(PlanNamed(report, "groove-lay-flat")["feasible"] == true);
+
+  const nlohmann::json& wrong = PlanNamed(report, "groove-wrong-side");
+  CHECK(wrong["feasible"] == false);
+  CHECK(wrong["transitions"][0]["verdict"] == "infeasible");
+  CHECK(wrong["transitions"][0]["reason"] ==
+        "another state reached instead: {Fs - floor.top}, planned later, before "
+        "{Fs - right.top}");
+  CHECK(wrong["transitions"][1]["reason"] ==
+        "not reached: the plan failed at an earlier transition");
+}
+
+TEST_CASE("A force limit is reported at the tick the force first exceeds it", "[plan]") {
+  const nlohmann::json report = EvaluateShipped("1");
+  const nlohmann::json& gentle = PlanNamed(report, "groove-gentle");
+  CHECK(gentle["feasible"] == false);
+  const nlohmann::json& last = gentle["transitions"][3];
+  CHECK(last["verdict"] == "infeasible");
+  const std::string reason = last["reason"];
+  // An independent replay of the same trajectory through the core: the first tick after the
+  // tube entered {Fs n floor.top} at which the operator force exceeds 0.2 N.
+  const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-gentle.yaml"));
+  REQUIRE(loaded.plan);
+  const std::vector<plan::HandSample> ticks =
+      plan::Resample(*loaded.trajectory, loaded.scene->model.time_step_s);
+  core::Core core(*loaded.scene);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = ticks.front().q_WH.toRotationMatrix();
+  X.translation() = ticks.front().p_WH_m;
+  core.Reset(X);
+  double first_t = -1.0, force = 0.0;
+  for (const plan::HandSample& s : ticks) {
+    X.linear() = s.q_WH.toRotationMatrix();
+    X.translation() = s.p_WH_m;
+    const core::StepOutput& out = core.Step(s.t_s, X);
+    if (s.t_s >= last["t_start_s"].get<double>() && out.force_W_N.norm() > 0.2) {
+      first_t = s.t_s, force = out.force_W_N.norm();
+      break;
+    }
+  }
+  REQUIRE(first_t > 0.0);
+  char expected[160];
+  std::snprintf(expected, sizeof expected,
+                "limit exceeded: operator force %.4g N > 0.2 N at t = %.3f s", force, first_t);
+  CHECK(reason == expected);
+  // Earlier transitions stay below the limit (their peaks are reported and below 0.2 N).
+  for (int i = 0; i < 3; ++i) CHECK(gentle["transitions"][i]["peak_force_N"] < 0.2);
+}
+
+TEST_CASE("The report is the same for any --jobs and is written whole", "[plan]") {
+  nlohmann::json one = EvaluateShipped("1");
+  nlohmann::json two = EvaluateShipped("2");
+  CHECK(one == two);
+  const std::string report = "judge_test_report.json";
+  std::filesystem::remove(report);
+  const Outcome r = RunTool({"evaluate", SourcePath("plans"), "--jobs", "2", "--report", report});
+  CHECK(r.exit_code == 1);
+  std::ifstream in(report);
+  REQUIRE(in);
+  CHECK(nlohmann::json::parse(in) == two);
+  for (const auto& e : std::filesystem::directory_iterator("."))
+    CHECK(e.path().filename().string().find(report + ".tmp") == std::string::npos);
+  std::filesystem::remove(report);
+}
+
+TEST_CASE("Bad plan files get every problem at once, and nothing is evaluated", "[plan]") {
+  const std::filesystem::path dir = "judge_test_plans";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream f(dir / "bad.yaml");
+    f << "tubeplan: 1\n"
+         "plan: bad\n"
+         "scene: "
+      << SourcePath("scenes/groove.yaml")
+      << "\n"
+         "trajectory: "
+      << SourcePath("plans/groove-insert.csv")
+      << "\n"
+         "states: [\"{}\", \"{Fs - flor.top}\", \"{Fe u floor.top}\"]\n"
+         "limits: {max_force: 5 mm, dwel: 20 ms}\n";
+  }
+  const Outcome r = RunTool({"evaluate", (dir / "bad.yaml").string()});
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.empty());
+  // Columns: the element's name inside the quoted CF (5:23), the marker that Fe cannot carry
+  // (5:40), the unit of the quantity (6:23), the unknown key (6:27).
+  const std::string file = (dir / "bad.yaml").string();
+  CHECK(r.err ==
+        file +
+            ":5:23: error: states[1]: no element 'flor.top' in this scene, did you mean "
+            "'floor.top'? (expected part.face, part.face_face or part.face_face_face)\n" +
+            file + ":5:40: error: states[2]: " +
+            states::ParseContactFormation("{Fe u floor.top}").error->message + "\n" + file +
+            ":6:23: error: limits.max_force: has a unit of length (mm), expected a force such "
+            "as \"2 N\"\n" +
+            file +
+            ":6:27: error: unknown key 'dwel' in 'limits', did you mean 'dwell'? "
+            "(expected one of: max_force, max_strain, max_penetration, dwell, stall)\n");
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
