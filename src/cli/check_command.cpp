@@ -9,7 +9,9 @@
 
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
+#include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/scene/elements.hpp>
 
@@ -77,6 +79,20 @@ Checked CheckFile(const std::string& file) {
     if (loaded.trajectory) c.summary = Summary(*loaded.trajectory);
     return c;
   }
+  // A plan file names its plan at the top level ("plan: ..."); any other YAML is a scene.
+  if (const std::optional<std::string> text = io::ReadTextFile(file);
+      text && (text->rfind("plan:", 0) == 0 || text->find("\nplan:") != std::string::npos)) {
+    io::PlanLoadResult plan = io::LoadPlanFile(file);
+    Checked c{"plan", std::move(plan.diagnostics), std::nullopt};
+    if (plan.plan) {
+      std::ostringstream out;
+      out << "plan \"" << plan.plan->name << "\": " << plan.plan->states.size() << " states, "
+          << plan.plan->states.front() << " to " << plan.plan->states.back() << "; scene \""
+          << plan.scene->name << "\"; " << Summary(*plan.trajectory);
+      c.summary = out.str();
+    }
+    return c;
+  }
   io::SceneLoadResult loaded = io::LoadSceneFile(file);
   Checked c{"scene", std::move(loaded.diagnostics), std::nullopt};
   if (loaded.scene) c.summary = Summary(*loaded.scene);
@@ -117,7 +133,7 @@ Command AddCheckCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<CheckOptions>();
   CLI::App* sub = app.add_subcommand(
       "check",
-      "Validate scene files (.yaml) and trajectories (.csv): every problem is reported as "
+      "Validate scene and plan files (.yaml) and trajectories (.csv): every problem is reported as "
       "file:line:col (exit 2), and each valid file gets a one-line summary.");
   sub->add_option("files", options->files, "scene files (.yaml) and trajectory files (.csv)")
       ->required();

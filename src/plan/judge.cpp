@@ -2,7 +2,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/judge.hpp>
@@ -62,8 +61,10 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
   core::FormationKey raw_key{};
   int raw_held = 0;
   double raw_since = 0.0, raw_energy = 0.0;
-  std::vector<std::string> passed;                            // unplanned states since states[at]
-  std::map<std::pair<int, int>, Eigen::Vector3d> last_point;  // (tube, element) -> contact point
+  std::vector<std::string> passed;  // unplanned states since states[at]
+  // Last tick's contacts, to measure each sliding PC's slip (fixed size: nothing allocated per
+  // tick).
+  core::StepOutput last{};
   long stuck_ticks = 0;  // held end separated from the hand, in a row
 
   auto fail = [&](std::size_t i, const std::string& reason) {
@@ -88,15 +89,14 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
         if (-c.distance_m > limits.max_penetration_m && v.reason.empty())
           fail(at, Format("penetration", -c.distance_m * 1e3, "mm", limits.max_penetration_m * 1e3,
                           sample.t_s));
-        const std::pair<int, int> key{static_cast<int>(c.tube), c.part_element};
-        const auto it = last_point.find(key);
-        if (c.sliding && it != last_point.end())
-          v.friction_work_J += c.friction_W_N.norm() * (c.p_WC_m - it->second).norm();
+        if (!c.sliding) continue;
+        for (const core::ContactState& before : last.Contacts()) {
+          if (before.tube == c.tube && before.part_element == c.part_element)
+            v.friction_work_J += c.friction_W_N.norm() * (c.p_WC_m - before.p_WC_m).norm();
+        }
       }
     }
-    last_point.clear();
-    for (const core::ContactState& c : out.Contacts())
-      last_point[{static_cast<int>(c.tube), c.part_element}] = c.p_WC_m;
+    last = out;
     stuck_ticks = (out.flags & core::kProxySeparated) ? stuck_ticks + 1 : 0;
 
     // Debounce: a state counts once held `dwell` ticks.
