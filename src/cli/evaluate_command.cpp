@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -31,7 +32,24 @@ struct EvaluateOptions {
   int jobs = 0;
   bool json = false;
   std::string report_path;
+  std::string shard;  // "I/N", empty: all
 };
+
+// A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
+// merge of shard reports is the report of the unsharded run.
+nlohmann::json Report(nlohmann::json plans) {
+  std::stable_sort(plans.begin(), plans.end(),
+                   [](const nlohmann::json& a, const nlohmann::json& b) {
+                     return a["file"].get<std::string>() < b["file"].get<std::string>();
+                   });
+  long feasible = 0;
+  for (const nlohmann::json& p : plans) feasible += p["feasible"].get<bool>();
+  const long count = static_cast<long>(plans.size());
+  return {
+      {"tubeplan_evaluate", kEvaluateJsonVersion},
+      {"plans", plans},
+      {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
+}
 
 // The plan files named: files as given, directories' *.yaml files in name order.
 std::vector<std::string> PlanFiles(const std::vector<std::string>& inputs, std::ostream& err,
@@ -66,10 +84,8 @@ struct Evaluated {
 
 nlohmann::json ToJson(const std::vector<Evaluated>& results) {
   nlohmann::json plans = nlohmann::json::array();
-  long feasible = 0;
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
-    feasible += j.feasible;
     nlohmann::json transitions = nlohmann::json::array();
     for (const plan::TransitionVerdict& v : j.transitions) {
       transitions.push_back({{"from", v.from},
@@ -94,17 +110,32 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
   }
-  return {{"tubeplan_evaluate", kEvaluateJsonVersion},
-          {"plans", plans},
-          {"summary",
-           {{"plans", results.size()},
-            {"feasible", feasible},
-            {"infeasible", static_cast<long>(results.size()) - feasible}}}};
+  return Report(std::move(plans));
 }
 
 int RunEvaluate(const EvaluateOptions& o, Streams io) {
   bool ok = true;
-  const std::vector<std::string> files = PlanFiles(o.inputs, io.err, ok);
+  std::vector<std::string> files = PlanFiles(o.inputs, io.err, ok);
+  // Plans are judged and reported in file order, whatever the order given.
+  std::sort(files.begin(), files.end());
+  files.erase(std::unique(files.begin(), files.end()), files.end());
+  if (!o.shard.empty()) {
+    // "I/N": the plans whose place in file order is I-1 modulo N, the same split on every
+    // machine given the same files.
+    int index = 0, count = 0;
+    char slash = 0, extra = 0;
+    std::istringstream in(o.shard);
+    if (!(in >> index >> slash >> count) || slash != '/' || in >> extra || count < 1 || index < 1 ||
+        index > count) {
+      io.err << "tubeplan evaluate: error: --shard \"" << o.shard
+             << "\" is not a shard, expected I/N with 1 <= I <= N, e.g. 2/8\n";
+      return kExitBadInput;
+    }
+    std::vector<std::string> mine;
+    for (std::size_t i = 0; i < files.size(); ++i)
+      if (static_cast<int>(i % std::size_t(count)) == index - 1) mine.push_back(files[i]);
+    files = std::move(mine);
+  }
   std::vector<io::PlanLoadResult> loaded;
   for (const std::string& f : files) {
     loaded.push_back(io::LoadPlanFile(f));
@@ -214,7 +245,90 @@ Command AddEvaluateCommand(CLI::App& app, Streams streams) {
       ->check(CLI::Range(1, 256));
   sub->add_flag("--json", options->json, "print the report as one JSON document");
   sub->add_option("--report", options->report_path, "also write the JSON report to FILE");
+  sub->add_option("--shard", options->shard,
+                  "evaluate only shard I of N (I/N) of the plans in file order; join the shards' "
+                  "reports with `tubeplan merge`");
   return {sub, [options, streams] { return RunEvaluate(*options, streams); }};
+}
+
+namespace {
+
+struct MergeOptions {
+  std::vector<std::string> reports;
+  bool json = false;
+  std::string report_path;
+};
+
+int RunMerge(const MergeOptions& o, Streams io) {
+  nlohmann::json plans = nlohmann::json::array();
+  std::set<std::string> files;
+  bool ok = true;
+  for (const std::string& path : o.reports) {
+    const std::optional<std::string> text = io::ReadTextFile(path);
+    nlohmann::json report;
+    if (text) report = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
+    if (!text || report.is_discarded() || !report.is_object() ||
+        report.value("tubeplan_evaluate", 0) != kEvaluateJsonVersion || !report.contains("plans") ||
+        !report["plans"].is_array()) {
+      io.err << path
+             << ": error: not a tubeplan evaluate report, expected the JSON that "
+                "`tubeplan evaluate --report` writes (version "
+             << kEvaluateJsonVersion << ")\n";
+      ok = false;
+      continue;
+    }
+    for (const nlohmann::json& p : report["plans"]) {
+      if (!p.is_object() || !p.contains("file") || !p["file"].is_string() ||
+          !p.contains("feasible") || !p["feasible"].is_boolean()) {
+        io.err << path
+               << ": error: a plan without \"file\" or \"feasible\", expected the "
+                  "entries `tubeplan evaluate` writes\n";
+        ok = false;
+        continue;
+      }
+      if (!files.insert(p["file"].get<std::string>()).second) {
+        io.err << path << ": error: plan " << p["file"] << " is in two reports, expected "
+               << "disjoint shards\n";
+        ok = false;
+      }
+      plans.push_back(p);
+    }
+  }
+  if (!ok) return kExitBadInput;
+  const nlohmann::json merged = Report(std::move(plans));
+  if (!o.report_path.empty()) {
+    if (const std::string e = io::WriteTextFileAtomically(o.report_path, merged.dump(1) + "\n");
+        !e.empty()) {
+      io.err << o.report_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
+  const bool all_feasible = merged["summary"]["infeasible"] == 0;
+  if (o.json) {
+    io.out << merged.dump(2) << "\n";
+  } else {
+    for (const nlohmann::json& p : merged["plans"])
+      io.out << p["file"].get<std::string>() << ": "
+             << (p["feasible"].get<bool>() ? "FEASIBLE" : "INFEASIBLE") << "\n";
+    io.out << "summary: " << merged["summary"]["plans"] << " plans, "
+           << merged["summary"]["feasible"] << " feasible, " << merged["summary"]["infeasible"]
+           << " infeasible (merged from " << o.reports.size() << " reports)\n";
+  }
+  return all_feasible ? kExitOk : kExitNegative;
+}
+
+}  // namespace
+
+Command AddMergeCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<MergeOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "merge",
+      "Join the JSON reports of `tubeplan evaluate --shard` runs into the report one unsharded "
+      "run gives.");
+  sub->add_option("reports", options->reports, "report files (JSON)")->required();
+  sub->add_flag("--json", options->json, "print the merged report as one JSON document");
+  sub->add_option("--report", options->report_path, "write the merged report to FILE");
+  return {sub, [options, streams] { return RunMerge(*options, streams); }};
 }
 
 }  // namespace tubeplan::cli

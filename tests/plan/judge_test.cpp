@@ -164,4 +164,26 @@ TEST_CASE("Bad plan files get every problem at once, and nothing is evaluated", 
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("Shards merged give the unsharded report", "[plan]") {
+  const nlohmann::json whole = EvaluateShipped("2");
+  std::vector<std::string> merge = {"merge", "--json"};
+  for (const char* shard : {"1/3", "2/3", "3/3"}) {
+    const std::string file = std::string("judge_test_shard_") + shard[0] + ".json";
+    const Outcome r =
+        RunTool({"evaluate", SourcePath("plans"), "--shard", shard, "--report", file, "--json"});
+    CHECK((r.exit_code == 0 || r.exit_code == 1));
+    // Five plans in three shards: 2, 2 and 1 of them.
+    CHECK(nlohmann::json::parse(r.out)["summary"]["plans"] == (shard[0] == '3' ? 1 : 2));
+    merge.push_back(file);
+  }
+  const Outcome merged = RunTool(merge);
+  CHECK(merged.exit_code == 1);
+  CHECK(nlohmann::json::parse(merged.out) == whole);
+  // The same shard twice is an error, not a double count.
+  const Outcome twice = RunTool({"merge", merge[2], merge[2]});
+  CHECK(twice.exit_code == 2);
+  for (std::size_t i = 2; i < merge.size(); ++i) std::filesystem::remove(merge[i]);
+  CHECK(RunTool({"evaluate", SourcePath("plans"), "--shard", "4/3"}).exit_code == 2);
+}
+
 }  // namespace
