@@ -19,6 +19,7 @@
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/plan/perturb.hpp>
 
 #include "commands.hpp"
 
@@ -33,6 +34,8 @@ struct EvaluateOptions {
   bool json = false;
   std::string report_path;
   std::string shard;  // "I/N", empty: all
+  int monte_carlo = 0;
+  std::uint64_t seed = 1;
 };
 
 // A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
@@ -80,14 +83,27 @@ struct Evaluated {
   std::string file;
   plan::Plan plan;
   plan::Judgement judgement;
+  int runs = 0;             // Monte-Carlo replicates
+  std::vector<int> robust;  // per transition: replicates in which it was feasible
+  double replayed_s = 0.0;  // trajectory time replayed, replicates included
+  double run_s = 0.0;       // wall time of those replays
 };
+
+// FNV-1a of the plan's path: each plan's replicates depend on the seed and the plan only, not on
+// which shard or thread judges it.
+std::uint64_t PlanSeed(std::uint64_t seed, const std::string& file) {
+  std::uint64_t h = 1469598103934665603ull ^ seed;
+  for (unsigned char c : file) h = (h ^ c) * 1099511628211ull;
+  return h;
+}
 
 nlohmann::json ToJson(const std::vector<Evaluated>& results) {
   nlohmann::json plans = nlohmann::json::array();
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
     nlohmann::json transitions = nlohmann::json::array();
-    for (const plan::TransitionVerdict& v : j.transitions) {
+    for (std::size_t k = 0; k < j.transitions.size(); ++k) {
+      const plan::TransitionVerdict& v = j.transitions[k];
       transitions.push_back({{"from", v.from},
                              {"to", v.to},
                              {"verdict", plan::ToString(v.verdict)},
@@ -99,6 +115,13 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"friction_work_J", v.friction_work_J},
                              {"energy_entry_J", v.energy_entry_J},
                              {"energy_exit_J", v.energy_exit_J}});
+      if (e.runs > 0) {
+        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+        transitions.back()["monte_carlo"] = {{"runs", e.runs},
+                                             {"feasible", e.robust[k]},
+                                             {"fraction", double(e.robust[k]) / e.runs},
+                                             {"ci95", {ci.low, ci.high}}};
+      }
     }
     nlohmann::json observed = nlohmann::json::array();
     for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
@@ -153,8 +176,26 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   auto work = [&] {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       const io::PlanLoadResult& l = loaded[i];
-      results[i] = {files[i], *l.plan,
-                    plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits)};
+      Evaluated e{files[i],
+                  *l.plan,
+                  plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits),
+                  0,
+                  {}};
+      e.runs = o.monte_carlo;
+      e.robust.assign(e.judgement.transitions.size(), 0);
+      e.replayed_s = e.judgement.replayed_s;
+      e.run_s = e.judgement.run_s;
+      for (int r = 0; r < o.monte_carlo; ++r) {
+        const plan::Judgement jr = plan::Judge(
+            *l.scene,
+            plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(o.seed, files[i]), r),
+            l.plan->states, l.plan->limits);
+        for (std::size_t k = 0; k < jr.transitions.size(); ++k)
+          e.robust[k] += jr.transitions[k].verdict != plan::Verdict::kInfeasible;
+        e.replayed_s += jr.replayed_s;
+        e.run_s += jr.run_s;
+      }
+      results[i] = std::move(e);
       if (progress) {
         const std::size_t d = ++done;
         // One short line per plan, on a terminal only (a log stays clean).
@@ -200,8 +241,8 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   long feasible = 0;
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
-    replayed_s += j.replayed_s;
-    run_s += j.run_s;
+    replayed_s += e.replayed_s;
+    run_s += e.run_s;
     feasible += j.feasible;
     t << e.file << " (" << e.plan.name << "): "
       << paint(j.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible,
@@ -216,6 +257,12 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
         for (const std::string& d : v.detour) t << " " << d;
       }
       if (!v.reason.empty()) t << " (" << v.reason << ")";
+      if (e.runs > 0) {
+        const std::size_t k = std::size_t(&v - j.transitions.data());
+        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+        t << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
+          << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
+      }
       t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
         << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
         << " -> " << v.energy_exit_J << " J\n";
@@ -245,6 +292,13 @@ Command AddEvaluateCommand(CLI::App& app, Streams streams) {
       ->check(CLI::Range(1, 256));
   sub->add_flag("--json", options->json, "print the report as one JSON document");
   sub->add_option("--report", options->report_path, "also write the JSON report to FILE");
+  sub->add_option("--monte-carlo", options->monte_carlo,
+                  "also replay each plan N times with perturbed trajectories (offset within 1 mm, "
+                  "0.1 mm 8-12 Hz tremor, 0.8-1.25x speed) and report each transition's feasible "
+                  "fraction with a 95 % interval")
+      ->check(CLI::Range(0, 100000));
+  sub->add_option("--seed", options->seed, "seed of the Monte-Carlo perturbations")
+      ->capture_default_str();
   sub->add_option("--shard", options->shard,
                   "evaluate only shard I of N (I/N) of the plans in file order; join the shards' "
                   "reports with `tubeplan merge`");

@@ -13,6 +13,7 @@
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/perturb.hpp>
 
 namespace {
 
@@ -184,6 +185,68 @@ TEST_CASE("Shards merged give the unsharded report", "[plan]") {
   CHECK(twice.exit_code == 2);
   for (std::size_t i = 2; i < merge.size(); ++i) std::filesystem::remove(merge[i]);
   CHECK(RunTool({"evaluate", SourcePath("plans"), "--shard", "4/3"}).exit_code == 2);
+}
+
+TEST_CASE("Wilson intervals and perturbed trajectories", "[plan]") {
+  // Known values of the 95 % Wilson score interval (e.g. Newcombe 1998, Table I: 8/10 gives
+  // 0.490 .. 0.943; 0/10 gives 0 .. 0.278).
+  const plan::Interval a = plan::WilsonInterval(8, 10);
+  CHECK(a.low == Approx(0.4902).margin(5e-5));
+  CHECK(a.high == Approx(0.9433).margin(5e-5));
+  const plan::Interval b = plan::WilsonInterval(0, 10);
+  CHECK(b.low == 0.0);
+  CHECK(b.high == Approx(0.2775).margin(5e-5));
+  CHECK(plan::WilsonInterval(10, 10).low == Approx(1.0 - 0.2775).margin(5e-5));
+
+  const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-insert.yaml"));
+  REQUIRE(loaded.trajectory);
+  const plan::Trajectory& nominal = *loaded.trajectory;
+  // No perturbation: the same samples, bit for bit.
+  const plan::Trajectory same = plan::Perturb(nominal, {0.0, 0.0, 1.0, 1.0}, 7, 3);
+  REQUIRE(same.samples.size() == nominal.samples.size());
+  for (std::size_t i = 0; i < same.samples.size(); i += 251) {
+    CHECK(same.samples[i].t_s == nominal.samples[i].t_s);
+    CHECK(same.samples[i].p_WH_m == nominal.samples[i].p_WH_m);
+  }
+  // The defaults: the offset stays within 1 mm plus the tremor's reach, the duration within the
+  // speed range, and another replicate differs.
+  const plan::Perturbation p;
+  for (int r = 0; r < 20; ++r) {
+    const plan::Trajectory t = plan::Perturb(nominal, p, 7, r);
+    const double duration = t.samples.back().t_s - t.samples.front().t_s;
+    const double nominal_duration = nominal.samples.back().t_s - nominal.samples.front().t_s;
+    CHECK(duration >= nominal_duration / p.speed_max - 1e-12);
+    CHECK(duration <= nominal_duration / p.speed_min + 1e-12);
+    CHECK((t.samples.front().p_WH_m - nominal.samples.front().p_WH_m).norm() <=
+          p.offset_m + std::sqrt(3.0) * p.tremor_m + 1e-12);
+  }
+  CHECK(plan::Perturb(nominal, p, 7, 0).samples[100].p_WH_m !=
+        plan::Perturb(nominal, p, 7, 1).samples[100].p_WH_m);
+}
+
+TEST_CASE("Monte-Carlo robustness is the same for any --jobs", "[plan]") {
+  auto run = [](const char* jobs) {
+    const Outcome r = RunTool({"evaluate", SourcePath("plans/groove-lay-flat.yaml"),
+                               SourcePath("plans/groove-insert.yaml"), "--monte-carlo", "4",
+                               "--json", "--jobs", jobs});
+    REQUIRE(r.exit_code == 0);
+    return nlohmann::json::parse(r.out);
+  };
+  const nlohmann::json one = run("1");
+  CHECK(one == run("2"));
+  for (const nlohmann::json& p : one["plans"]) {
+    for (const nlohmann::json& t : p["transitions"]) {
+      const nlohmann::json& mc = t["monte_carlo"];
+      CHECK(mc["runs"] == 4);
+      CHECK(mc["feasible"] >= 0);
+      CHECK(mc["feasible"] <= 4);
+      CHECK(mc["ci95"][0] <= mc["fraction"]);
+      CHECK(mc["fraction"] <= mc["ci95"][1]);
+    }
+  }
+  // Laying the tube flat into the groove does not depend on millimetres or speed: every
+  // perturbed replay reaches the goal.
+  CHECK(PlanNamed(one, "groove-lay-flat")["transitions"][0]["monte_carlo"]["feasible"] == 4);
 }
 
 }  // namespace
