@@ -44,9 +44,9 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   app.require_subcommand(1);
   const Streams streams{out, err};
   const std::vector<Command> commands = {
-      AddCheckCommand(app, streams),   AddBeamCommand(app, streams),
-      AddBenchCommand(app, streams),   AddSimulateCommand(app, streams),
-      AddGraphCommand(app, streams),   AddPlansCommand(app, streams),
+      AddCheckCommand(app, streams),    AddBeamCommand(app, streams),
+      AddBenchCommand(app, streams),    AddSimulateCommand(app, streams),
+      AddGraphCommand(app, streams),    AddPlansCommand(app, streams),
       AddEvaluateCommand(app, streams), AddMergeCommand(app, streams)};
 
   // CLI11 wants argv order reversed when given a vector.

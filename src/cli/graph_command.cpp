@@ -19,6 +19,7 @@
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/paths.hpp>
+#include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
@@ -41,7 +42,51 @@ struct GraphOptions {
   int jobs = 0;  // 0: the machine's cores
   std::string weights;
   std::optional<double> tolerance;
+  std::string verdicts_path;  // graph only: an evaluate report
 };
+
+// The judged plans of an evaluate report (docs/evaluate.md), or nullopt after reporting why not.
+std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& path,
+                                                             std::ostream& err) {
+  const std::optional<std::string> text = io::ReadTextFile(path);
+  const nlohmann::json report =
+      text ? nlohmann::json::parse(*text, nullptr, false) : nlohmann::json();
+  std::vector<graph::ReplayedPlan> plans;
+  bool ok = text && !report.is_discarded() && report.is_object() &&
+            report.value("tubeplan_evaluate", 0) == 1 && report.contains("plans") &&
+            report["plans"].is_array();
+  for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
+    const nlohmann::json& p = report["plans"][i];
+    graph::ReplayedPlan r;
+    ok = p.is_object() && p.contains("transitions") && p["transitions"].is_array() &&
+         p.contains("observed") && p["observed"].is_array();
+    for (std::size_t k = 0; ok && k < p["transitions"].size(); ++k) {
+      const nlohmann::json& t = p["transitions"][k];
+      ok = t.is_object() && t.value("from", nlohmann::json()).is_string() &&
+           t.value("to", nlohmann::json()).is_string() &&
+           t.value("verdict", nlohmann::json()).is_string() &&
+           t.value("t_start_s", nlohmann::json()).is_number() &&
+           t.value("t_end_s", nlohmann::json()).is_number();
+      if (ok)
+        r.transitions.push_back(
+            {t["from"], t["to"], t["verdict"] != "infeasible", t["t_start_s"], t["t_end_s"]});
+    }
+    for (std::size_t k = 0; ok && k < p["observed"].size(); ++k) {
+      const nlohmann::json& o = p["observed"][k];
+      ok = o.is_object() && o.value("t", nlohmann::json()).is_number() &&
+           o.value("cf", nlohmann::json()).is_string();
+      if (ok) r.observed.push_back({o["t"].get<double>(), o["cf"].get<std::string>()});
+    }
+    plans.push_back(std::move(r));
+  }
+  if (!ok) {
+    err << path
+        << ": error: not a readable tubeplan evaluate report, expected the JSON that "
+           "`tubeplan evaluate --report` writes (version 1)\n";
+    return std::nullopt;
+  }
+  return plans;
+}
 
 // "friction=1,energy=0.5,distance=2" over the scene's weights.
 bool ParseWeights(const std::string& text, graph::PruneWeights& w, std::string& error) {
@@ -104,8 +149,14 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
   explore.effort = o.effort;
   explore.max_motions = o.budget;
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  std::optional<std::vector<graph::ReplayedPlan>> verdicts;
+  if (!o.verdicts_path.empty()) {
+    verdicts = ReadVerdicts(o.verdicts_path, io.err);
+    if (!verdicts) return kExitBadInput;
+  }
   graph::ContactGraph g = graph::Explore(s, explore);
   graph::Prune(g, weights);
+  if (verdicts) graph::ApplyVerdicts(g, *verdicts);
   return Built{s, std::move(g), explore, weights};
 }
 
@@ -203,6 +254,18 @@ int RunGraph(const GraphOptions& o, Streams io) {
     t << (i == 0 ? " (" : ", ") << g.unreached_elements[i];
   if (!g.unreached_elements.empty()) t << (g.unreached_elements.size() > 8 ? ", ...)" : ")");
   t << "\n";
+  if (!o.verdicts_path.empty()) {
+    auto count = [&](graph::BatchResult result) {
+      return std::count_if(g.arcs.begin(), g.arcs.end(),
+                           [&](const auto& a) { return a.batch == result; });
+    };
+    t << "verdicts from " << o.verdicts_path << ": " << count(graph::BatchResult::kFeasible)
+      << " arcs feasible, " << count(graph::BatchResult::kInfeasible) << " infeasible; "
+      << std::count_if(g.nodes.begin(), g.nodes.end(), [](const auto& n) { return n.from_replay; })
+      << " states and "
+      << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.from_replay; })
+      << " transitions seen only in the replays added\n";
+  }
   if (!o.dot_path.empty()) t << "DOT written to " << o.dot_path << "\n";
   if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";
   io.out << t.str();
@@ -327,6 +390,9 @@ Command AddGraphCommand(CLI::App& app, Streams streams) {
   sub->add_option("scene", options->scene_path, "scene file (.yaml)")->required();
   sub->add_option("--dot", options->dot_path, "write the graph in Graphviz DOT to FILE");
   sub->add_option("--json", options->json_path, "write the graph as JSON to FILE (docs/graph.md)");
+  sub->add_option("--verdicts", options->verdicts_path,
+                  "colour arcs by an evaluate report (feasible green, infeasible red) and add the "
+                  "states its replays saw that exploration missed");
   sub->add_flag("--unpruned", options->unpruned,
                 "DOT: draw every arc, the dropped ones dashed with their reason (default: the "
                 "pruned graph only)");

@@ -52,6 +52,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                      {"force_N", n.force_N},
                      {"distance_m", n.distance_m >= 0.0 ? nlohmann::json(n.distance_m) : nullptr},
                      {"ticks", n.ticks},
+                     {"from_replay", n.from_replay},
                      {"witness", w}});
   }
   j["nodes"] = nodes;
@@ -63,6 +64,10 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                     {"reason", a.reason},
                     {"count", a.count},
                     {"simultaneous", a.simultaneous},
+                    {"batch", a.batch == graph::BatchResult::kFeasible     ? "feasible"
+                              : a.batch == graph::BatchResult::kInfeasible ? "infeasible"
+                                                                           : "untried"},
+                    {"from_replay", a.from_replay},
                     {"witness", Ref(a.witness, T)}});
   }
   j["arcs"] = arcs;

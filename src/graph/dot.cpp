@@ -110,6 +110,11 @@ std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
     }
     for (std::size_t i = 0; i < graph.nodes.size(); ++i)
       drawn[i] = drawn[i] || (from_start[i] && to_goal[i]);
+    // With batch results, also what the replays went through.
+    for (const Arc& a : graph.arcs) {
+      if (a.batch == BatchResult::kUntried) continue;
+      drawn[std::size_t(a.from)] = drawn[std::size_t(a.to)] = true;
+    }
   }
   std::vector<int> vertex_of(graph.nodes.size(), -1);
   std::vector<std::size_t> node_of;
@@ -121,7 +126,8 @@ std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
   std::vector<std::size_t> arc_of;
   for (std::size_t i = 0; i < graph.arcs.size(); ++i) {
     const Arc& a = graph.arcs[i];
-    if ((options.dropped_arcs || a.kept) && drawn[std::size_t(a.from)] && drawn[std::size_t(a.to)])
+    if ((options.dropped_arcs || a.kept || a.batch != BatchResult::kUntried) &&
+        drawn[std::size_t(a.from)] && drawn[std::size_t(a.to)])
       arc_of.push_back(i);
   }
   G g(node_of.size());
@@ -136,8 +142,11 @@ std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
     std::string label;
     if (n.start) label += "<B>start</B><BR/>";
     if (n.goal) label += "<B>goal</B><BR/>";
-    label += PaperNotation(n.cf) + "<BR/><FONT POINT-SIZE=\"9\">" + Figures(n) + "</FONT>";
+    label += PaperNotation(n.cf) + "<BR/><FONT POINT-SIZE=\"9\">" +
+             (n.from_replay ? std::string("<I>seen in replays, not explored</I>") : Figures(n)) +
+             "</FONT>";
     os << "[label=<" << label << ">, tooltip=" << Quoted(n.cf);
+    if (n.from_replay) os << ", style=\"rounded,dashed\", color=\"#d62728\"";
     if (n.start) os << ", fillcolor=\"#dbe9f6\", style=\"rounded,filled\"";
     if (n.goal) os << ", fillcolor=\"#d9f2d9\", style=\"rounded,filled\", peripheries=2";
     os << "]";
@@ -146,7 +155,14 @@ std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
   auto edge_writer = [&](std::ostream& os, const boost::graph_traits<G>::edge_descriptor& e) {
     const Arc& a = graph.arcs[arc_of[boost::get(edge_index, e)]];
     std::string label = a.simultaneous ? "simultaneous" : "";
-    if (a.kept) {
+    if (a.batch != BatchResult::kUntried) {
+      // What batch replays found overrides the pruning's colours.
+      const bool ok = a.batch == BatchResult::kFeasible;
+      os << "[color=\"" << (ok ? "#2ca02c" : "#d62728") << "\", penwidth=2.2"
+         << (a.from_replay ? ", style=dashed" : "") << ", tooltip="
+         << Quoted(std::string(ok ? "feasible in a batch replay" : "infeasible in a batch replay") +
+                   (a.kept ? "" : "; pruning: " + a.reason));
+    } else if (a.kept) {
       os << "[color=\"#e8850c\", penwidth=1.6";
     } else {
       if (!label.empty()) label += ", ";

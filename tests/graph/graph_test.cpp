@@ -15,6 +15,7 @@
 
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 
 namespace {
@@ -201,6 +202,47 @@ TEST_CASE("DOT renders with Graphviz without warnings and reads back into Boost"
     // G) and the kept arcs among them (A->B, A->D, B->G, D->G).
     CHECK(boost::num_vertices(read) == (unpruned ? 8u : 4u));
     CHECK(boost::num_edges(read) == (unpruned ? 11u : 4u));
+  }
+}
+
+TEST_CASE("Batch verdicts colour the arcs replays went along and add what they saw", "[graph]") {
+  ContactGraph g = HandMade();
+  graph::Prune(g, graph::PruneWeights{});
+  graph::ReplayedPlan ok;  // {} -> goal, feasible, through B
+  ok.transitions = {{"{}", "{Fs - floor.top}", true, 0.0, 3.0}};
+  ok.observed = {{0.0, "{}"}, {1.0, "{Ee - floor.top}"}, {2.0, "{Fs - floor.top}"}};
+  graph::ReplayedPlan bad;  // {} -> F planned, infeasible; the replay met a state never explored
+  bad.transitions = {{"{}", "{Fs - left.top}", false, 0.0, 2.0}};
+  bad.observed = {{0.0, "{}"}, {1.5, "{Fs u right.inner}"}};
+  CHECK(graph::ApplyVerdicts(g, {ok, bad}) == 1);
+  auto arc = [&](const std::string& from, const std::string& to) -> const Arc& {
+    for (const Arc& a : g.arcs)
+      if (g.nodes[std::size_t(a.from)].cf == from && g.nodes[std::size_t(a.to)].cf == to) return a;
+    FAIL("no arc " << from << " -> " << to);
+    return g.arcs.front();
+  };
+  CHECK(arc("{}", "{Ee - floor.top}").batch == graph::BatchResult::kFeasible);
+  CHECK(arc("{Ee - floor.top}", "{Fs - floor.top}").batch == graph::BatchResult::kFeasible);
+  CHECK(arc("{}", "{Fs - left.top}").batch == graph::BatchResult::kInfeasible);  // as planned
+  const Arc& seen = arc("{}", "{Fs u right.inner}");
+  CHECK(seen.batch == graph::BatchResult::kInfeasible);
+  CHECK(seen.from_replay);
+  CHECK(g.nodes.back().cf == "{Fs u right.inner}");
+  CHECK(g.nodes.back().from_replay);
+  CHECK(arc("{}", "{Ee ~ floor.top}").batch == graph::BatchResult::kUntried);
+  // The coloured graph renders without a warning, pruned and unpruned.
+  for (const bool unpruned : {false, true}) {
+    graph::DotOptions options;
+    options.dropped_arcs = unpruned;
+    {
+      std::ofstream out("graph_test_verdicts.dot");
+      out << graph::ToDot(g, options);
+    }
+    std::string err;
+    CHECK(Run("dot -Tsvg graph_test_verdicts.dot -o graph_test_verdicts.svg", err) == 0);
+    CHECK(err.empty());
+    std::remove("graph_test_verdicts.dot");
+    std::remove("graph_test_verdicts.svg");
   }
 }
 

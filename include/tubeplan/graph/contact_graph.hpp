@@ -32,7 +32,11 @@ struct Node {
   double distance_m = -1.0;
   long ticks = 0;  ///< ticks spent in this CF over all motions
   bool start = false, goal = false;
+  bool from_replay = false;  ///< not found by exploration; seen in a batch replay (ApplyVerdicts)
 };
+
+/// What batch replays found for an arc (ApplyVerdicts).
+enum class BatchResult : unsigned char { kUntried, kFeasible, kInfeasible };
 
 struct Arc {
   int from = 0, to = 0;  ///< node indices
@@ -43,6 +47,8 @@ struct Arc {
   TickRef witness;  ///< first tick at which it was produced (the tick in the new CF)
   bool kept = true;
   std::string reason;  ///< why pruning dropped it (empty when kept)
+  BatchResult batch = BatchResult::kUntried;
+  bool from_replay = false;  ///< not found by exploration; produced in a batch replay
 };
 
 struct SaturationPoint {

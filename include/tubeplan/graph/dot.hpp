@@ -2,7 +2,9 @@
 // The contact-state graph in Graphviz DOT (written with Boost.Graph's write_graphviz): nodes
 // labelled in the paper's notation with HTML-like labels (F&#771; for a bent element, the arcs
 // &#8995; / &#8994; for concave / convex), start and goal marked, kept arcs solid orange, dropped
-// arcs dashed grey and labelled with why they were dropped. Renders with `dot -Tsvg`.
+// arcs dashed grey and labelled with why they were dropped; after ApplyVerdicts, arcs batch
+// replays went along green (feasible) or red (infeasible), states only replays saw dashed red.
+// Renders with `dot -Tsvg`.
 
 #include <string>
 
