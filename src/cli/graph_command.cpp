@@ -192,7 +192,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
     graph::DotOptions dot;
     dot.dropped_arcs = o.unpruned;
     dot.title = "tubeplan: contact-state graph of " + s.name + (o.unpruned ? " (unpruned)" : "");
-    if (const std::string e = io::WriteTextFileAtomically(o.dot_path, graph::ToDot(g, dot));
+    if (const std::string e = io::WriteTextFileAtomically(o.dot_path, graph::FormatDot(g, dot));
         !e.empty()) {
       io.err << o.dot_path << ": error: " << e << "\n";
       return kExitBadInput;

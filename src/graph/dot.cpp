@@ -85,7 +85,7 @@ std::string PaperNotation(const std::string& cf_text) {
   return out;
 }
 
-std::string ToDot(const ContactGraph& graph, const DotOptions& options) {
+std::string FormatDot(const ContactGraph& graph, const DotOptions& options) {
   using G = boost::adjacency_list<boost::vecS, boost::vecS, boost::directedS, boost::no_property,
                                   boost::property<boost::edge_index_t, std::size_t>>;
   // The nodes drawn: all of them; or, for the pruned graph, those a plan from the start can pass

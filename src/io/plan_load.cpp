@@ -59,38 +59,44 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
   if (const YAML::Node n = r.Get(root, "limits", "plan file", false); n.IsDefined())
     ReadLimits(r, n, p.limits);
 
+  // A file the plan names, read once, relative to the plan's directory: (node, path, text), or
+  // nothing after reporting why.
+  struct Named {
+    YAML::Node node;
+    std::string full;
+    std::string text;
+  };
+  auto read_named = [&](const char* key, const char* expected, std::string& target) {
+    std::optional<Named> named;
+    const YAML::Node n = r.Get(root, key, "plan file", true);
+    if (!n.IsDefined()) return named;
+    const auto path = r.String(n, key);
+    if (!path) return named;
+    target = *path;
+    const std::filesystem::path full = directory / *path;
+    if (std::optional<std::string> text = ReadTextFile(full)) {
+      named = Named{n, full.string(), std::move(*text)};
+    } else {
+      r.Error(n, std::string(key) + ": cannot read '" + full.string() + "', expected " + expected);
+    }
+    return named;
+  };
   // The scene first: the states are checked against its elements.
   std::optional<scene::Scene> scene;
-  if (const YAML::Node n = r.Get(root, "scene", "plan file", true); n.IsDefined()) {
-    if (auto path = r.String(n, "scene")) {
-      p.scene = *path;
-      const std::filesystem::path full = directory / *path;
-      if (!ReadTextFile(full)) {
-        r.Error(n, "scene: cannot read '" + full.string() +
-                       "', expected a scene file path relative to the plan file");
-      } else {
-        SceneLoadResult loaded = LoadSceneFile(full);
-        result.diagnostics.Append(loaded.diagnostics);
-        if (!loaded.scene) r.Error(n, "scene: '" + full.string() + "' has errors (listed)");
-        scene = std::move(loaded.scene);
-      }
-    }
+  if (const auto named =
+          read_named("scene", "a scene file path relative to the plan file", p.scene)) {
+    SceneLoadResult loaded = LoadSceneText(named->text, named->full);
+    result.diagnostics.Append(loaded.diagnostics);
+    if (!loaded.scene) r.Error(named->node, "scene: '" + named->full + "' has errors (listed)");
+    scene = std::move(loaded.scene);
   }
-  if (const YAML::Node n = r.Get(root, "trajectory", "plan file", true); n.IsDefined()) {
-    if (auto path = r.String(n, "trajectory")) {
-      p.trajectory = *path;
-      const std::filesystem::path full = directory / *path;
-      if (!ReadTextFile(full)) {
-        r.Error(n, "trajectory: cannot read '" + full.string() +
-                       "', expected a trajectory CSV path relative to the plan file");
-      } else {
-        TrajectoryLoadResult loaded = LoadTrajectoryFile(full);
-        result.diagnostics.Append(loaded.diagnostics);
-        if (!loaded.trajectory)
-          r.Error(n, "trajectory: '" + full.string() + "' has errors (listed)");
-        result.trajectory = std::move(loaded.trajectory);
-      }
-    }
+  if (const auto named = read_named("trajectory", "a trajectory CSV path relative to the plan file",
+                                    p.trajectory)) {
+    TrajectoryLoadResult loaded = LoadTrajectoryText(named->text, named->full);
+    result.diagnostics.Append(loaded.diagnostics);
+    if (!loaded.trajectory)
+      r.Error(named->node, "trajectory: '" + named->full + "' has errors (listed)");
+    result.trajectory = std::move(loaded.trajectory);
   }
   if (const YAML::Node n = r.Get(root, "states", "plan file", true); n.IsDefined()) {
     if (!n.IsSequence() || n.size() < 2) {

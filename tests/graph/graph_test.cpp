@@ -151,7 +151,7 @@ int Run(const std::string& command, std::string& err) {
 
 // Boost 1.74's read_graphviz cannot read HTML strings at all (even `label=<a>` fails with
 // "Unclosed HTML string"; Graphviz reads them), so the structure check swaps each HTML label for
-// a quoted placeholder first. The file as written is what the Graphviz check renders.
+// the quoted string "html" first. The file as written is what the Graphviz check renders.
 std::string WithoutHtmlLabels(const std::string& dot) {
   std::string out;
   for (std::size_t i = 0; i < dot.size();) {
@@ -179,7 +179,7 @@ TEST_CASE("DOT renders with Graphviz without warnings and reads back into Boost"
     graph::DotOptions options;
     options.dropped_arcs = unpruned;
     options.title = "hand-made \"graph\"";
-    const std::string dot = graph::ToDot(g, options);
+    const std::string dot = graph::FormatDot(g, options);
     {
       std::ofstream out("graph_test.dot");
       out << dot;
@@ -236,7 +236,7 @@ TEST_CASE("Batch verdicts colour the arcs replays went along and add what they s
     options.dropped_arcs = unpruned;
     {
       std::ofstream out("graph_test_verdicts.dot");
-      out << graph::ToDot(g, options);
+      out << graph::FormatDot(g, options);
     }
     std::string err;
     CHECK(Run("dot -Tsvg graph_test_verdicts.dot -o graph_test_verdicts.svg", err) == 0);

@@ -19,7 +19,7 @@ struct DotOptions {
   std::string title;  ///< graph label, e.g. the scene's name
 };
 
-std::string ToDot(const ContactGraph& graph, const DotOptions& options);
+std::string FormatDot(const ContactGraph& graph, const DotOptions& options);
 
 /// One PC or CF in the paper's notation as a Graphviz HTML-like label fragment.
 std::string PaperNotation(const std::string& cf_text);
