@@ -616,17 +616,15 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   cores.push_back(std::make_unique<core::Core>(scene));
   core::Core& probe = *cores.front();
   const Box box = PartsBox(scene, probe.reachable_parts());
+  // Sweeps and aims run whole, merged in order (saturation counts random motions only).
   auto run = [&](std::vector<Motion> batch) {
     const int first = static_cast<int>(graph.motions.size());
+    const int count = static_cast<int>(batch.size());
     for (Motion& m : batch) graph.motions.push_back(std::move(m));
-    std::vector<MotionResult> results =
-        RunAll(scene, graph.motions, first, static_cast<int>(batch.size()), o, cores);
-    std::vector<bool> added;
-    for (const MotionResult& r : results) {
-      added.push_back(merger.Add(r));
+    for (const MotionResult& r : RunAll(scene, graph.motions, first, count, o, cores)) {
+      merger.Add(r);
       if (progress) progress(graph.saturation.back());
     }
-    return added;
   };
 
   run(Sweeps(scene, box, o));
