@@ -76,6 +76,24 @@ double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d
   // where a coordinate crosses a face plane (at most six), quadratic in t: minimise it exactly on
   // each piece. All points in the box's frame.
   const Eigen::Vector3d d = b - a;
+  // The common case first: both ends beyond the same face and within the other two slabs (a
+  // capsule lying over a face). Then only that axis is outside along the whole segment, its
+  // excess is linear in t, and the nearer end is nearest (the first on a tie, as below).
+  int outside = -1;
+  bool one_face = true;
+  for (int k = 0; k < 3 && one_face; ++k) {
+    const bool a_out = std::abs(a[k]) > half[k], b_out = std::abs(b[k]) > half[k];
+    if (!a_out && !b_out) continue;
+    one_face = a_out && b_out && (a[k] > 0.0) == (b[k] > 0.0) && outside < 0;
+    outside = k;
+  }
+  if (one_face && outside >= 0) {
+    const double excess_a = std::abs(a[outside]) - half[outside];
+    const double excess_b = std::abs(b[outside]) - half[outside];
+    t_min = excess_b < excess_a ? 1.0 : 0.0;
+    const double e = std::min(excess_a, excess_b);
+    return e * e;
+  }
   std::array<double, 8> cuts{};
   int n = 0;
   cuts[std::size_t(n++)] = 0.0;
@@ -114,6 +132,37 @@ double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d
     if (f < best) best = f, t_min = t;
   }
   return best;
+}
+
+bool CylinderBoxFaceDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                             const Eigen::Vector3d& half, double& distance,
+                             Eigen::Vector3d& p_cylinder, Eigen::Vector3d& q_box) {
+  const Eigen::Vector3d axis = b - a;
+  const double length = axis.norm();
+  if (!(length > 0.0)) return false;
+  const Eigen::Vector3d u = axis / length;
+  for (int k = 0; k < 3; ++k) {
+    for (const double side : {-1.0, 1.0}) {
+      // Outward normal n = side e_k. The support point in -n: the axis end with the smaller
+      // n.x, then the rim point farthest along -n within the end's plane.
+      const double n_u = side * u[k];
+      Eigen::Vector3d s = n_u > 0.0 ? a : b;
+      Eigen::Vector3d radial = n_u * u;  // -(n - (n.u) u): the part of -n across the axis
+      radial[k] -= side;
+      const double radial_norm = radial.norm();
+      if (radial_norm > 1e-12) s += (radius / radial_norm) * radial;
+      const double beyond = side * s[k] - half[k];
+      if (!(beyond > 0.0)) continue;
+      const int i = (k + 1) % 3, j = (k + 2) % 3;
+      if (std::abs(s[i]) > half[i] || std::abs(s[j]) > half[j]) continue;
+      distance = beyond;
+      p_cylinder = s;
+      q_box = s;
+      q_box[k] = side * half[k];
+      return true;
+    }
+  }
+  return false;
 }
 
 bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P,
@@ -219,9 +268,20 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       double d = 0.0;
       Eigen::Vector3d p_tube_W, q_part_W;
       ++narrow_calls_;
-      const bool separated = is_end ? solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box,
-                                                            part.X_WP, &d, &p_tube_W, &q_part_W)
-                                    : CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
+      bool separated = false;
+      if (!is_end) {
+        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
+      } else if (Eigen::Vector3d p_P, q_P;
+                 CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
+        // The end piece nearest to a face (the usual case: the tip on the floor, the end against
+        // a wall) in closed form; FCL's GJK only for an edge or a vertex nearest, or overlap.
+        separated = true;
+        p_tube_W = part.ToWorld(p_P);
+        q_part_W = part.ToWorld(q_P);
+      } else {
+        separated = solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box, part.X_WP, &d,
+                                          &p_tube_W, &q_part_W);
+      }
       RawContact c;
       c.part = part.index;
       if (separated && d >= band_m) continue;

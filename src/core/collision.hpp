@@ -40,6 +40,18 @@ inline constexpr int kMaxRawContacts = 4 * kMaxCapsules;
 double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                  const Eigen::Vector3d& half, double& t_min);
 
+/// Distance from the flat-ended cylinder of radius r on the axis a-b to the box [-half, half]
+/// (all in the box's frame) when a face of the box is nearest: the cylinder's lowest point along
+/// a face's outward normal (its support point) lies beyond that face's plane, and its foot on the
+/// plane lies within the face. The plane bounds the box, so no box point is nearer than the plane
+/// distance, and the foot is a box point at exactly that distance: the result is exact. Returns
+/// false when no face certifies itself this way (an edge or a vertex is nearest, or the shapes
+/// overlap); then a general method is needed. On an exact tie (the end face or a generator
+/// parallel to the face) the support point is the end's centre or the axis end nearer the face.
+bool CylinderBoxFaceDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                             const Eigen::Vector3d& half, double& distance,
+                             Eigen::Vector3d& p_cylinder, Eigen::Vector3d& q_box);
+
 class Collision {
  public:
   /// `element_of[part][mask]` is the element index of a face mask of a part.
