@@ -1,7 +1,6 @@
 #include "collision.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -317,8 +316,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         }
         if (c.tube != states::TubeElement::kSide) c.s_m = length_m_;
       }
-      if (is_end && c.tube == states::TubeElement::kSide && !c.overlap &&
-          std::popcount(unsigned(c.face_mask)) == 1) {
+      if (is_end && c.tube == states::TubeElement::kSide && !c.overlap && IsFaceMask(c.face_mask)) {
         // The end cylinder's side on a face is a line contact along its nearest generator: GJK
         // returns one point of it, at either end depending on the sign of a tiny tilt, which
         // would make the load jump by the cylinder's length from tick to tick. Both ends of the

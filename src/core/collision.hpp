@@ -33,6 +33,10 @@ struct RawContact {
   Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the tube
 };
 
+/// Whether a face mask names a face (one bit), not an edge or a vertex. Not std::popcount, which
+/// without -mpopcnt is a library call (2 % of a tick in the profile).
+inline bool IsFaceMask(std::uint8_t mask) { return mask != 0 && (mask & (mask - 1)) == 0; }
+
 inline constexpr int kMaxRawContacts = 4 * kMaxCapsules;
 
 /// Squared distance from the segment a-b to the box [-half, half] (all in the box's frame), and

@@ -1,5 +1,4 @@
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -239,8 +238,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       // Only an edge, a vertex or the rim bounds another element: a face touched by the end
       // face or the side joins nothing (most pairs of a tube lying in a groove; this loop is
       // quadratic in them).
-      if (std::popcount(unsigned(a.face_mask)) == 1 && a.tube != states::TubeElement::kEndRim)
-        break;
+      if (IsFaceMask(a.face_mask) && a.tube != states::TubeElement::kEndRim) break;
       const RawContact& b = m.raw[std::size_t(j)];
       if (i == j || a.part != b.part) continue;
       const bool part_bounds = (a.face_mask & b.face_mask) == b.face_mask;
