@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -163,6 +164,47 @@ TEST_CASE("The same inputs give the same bits, in any thread", "[core][determini
   tb.join();
   CHECK(a == first);
   CHECK(b == first);
+}
+
+TEST_CASE("The shipped insertion replays to its golden hash", "[core][determinism]") {
+  // The golden value pins the physics: any change of a force, a pose, an energy, a flag or a
+  // contact formation anywhere in the 5501 ticks of plans/groove-insert.csv changes it. Values are
+  // hashed at 7 significant digits so that the release and the sanitizer builds (different
+  // optimisation levels, same IEEE arithmetic) agree even if one ever rounds a last bit
+  // differently; the CFs, markers and flags are hashed exactly.
+  // A deliberate change of the physics changes this value: run this test, take the value it
+  // prints, and say in the commit message why the physics changed.
+  constexpr std::uint64_t kGolden = 0xbe98b5a8bdeff952ull;
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  const std::vector<plan::HandSample> ticks = DemoTicks();
+  core::Core c(s);
+  c.Reset(Pose(ticks.front()));
+  Hash hash;
+  const auto add = [&](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6e", v == 0.0 ? 0.0 : v);  // -0 and 0 alike
+    hash.Add(text, std::strlen(text));
+  };
+  const auto add3 = [&](const Eigen::Vector3d& v) {
+    for (int i = 0; i < 3; ++i) add(v[i]);
+  };
+  for (const plan::HandSample& sample : ticks) {
+    const core::StepOutput& out = c.Step(sample.t_s, Pose(sample));
+    add3(out.force_W_N);
+    add3(out.torque_W_Nm);
+    add3(out.X_WH.translation());
+    add(out.energy_J);
+    add(out.max_strain);
+    hash.Add(&out.flags, sizeof out.flags);
+    for (const core::ContactState& pc : out.Contacts()) {
+      const int code[3] = {int(pc.tube), int(pc.marker), pc.part_element};
+      hash.Add(code, sizeof code);
+    }
+  }
+  char printed[32];
+  std::snprintf(printed, sizeof printed, "0x%016llxull", static_cast<unsigned long long>(hash.h));
+  INFO("golden hash of this run: " << printed);
+  CHECK(hash.h == kGolden);
 }
 
 TEST_CASE("Invariants on random states of both shipped scenes", "[core][invariants]") {
