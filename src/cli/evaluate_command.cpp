@@ -22,11 +22,10 @@
 #include <tubeplan/plan/perturb.hpp>
 
 #include "commands.hpp"
+#include "report.hpp"
 
 namespace tubeplan::cli {
 namespace {
-
-inline constexpr int kEvaluateJsonVersion = 1;
 
 struct EvaluateOptions {
   std::vector<std::string> inputs;
@@ -37,22 +36,6 @@ struct EvaluateOptions {
   int monte_carlo = 0;
   std::uint64_t seed = 1;
 };
-
-// A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
-// merge of shard reports is the report of the unsharded run.
-nlohmann::json Report(nlohmann::json plans) {
-  std::stable_sort(plans.begin(), plans.end(),
-                   [](const nlohmann::json& a, const nlohmann::json& b) {
-                     return a["file"].get<std::string>() < b["file"].get<std::string>();
-                   });
-  long feasible = 0;
-  for (const nlohmann::json& p : plans) feasible += p["feasible"].get<bool>();
-  const long count = static_cast<long>(plans.size());
-  return {
-      {"tubeplan_evaluate", kEvaluateJsonVersion},
-      {"plans", plans},
-      {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
-}
 
 // The plan files named: files as given, directories' *.yaml files in name order.
 std::vector<std::string> PlanFiles(const std::vector<std::string>& inputs, std::ostream& err,
@@ -79,61 +62,12 @@ std::vector<std::string> PlanFiles(const std::vector<std::string>& inputs, std::
   return files;
 }
 
-struct Evaluated {
-  std::string file;
-  plan::Plan plan;
-  plan::Judgement judgement;
-  int runs = 0;             // Monte-Carlo replicates
-  std::vector<int> robust;  // per transition: replicates in which it was feasible
-  double replayed_s = 0.0;  // trajectory time replayed, replicates included
-  double run_s = 0.0;       // wall time of those replays
-};
-
 // FNV-1a of the plan's path: each plan's replicates depend on the seed and the plan only, not on
 // which shard or thread judges it.
 std::uint64_t PlanSeed(std::uint64_t seed, const std::string& file) {
   std::uint64_t h = 1469598103934665603ull ^ seed;
   for (unsigned char c : file) h = (h ^ c) * 1099511628211ull;
   return h;
-}
-
-nlohmann::json ToJson(const std::vector<Evaluated>& results) {
-  nlohmann::json plans = nlohmann::json::array();
-  for (const Evaluated& e : results) {
-    const plan::Judgement& j = e.judgement;
-    nlohmann::json transitions = nlohmann::json::array();
-    for (std::size_t k = 0; k < j.transitions.size(); ++k) {
-      const plan::TransitionVerdict& v = j.transitions[k];
-      transitions.push_back({{"from", v.from},
-                             {"to", v.to},
-                             {"verdict", plan::ToString(v.verdict)},
-                             {"reason", v.reason},
-                             {"detour", v.detour},
-                             {"t_start_s", v.t_start_s},
-                             {"t_end_s", v.t_end_s},
-                             {"peak_force_N", v.peak_force_N},
-                             {"friction_work_J", v.friction_work_J},
-                             {"energy_entry_J", v.energy_entry_J},
-                             {"energy_exit_J", v.energy_exit_J}});
-      if (e.runs > 0) {
-        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
-        transitions.back()["monte_carlo"] = {{"runs", e.runs},
-                                             {"feasible", e.robust[k]},
-                                             {"fraction", double(e.robust[k]) / e.runs},
-                                             {"ci95", {ci.low, ci.high}}};
-      }
-    }
-    nlohmann::json observed = nlohmann::json::array();
-    for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
-    plans.push_back({{"plan", e.plan.name},
-                     {"file", e.file},
-                     {"feasible", j.feasible},
-                     {"transitions", transitions},
-                     {"observed", observed},
-                     {"ticks", j.ticks},
-                     {"replayed_s", j.replayed_s}});
-  }
-  return Report(std::move(plans));
 }
 
 int RunEvaluate(const EvaluateOptions& o, Streams io) {
@@ -228,45 +162,15 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     return all_feasible ? kExitOk : kExitNegative;
   }
   const bool colour = isatty(STDOUT_FILENO) != 0;
-  auto paint = [&](plan::Verdict v, const std::string& text) {
-    if (!colour) return text;
-    const char* code = v == plan::Verdict::kFeasible             ? "\033[32m"
-                       : v == plan::Verdict::kFeasibleWithDetour ? "\033[33m"
-                                                                 : "\033[31m";
-    return std::string(code) + text + "\033[0m";
-  };
   std::ostringstream t;
   t << std::setprecision(3);
   double replayed_s = 0.0, run_s = 0.0;
   long feasible = 0;
   for (const Evaluated& e : results) {
-    const plan::Judgement& j = e.judgement;
     replayed_s += e.replayed_s;
     run_s += e.run_s;
-    feasible += j.feasible;
-    t << e.file << " (" << e.plan.name << "): "
-      << paint(j.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible,
-               j.feasible ? "FEASIBLE" : "INFEASIBLE")
-      << ", " << j.transitions.size()
-      << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
-      << " s replayed\n";
-    for (const plan::TransitionVerdict& v : j.transitions) {
-      t << "  " << v.from << " -> " << v.to << ": " << paint(v.verdict, plan::ToString(v.verdict));
-      if (!v.detour.empty()) {
-        t << " via";
-        for (const std::string& d : v.detour) t << " " << d;
-      }
-      if (!v.reason.empty()) t << " (" << v.reason << ")";
-      if (e.runs > 0) {
-        const std::size_t k = std::size_t(&v - j.transitions.data());
-        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
-        t << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
-          << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
-      }
-      t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
-        << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
-        << " -> " << v.energy_exit_J << " J\n";
-    }
+    feasible += e.judgement.feasible;
+    PrintVerdicts(t, e, colour);
   }
   t << "summary: " << results.size() << " plan" << (results.size() == 1 ? "" : "s") << ", "
     << feasible << " feasible, " << long(results.size()) - feasible << " infeasible; " << replayed_s

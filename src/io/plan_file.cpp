@@ -1,3 +1,4 @@
+#include <charconv>
 #include <cstdio>
 #include <sstream>
 
@@ -44,12 +45,27 @@ std::string FormatPlanYaml(const plan::Plan& p) {
   return out.str();
 }
 
-std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
+std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz) {
   std::string out;
-  if (!t.device.empty()) out += "# device: " + t.device + "\n";
-  if (t.nominal_rate_Hz > 0.0) out += "# rate: " + Number(t.nominal_rate_Hz) + " Hz\n";
+  if (!device.empty()) out += "# device: " + device + "\n";
+  if (nominal_rate_Hz > 0.0) out += "# rate: " + Number(nominal_rate_Hz) + " Hz\n";
   out += "# units: m\n";
   out += "t,px,py,pz,qw,qx,qy,qz\n";
+  return out;
+}
+
+void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s) {
+  char t[32];
+  const auto [end, ec] = std::to_chars(t, t + sizeof t, s.t_s);  // shortest round trip
+  out.append(t, ec == std::errc() ? end : t);
+  char row[192];
+  std::snprintf(row, sizeof row, ",%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", s.p_WH_m.x(),
+                s.p_WH_m.y(), s.p_WH_m.z(), s.q_WH.w(), s.q_WH.x(), s.q_WH.y(), s.q_WH.z());
+  out += row;
+}
+
+std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
+  std::string out = TrajectoryCsvHeader(t.device, t.nominal_rate_Hz);
   char row[192];
   for (const plan::HandSample& s : t.samples) {
     std::snprintf(row, sizeof row, "%.6f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", s.t_s, s.p_WH_m.x(),

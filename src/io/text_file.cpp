@@ -46,4 +46,50 @@ std::string WriteTextFileAtomically(const std::filesystem::path& path, std::stri
   return {};
 }
 
+StreamingTextFile::~StreamingTextFile() {
+  if (file_ == nullptr) return;
+  std::fclose(file_);
+  std::error_code ignored;
+  std::filesystem::remove(temporary_, ignored);
+}
+
+std::string StreamingTextFile::Open(const std::filesystem::path& path) {
+  path_ = path;
+  temporary_ = path;
+  temporary_ += ".tmp." + std::to_string(::getpid());
+  file_ = std::fopen(temporary_.c_str(), "wb");
+  if (file_ == nullptr) return "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+  return {};
+}
+
+void StreamingTextFile::Append(std::string_view text) {
+  if (file_ == nullptr || failed_) return;
+  if (std::fwrite(text.data(), 1, text.size(), file_) != text.size()) failed_ = true;
+}
+
+std::string StreamingTextFile::Flush() {
+  if (file_ == nullptr) return "not open";
+  if (failed_ || std::fflush(file_) != 0)
+    return "cannot write " + temporary_.string() + ": " + std::strerror(errno);
+  return {};
+}
+
+std::string StreamingTextFile::Commit() {
+  std::string error = Flush();
+  if (file_ != nullptr && ::fsync(::fileno(file_)) != 0 && error.empty())
+    error = "cannot sync " + temporary_.string() + ": " + std::strerror(errno);
+  if (file_ != nullptr && std::fclose(file_) != 0 && error.empty())
+    error = "cannot close " + temporary_.string() + ": " + std::strerror(errno);
+  file_ = nullptr;
+  std::error_code ec;
+  if (error.empty()) {
+    std::filesystem::rename(temporary_, path_, ec);
+    if (ec)
+      error =
+          "cannot rename " + temporary_.string() + " to " + path_.string() + ": " + ec.message();
+  }
+  if (!error.empty()) std::filesystem::remove(temporary_, ec);
+  return error;
+}
+
 }  // namespace tubeplan::io

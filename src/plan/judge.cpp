@@ -2,6 +2,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <stdexcept>
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/judge.hpp>
@@ -38,149 +39,156 @@ const char* ToString(Verdict verdict) {
   return "infeasible";
 }
 
+Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s)
+    : states_(std::move(states)),
+      limits_(limits),
+      step_s_(step_s),
+      dwell_(std::max(1, static_cast<int>(std::lround(limits.dwell_s / step_s)))) {
+  if (states_.size() < 2) throw std::invalid_argument("Judging: a plan needs two states");
+  // Per planned transition i (states[i] -> states[i+1]).
+  n_ = states_.size() - 1;
+  j_.transitions.resize(n_);
+  for (std::size_t i = 0; i < n_; ++i) {
+    j_.transitions[i].from = states_[i];
+    j_.transitions[i].to = states_[i + 1];
+  }
+}
+
+void Judging::Fail(std::size_t i, const std::string& reason) {
+  TransitionVerdict& v = j_.transitions[i];
+  if (v.verdict != Verdict::kInfeasible || v.reason.empty()) v.reason = reason;
+  v.verdict = Verdict::kInfeasible;
+}
+
+void Judging::Tick(double t_s, const core::StepOutput& out,
+                   const std::function<std::string()>& cf_text) {
+  ++j_.ticks;
+  if (j_.ticks == 1) t_first_ = t_s;
+  t_last_ = t_s;
+  const std::vector<std::string>& states = states_;
+  // Figures and limits of the transition under way.
+  if (!failed_ && at_ < n_) {
+    TransitionVerdict& v = j_.transitions[at_];
+    const double force_N = out.force_W_N.norm();
+    v.peak_force_N = std::max(v.peak_force_N, force_N);
+    if (force_N > limits_.max_force_N && v.reason.empty())
+      Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+    if (out.max_strain > limits_.max_strain && v.reason.empty())
+      Fail(at_, Format("strain", out.max_strain, "", limits_.max_strain, t_s));
+    for (const core::ContactState& c : out.Contacts()) {
+      if (-c.distance_m > limits_.max_penetration_m && v.reason.empty())
+        Fail(at_, Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3,
+                         t_s));
+      if (!c.sliding) continue;
+      for (const core::ContactState& before : last_.Contacts()) {
+        if (before.tube == c.tube && before.part_element == c.part_element)
+          v.friction_work_J += c.friction_W_N.norm() * (c.p_WC_m - before.p_WC_m).norm();
+      }
+    }
+  }
+  last_ = out;
+  stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
+
+  // Debounce: a state counts once held `dwell` ticks.
+  const core::FormationKey key = core::KeyOf(out);
+  if (j_.ticks == 1 || key != raw_key_) {
+    raw_key_ = key;
+    raw_ = cf_text();  // text only when the state changes
+    raw_held_ = 0;
+    raw_since_ = t_s;
+    raw_energy_ = out.energy_J;
+  }
+  ++raw_held_;
+  const bool first = j_.observed.empty();
+  if (!(first || (raw_held_ == dwell_ && raw_ != stable_))) return;
+  stable_ = raw_;
+  j_.observed.push_back({raw_since_, raw_});
+  if (first) {
+    j_.transitions[0].t_start_s = raw_since_;
+    j_.transitions[0].energy_entry_J = raw_energy_;
+    if (raw_ != states[0]) {
+      Fail(0, "the replay starts in " + raw_ + ", not in the planned " + states[0]);
+      failed_ = true;
+    }
+    return;
+  }
+  if (failed_ || at_ >= n_) return;
+  TransitionVerdict& v = j_.transitions[at_];
+  if (raw_ == states[at_ + 1]) {
+    v.t_end_s = raw_since_;
+    v.energy_exit_J = raw_energy_;
+    v.detour = passed_;
+    if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
+      failed_ = true;  // a limit was exceeded on the way
+    } else {
+      v.verdict = passed_.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
+    }
+    passed_.clear();
+    ++at_;
+    if (at_ < n_) {
+      j_.transitions[at_].t_start_s = raw_since_;
+      j_.transitions[at_].energy_entry_J = raw_energy_;
+    }
+  } else if (std::find(states.begin() + long(at_) + 2, states.end(), raw_) != states.end()) {
+    v.t_end_s = raw_since_;
+    v.detour = passed_;
+    Fail(at_,
+         "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1]);
+    failed_ = true;
+  } else if (raw_ != states[at_]) {
+    passed_.push_back(raw_);
+  }
+}
+
+Judgement Judging::Finish() {
+  const std::vector<std::string>& states = states_;
+  const double t_end = t_last_;
+  const double T = step_s_;
+  if (!failed_ && at_ < n_) {
+    TransitionVerdict& v = j_.transitions[at_];
+    v.t_end_s = t_end;
+    v.detour = passed_;
+    if (v.reason.empty()) {
+      char buffer[96];
+      std::string why;
+      if (stuck_ticks_ * T >= limits_.stall_s) {
+        std::snprintf(buffer, sizeof buffer,
+                      "stalled: the tube was held back from the hand for the last %.2f s",
+                      stuck_ticks_ * T);
+        why = buffer;
+      } else if (stable_ == states[at_]) {
+        why = passed_.empty() ? "the trajectory ended still in " + stable_
+                              : "went back to " + stable_ + " and the trajectory ended";
+      } else {
+        why = "another state reached instead: " + stable_ + " (the trajectory ended there)";
+      }
+      Fail(at_, states[at_ + 1] + " never reached: " + why);
+    }
+    failed_ = true;
+  }
+  for (std::size_t i = 0; i < n_; ++i) {
+    TransitionVerdict& v = j_.transitions[i];
+    if (v.verdict == Verdict::kInfeasible && v.reason.empty())
+      v.reason = "not reached: the plan failed at an earlier transition";
+  }
+  j_.feasible = std::all_of(j_.transitions.begin(), j_.transitions.end(),
+                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; });
+  j_.replayed_s = t_end - t_first_;
+  return j_;
+}
+
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits) {
   const auto clock_start = std::chrono::steady_clock::now();
-  Judgement j;
   const double T = scene.model.time_step_s;
   const std::vector<HandSample> ticks = Resample(trajectory, T);
   core::Core core(scene);
   core.Reset(Pose(ticks.front()));
-  const int dwell = std::max(1, static_cast<int>(std::lround(limits.dwell_s / T)));
-
-  // Per planned transition i (states[i] -> states[i+1]).
-  const std::size_t n = states.size() - 1;
-  j.transitions.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    j.transitions[i].from = states[i];
-    j.transitions[i].to = states[i + 1];
-  }
-  std::size_t at = 0;       // the transition being waited for
-  bool failed = false;      // a transition failed: later ones are not reached
-  std::string stable, raw;  // counted state and the core's state
-  core::FormationKey raw_key{};
-  int raw_held = 0;
-  double raw_since = 0.0, raw_energy = 0.0;
-  std::vector<std::string> passed;  // unplanned states since states[at]
-  // Last tick's contacts, to measure each sliding PC's slip (fixed size: nothing allocated per
-  // tick).
-  core::StepOutput last{};
-  long stuck_ticks = 0;  // held end separated from the hand, in a row
-
-  auto fail = [&](std::size_t i, const std::string& reason) {
-    TransitionVerdict& v = j.transitions[i];
-    if (v.verdict != Verdict::kInfeasible || v.reason.empty()) v.reason = reason;
-    v.verdict = Verdict::kInfeasible;
-  };
-
-  for (const HandSample& sample : ticks) {
-    const core::StepOutput& out = core.Step(sample.t_s, Pose(sample));
-    ++j.ticks;
-    // Figures and limits of the transition under way.
-    if (!failed && at < n) {
-      TransitionVerdict& v = j.transitions[at];
-      const double force_N = out.force_W_N.norm();
-      v.peak_force_N = std::max(v.peak_force_N, force_N);
-      if (force_N > limits.max_force_N && v.reason.empty())
-        fail(at, Format("operator force", force_N, "N", limits.max_force_N, sample.t_s));
-      if (out.max_strain > limits.max_strain && v.reason.empty())
-        fail(at, Format("strain", out.max_strain, "", limits.max_strain, sample.t_s));
-      for (const core::ContactState& c : out.Contacts()) {
-        if (-c.distance_m > limits.max_penetration_m && v.reason.empty())
-          fail(at, Format("penetration", -c.distance_m * 1e3, "mm", limits.max_penetration_m * 1e3,
-                          sample.t_s));
-        if (!c.sliding) continue;
-        for (const core::ContactState& before : last.Contacts()) {
-          if (before.tube == c.tube && before.part_element == c.part_element)
-            v.friction_work_J += c.friction_W_N.norm() * (c.p_WC_m - before.p_WC_m).norm();
-        }
-      }
-    }
-    last = out;
-    stuck_ticks = (out.flags & core::kProxySeparated) ? stuck_ticks + 1 : 0;
-
-    // Debounce: a state counts once held `dwell` ticks.
-    const core::FormationKey key = core::KeyOf(out);
-    if (j.ticks == 1 || key != raw_key) {
-      raw_key = key;
-      raw = core.FormationText();  // text only when the state changes
-      raw_held = 0;
-      raw_since = sample.t_s;
-      raw_energy = out.energy_J;
-    }
-    ++raw_held;
-    const bool first = j.observed.empty();
-    if (!(first || (raw_held == dwell && raw != stable))) continue;
-    stable = raw;
-    j.observed.push_back({raw_since, raw});
-    if (first) {
-      j.transitions[0].t_start_s = raw_since;
-      j.transitions[0].energy_entry_J = raw_energy;
-      if (raw != states[0]) {
-        fail(0, "the replay starts in " + raw + ", not in the planned " + states[0]);
-        failed = true;
-      }
-      continue;
-    }
-    if (failed || at >= n) continue;
-    TransitionVerdict& v = j.transitions[at];
-    if (raw == states[at + 1]) {
-      v.t_end_s = raw_since;
-      v.energy_exit_J = raw_energy;
-      v.detour = passed;
-      if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
-        failed = true;  // a limit was exceeded on the way
-      } else {
-        v.verdict = passed.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
-      }
-      passed.clear();
-      ++at;
-      if (at < n) {
-        j.transitions[at].t_start_s = raw_since;
-        j.transitions[at].energy_entry_J = raw_energy;
-      }
-    } else if (std::find(states.begin() + long(at) + 2, states.end(), raw) != states.end()) {
-      v.t_end_s = raw_since;
-      v.detour = passed;
-      fail(at,
-           "another state reached instead: " + raw + ", planned later, before " + states[at + 1]);
-      failed = true;
-    } else if (raw != states[at]) {
-      passed.push_back(raw);
-    }
-  }
-
-  const double t_end = ticks.back().t_s;
-  if (!failed && at < n) {
-    TransitionVerdict& v = j.transitions[at];
-    v.t_end_s = t_end;
-    v.detour = passed;
-    if (v.reason.empty()) {
-      char buffer[96];
-      std::string why;
-      if (stuck_ticks * T >= limits.stall_s) {
-        std::snprintf(buffer, sizeof buffer,
-                      "stalled: the tube was held back from the hand for the last %.2f s",
-                      stuck_ticks * T);
-        why = buffer;
-      } else if (stable == states[at]) {
-        why = passed.empty() ? "the trajectory ended still in " + stable
-                             : "went back to " + stable + " and the trajectory ended";
-      } else {
-        why = "another state reached instead: " + stable + " (the trajectory ended there)";
-      }
-      fail(at, states[at + 1] + " never reached: " + why);
-    }
-    failed = true;
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    TransitionVerdict& v = j.transitions[i];
-    if (v.verdict == Verdict::kInfeasible && v.reason.empty())
-      v.reason = "not reached: the plan failed at an earlier transition";
-  }
-  j.feasible = std::all_of(j.transitions.begin(), j.transitions.end(),
-                           [](const auto& v) { return v.verdict != Verdict::kInfeasible; });
-  j.replayed_s = t_end - ticks.front().t_s;
+  Judging judging(states, limits, T);
+  const auto text = [&core] { return core.FormationText(); };
+  for (const HandSample& sample : ticks)
+    judging.Tick(sample.t_s, core.Step(sample.t_s, Pose(sample)), text);
+  Judgement j = judging.Finish();
   j.run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return j;
 }

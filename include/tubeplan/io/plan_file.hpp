@@ -40,4 +40,11 @@ std::string FormatPlanYaml(const plan::Plan& plan);
 /// nanometre, quaternions to 1e-9).
 std::string FormatTrajectoryCsv(const plan::Trajectory& trajectory);
 
+/// The '#' metadata lines and the header of a trajectory CSV, as FormatTrajectoryCsv writes them.
+std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz);
+/// Appends one sample as a row for a streamed recording: t as the shortest text that reads back
+/// to the same double (so a replay's grid t0 + k T meets the samples exactly), the position to
+/// the nanometre and the quaternion to 1e-9 as written (the reader normalises it).
+void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& sample);
+
 }  // namespace tubeplan::io

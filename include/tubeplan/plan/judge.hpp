@@ -3,9 +3,11 @@
 // transition a verdict (architecture.md, docs/evaluate.md). A state counts once the core has
 // kept it for the plan's dwell; the counted sequence is matched against the plan.
 
+#include <functional>
 #include <string>
 #include <vector>
 
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/plan.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
@@ -39,6 +41,49 @@ struct Judgement {
   long ticks = 0;
   double replayed_s = 0.0;  ///< trajectory time replayed
   double run_s = 0.0;       ///< wall time of the replay
+};
+
+/// The judge, tick by tick: batch replay (Judge below) and the live servo loop feed it the core's
+/// output of every tick, so both give the same verdicts for the same ticks.
+class Judging {
+ public:
+  /// `states`: planned CFs (canonical, at least two); `step_s`: the core's step.
+  Judging(std::vector<std::string> states, const Limits& limits, double step_s);
+
+  /// One tick at t_s. `cf_text` gives the CF's canonical text (core::Core::FormationText()); it is
+  /// called only on a tick whose formation key differs from the last one's.
+  void Tick(double t_s, const core::StepOutput& out, const std::function<std::string()>& cf_text);
+  /// Closes the judgement after the last tick (nothing is judged without a tick).
+  Judgement Finish();
+
+  // The judgement so far (live display).
+  const std::vector<TransitionVerdict>& transitions() const { return j_.transitions; }
+  const std::vector<Observation>& observed() const { return j_.observed; }
+  /// Index of the planned transition under way; states().size() - 1 once all are done.
+  std::size_t at() const { return at_; }
+  bool failed() const { return failed_; }
+  const std::vector<std::string>& states() const { return states_; }
+  const std::string& counted() const { return stable_; }  ///< the last state that counted
+  const std::string& current() const { return raw_; }     ///< the core's state now
+  long ticks() const { return j_.ticks; }
+
+ private:
+  void Fail(std::size_t i, const std::string& reason);
+
+  std::vector<std::string> states_;
+  Limits limits_;
+  double step_s_;
+  int dwell_;
+  Judgement j_;
+  std::size_t n_ = 0, at_ = 0;
+  bool failed_ = false;
+  std::string stable_, raw_;
+  core::FormationKey raw_key_{};
+  int raw_held_ = 0;
+  double raw_since_ = 0.0, raw_energy_ = 0.0, t_first_ = 0.0, t_last_ = 0.0;
+  std::vector<std::string> passed_;
+  core::StepOutput last_{};
+  long stuck_ticks_ = 0;
 };
 
 /// Replays `trajectory` (resampled onto the scene's step) from its first pose and judges

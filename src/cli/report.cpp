@@ -1,0 +1,100 @@
+#include "report.hpp"
+
+#include <iomanip>
+
+#include <tubeplan/plan/perturb.hpp>
+
+namespace tubeplan::cli {
+
+// A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
+// merge of shard reports is the report of the unsharded run.
+nlohmann::json Report(nlohmann::json plans) {
+  std::stable_sort(plans.begin(), plans.end(),
+                   [](const nlohmann::json& a, const nlohmann::json& b) {
+                     return a["file"].get<std::string>() < b["file"].get<std::string>();
+                   });
+  long feasible = 0;
+  for (const nlohmann::json& p : plans) feasible += p["feasible"].get<bool>();
+  const long count = static_cast<long>(plans.size());
+  return {
+      {"tubeplan_evaluate", kEvaluateJsonVersion},
+      {"plans", plans},
+      {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
+}
+
+nlohmann::json ToJson(const std::vector<Evaluated>& results) {
+  nlohmann::json plans = nlohmann::json::array();
+  for (const Evaluated& e : results) {
+    const plan::Judgement& j = e.judgement;
+    nlohmann::json transitions = nlohmann::json::array();
+    for (std::size_t k = 0; k < j.transitions.size(); ++k) {
+      const plan::TransitionVerdict& v = j.transitions[k];
+      transitions.push_back({{"from", v.from},
+                             {"to", v.to},
+                             {"verdict", plan::ToString(v.verdict)},
+                             {"reason", v.reason},
+                             {"detour", v.detour},
+                             {"t_start_s", v.t_start_s},
+                             {"t_end_s", v.t_end_s},
+                             {"peak_force_N", v.peak_force_N},
+                             {"friction_work_J", v.friction_work_J},
+                             {"energy_entry_J", v.energy_entry_J},
+                             {"energy_exit_J", v.energy_exit_J}});
+      if (e.runs > 0) {
+        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+        transitions.back()["monte_carlo"] = {{"runs", e.runs},
+                                             {"feasible", e.robust[k]},
+                                             {"fraction", double(e.robust[k]) / e.runs},
+                                             {"ci95", {ci.low, ci.high}}};
+      }
+    }
+    nlohmann::json observed = nlohmann::json::array();
+    for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
+    plans.push_back({{"plan", e.plan.name},
+                     {"file", e.file},
+                     {"feasible", j.feasible},
+                     {"transitions", transitions},
+                     {"observed", observed},
+                     {"ticks", j.ticks},
+                     {"replayed_s", j.replayed_s}});
+  }
+  return Report(std::move(plans));
+}
+
+void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
+  auto paint = [&](plan::Verdict v, const std::string& text) {
+    if (!colour) return text;
+    const char* code = v == plan::Verdict::kFeasible             ? "\033[32m"
+                       : v == plan::Verdict::kFeasibleWithDetour ? "\033[33m"
+                                                                 : "\033[31m";
+    return std::string(code) + text + "\033[0m";
+  };
+  const std::streamsize precision = t.precision(3);
+  const plan::Judgement& j = e.judgement;
+  t << e.file << " (" << e.plan.name << "): "
+    << paint(j.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible,
+             j.feasible ? "FEASIBLE" : "INFEASIBLE")
+    << ", " << j.transitions.size()
+    << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
+    << " s replayed\n";
+  for (const plan::TransitionVerdict& v : j.transitions) {
+    t << "  " << v.from << " -> " << v.to << ": " << paint(v.verdict, plan::ToString(v.verdict));
+    if (!v.detour.empty()) {
+      t << " via";
+      for (const std::string& d : v.detour) t << " " << d;
+    }
+    if (!v.reason.empty()) t << " (" << v.reason << ")";
+    if (e.runs > 0) {
+      const std::size_t k = std::size_t(&v - j.transitions.data());
+      const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+      t << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
+        << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
+    }
+    t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
+      << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
+      << " -> " << v.energy_exit_J << " J\n";
+  }
+  t.precision(precision);
+}
+
+}  // namespace tubeplan::cli
