@@ -43,9 +43,10 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
   const auto clock_start = std::chrono::steady_clock::now();
   Judgement j;
   const double T = scene.model.time_step_s;
-  const std::vector<HandSample> ticks = Resample(trajectory, T);
+  // One tick at a time (TickStream), not Resample: a long recording is not held twice.
+  TickStream ticks(trajectory, T);
   core::Core core(scene);
-  core.Reset(Pose(ticks.front()));
+  core.Reset(Pose(ticks.Tick(0)));
   const int dwell = std::max(1, static_cast<int>(std::lround(limits.dwell_s / T)));
 
   // Per planned transition i (states[i] -> states[i+1]).
@@ -73,7 +74,8 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
     v.verdict = Verdict::kInfeasible;
   };
 
-  for (const HandSample& sample : ticks) {
+  for (std::size_t k = 0; k < ticks.count(); ++k) {
+    const HandSample sample = ticks.Tick(k);
     const core::StepOutput& out = core.Step(sample.t_s, Pose(sample));
     ++j.ticks;
     // Figures and limits of the transition under way.
@@ -150,7 +152,7 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
     }
   }
 
-  const double t_end = ticks.back().t_s;
+  const double t_end = ticks.TimeOf(ticks.count() - 1);
   if (!failed && at < n) {
     TransitionVerdict& v = j.transitions[at];
     v.t_end_s = t_end;
@@ -180,7 +182,7 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
   }
   j.feasible = std::all_of(j.transitions.begin(), j.transitions.end(),
                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; });
-  j.replayed_s = t_end - ticks.front().t_s;
+  j.replayed_s = t_end - ticks.TimeOf(0);
   j.run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return j;
 }
