@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <iomanip>
 #include <memory>
@@ -70,6 +71,43 @@ std::uint64_t PlanSeed(std::uint64_t seed, const std::string& file) {
   return h;
 }
 
+// Ctrl-C (SIGINT) or SIGTERM during a batch: the plans being judged finish, no new one starts,
+// and no report is written (a report is complete or absent, never half of a batch). A second
+// signal takes the default action at once (SA_RESETHAND), for a user who does not want to wait.
+std::atomic<bool> g_interrupted{false};
+extern "C" void OnInterrupt(int) { g_interrupted.store(true); }
+
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    g_interrupted.store(false);
+    struct sigaction action {};
+    action.sa_handler = OnInterrupt;
+    action.sa_flags = SA_RESETHAND;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, &old_int_);
+    sigaction(SIGTERM, &action, &old_term_);
+    // A signal sent while it was blocked (by a parent's mask, inherited) is delivered now.
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    pthread_sigmask(SIG_UNBLOCK, &set, &old_mask_);
+  }
+  ~InterruptGuard() {
+    pthread_sigmask(SIG_SETMASK, &old_mask_, nullptr);
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+  sigset_t old_mask_{};
+};
+
 int RunEvaluate(const EvaluateOptions& o, Streams io) {
   bool ok = true;
   std::vector<std::string> files = PlanFiles(o.inputs, io.err, ok);
@@ -107,8 +145,10 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   std::atomic<std::size_t> next{0};
   const bool progress = isatty(STDERR_FILENO) != 0 && !o.json;
   std::atomic<std::size_t> done{0};
+  std::atomic<std::size_t> judged{0};
+  const InterruptGuard interrupt_guard;
   auto work = [&] {
-    for (std::size_t i = next++; i < files.size(); i = next++) {
+    for (std::size_t i = next++; i < files.size() && !g_interrupted.load(); i = next++) {
       const io::PlanLoadResult& l = loaded[i];
       Evaluated e{files[i],
                   *l.plan,
@@ -119,7 +159,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       e.robust.assign(e.judgement.transitions.size(), 0);
       e.replayed_s = e.judgement.replayed_s;
       e.run_s = e.judgement.run_s;
-      for (int r = 0; r < o.monte_carlo; ++r) {
+      for (int r = 0; r < o.monte_carlo && !g_interrupted.load(); ++r) {
         const plan::Judgement jr = plan::Judge(
             *l.scene,
             plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(o.seed, files[i]), r),
@@ -129,7 +169,9 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
         e.replayed_s += jr.replayed_s;
         e.run_s += jr.run_s;
       }
+      if (g_interrupted.load()) break;  // a Monte Carlo series cut short is not a result
       results[i] = std::move(e);
+      ++judged;
       if (progress) {
         const std::size_t d = ++done;
         // One short line per plan, on a terminal only (a log stays clean).
@@ -147,6 +189,13 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
 
+  if (judged.load() < files.size()) {
+    io.err << "tubeplan evaluate: interrupted after " << judged.load() << " of " << files.size()
+           << " plans; no report written"
+           << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
+           << "\n";
+    return kExitInterrupted;
+  }
   const nlohmann::json report = ToJson(results);
   if (!o.report_path.empty()) {
     if (const std::string e = io::WriteTextFileAtomically(o.report_path, report.dump(1) + "\n");

@@ -21,6 +21,8 @@ class SeriesWriter {
   /// Appends one tick. `cf_text` is core.FormationText() for that tick.
   void Add(const core::Core& core, const core::StepOutput& out, const std::string& cf_text);
   const std::string& text() const { return text_; }
+  /// Forgets the text written so far (after the caller saved it), keeping the buffer's memory.
+  void Clear() { text_.clear(); }
 
   /// Points of the centreline written with --mesh.
   static constexpr int kMeshPoints = 21;

@@ -9,6 +9,7 @@
 #include <iomanip>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -58,10 +59,21 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   if (!scene.scene || !trajectory.trajectory) return kExitBadInput;
 
   const scene::Scene& s = *scene.scene;
-  const std::vector<plan::HandSample> ticks =
-      plan::Resample(*trajectory.trajectory, s.model.time_step_s);
+  // The series goes to its file as it is made (an hour at 1 kHz is about 2 GB of CSV), into a
+  // temporary file renamed at the end; a directory that cannot be written to is said before the
+  // replay, not after it.
+  std::optional<io::AtomicFile> series_file;
+  if (format != SeriesFormat::kNone) {
+    series_file.emplace(o.out_path);
+    if (!series_file->error().empty()) {
+      io.err << o.out_path << ": error: " << series_file->Commit() << "\n";
+      return kExitBadInput;
+    }
+  }
+  // Ticks one at a time: the resampled trajectory is never held as a second copy.
+  plan::TickStream ticks(*trajectory.trajectory, s.model.time_step_s);
   core::Core core(s);
-  const plan::HandSample& first = ticks.front();
+  const plan::HandSample first = ticks.Tick(0);
   Eigen::Isometry3d X_W_hand0 = Eigen::Isometry3d::Identity();
   X_W_hand0.linear() = first.q_WH.toRotationMatrix();
   X_W_hand0.translation() = first.p_WH_m;
@@ -84,7 +96,9 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   double peak_energy_J = 0.0, peak_torque_Nm = 0.0;
   std::array<long, 6> flag_ticks{};
   double core_s = 0.0, worst_tick_s = 0.0;
-  for (const plan::HandSample& sample : ticks) {
+  constexpr std::size_t kSeriesChunkBytes = std::size_t{1} << 20;
+  for (std::size_t k = 0; k < ticks.count(); ++k) {
+    const plan::HandSample sample = ticks.Tick(k);
     Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
     X_W_hand.linear() = sample.q_WH.toRotationMatrix();
     X_W_hand.translation() = sample.p_WH_m;
@@ -104,21 +118,26 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     for (int b = 0; b < 6; ++b)
       if (out.flags & (1u << b)) ++flag_ticks[std::size_t(b)];
     writer.Add(core, out, cf_text);
+    if (series_file && writer.text().size() >= kSeriesChunkBytes) {
+      series_file->Write(writer.text());
+      writer.Clear();
+    }
   }
-  if (format != SeriesFormat::kNone) {
-    const std::string error = io::WriteTextFileAtomically(o.out_path, writer.text());
-    if (!error.empty()) {
+  if (series_file) {
+    series_file->Write(writer.text());
+    if (const std::string error = series_file->Commit(); !error.empty()) {
       io.err << o.out_path << ": error: " << error << "\n";
       return kExitBadInput;
     }
   }
 
-  const double duration_s = ticks.back().t_s - ticks.front().t_s;
+  const std::size_t tick_count = ticks.count();
+  const double duration_s = ticks.TimeOf(tick_count - 1) - ticks.TimeOf(0);
   if (o.json) {
     nlohmann::json j;
     j["scene"] = o.scene_path;
     j["trajectory"] = o.trajectory_path;
-    j["ticks"] = ticks.size();
+    j["ticks"] = tick_count;
     j["time_step_s"] = s.model.time_step_s;
     j["duration_s"] = duration_s;
     j["capsules"] = core.capsule_count();
@@ -138,7 +157,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     for (int b = 0; b < 6; ++b) flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
     j["flag_ticks"] = flags;
     j["run_time_s"] = core_s;
-    j["mean_tick_us"] = 1e6 * core_s / static_cast<double>(ticks.size());
+    j["mean_tick_us"] = 1e6 * core_s / static_cast<double>(tick_count);
     j["worst_tick_us"] = 1e6 * worst_tick_s;
     if (!o.out_path.empty()) j["out"] = o.out_path;
     io.out << j.dump(2) << "\n";
@@ -146,7 +165,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   }
   std::ostringstream text;
   text << std::setprecision(4);
-  text << o.scene_path << " + " << o.trajectory_path << ": " << ticks.size() << " ticks of "
+  text << o.scene_path << " + " << o.trajectory_path << ": " << tick_count << " ticks of "
        << s.model.time_step_s * 1e3 << " ms (" << duration_s << " s), " << core.capsule_count()
        << " capsules\n";
   text << "contact formations, in order (t = entry time):\n";
@@ -169,7 +188,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     }
   text << (any ? "" : " none") << "\n";
   text << "core run time " << core_s * 1e3 << " ms: mean "
-       << 1e6 * core_s / static_cast<double>(ticks.size()) << " us per tick, worst "
+       << 1e6 * core_s / static_cast<double>(tick_count) << " us per tick, worst "
        << 1e6 * worst_tick_s << " us\n";
   if (!o.out_path.empty()) text << "series written to " << o.out_path << "\n";
   io.out << text.str();

@@ -31,18 +31,33 @@ void ReadLimits(Reader& r, const YAML::Node& node, plan::Limits& l) {
 
 }  // namespace
 
-PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
+PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& display_name,
                             const std::filesystem::path& directory) {
   PlanLoadResult result;
   Reader r(display_name, result.diagnostics);
   plan::Plan p;
+  if (yaml_text.size() > kMaxYamlBytes) {
+    result.diagnostics.Error(display_name, 0, 0,
+                             "the file is " + std::to_string(yaml_text.size() >> 20) +
+                                 " MiB, expected a YAML plan file of at most " +
+                                 std::to_string(kMaxYamlBytes >> 20) + " MiB");
+    return result;
+  }
+  if (!CheckInputText(yaml_text, display_name, "a YAML plan file", result.diagnostics))
+    return result;
   YAML::Node root;
   try {
     root = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
+    r.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +
+                        " levels, expected a plan file (a few levels deep)");
+    return result;
   } catch (const YAML::Exception& e) {
     r.Error(e.mark, e.msg + ", expected valid YAML");
     return result;
   }
+  if (!CheckYamlShape(r, root, "a plan file")) return result;
   if (!root.IsMap()) {
     r.Error(root, std::string("a plan file must be a map, found ") + KindName(root) +
                       ", expected keys such as tubeplan, plan, scene, trajectory, states");
@@ -51,7 +66,8 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
   r.ExpectMap(root, "plan file", {"tubeplan", "plan", "scene", "trajectory", "states", "limits"});
   if (const YAML::Node n = r.Get(root, "tubeplan", "plan file", true); n.IsDefined()) {
     if (!n.IsScalar() || n.Scalar() != "1")
-      r.Error(n, "unsupported format version " + (n.IsScalar() ? n.Scalar() : KindName(n)) +
+      r.Error(n, "unsupported format version " +
+                     (n.IsScalar() ? Abbreviate(n.Scalar()) : std::string(KindName(n))) +
                      ", expected 1");
   }
   if (const YAML::Node n = r.Get(root, "plan", "plan file", true); n.IsDefined())
@@ -66,7 +82,8 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
     std::string full;
     std::string text;
   };
-  auto read_named = [&](const char* key, const char* expected, std::string& target) {
+  auto read_named = [&](const char* key, const char* expected, std::uintmax_t max_bytes,
+                        std::string& target) {
     std::optional<Named> named;
     const YAML::Node n = r.Get(root, key, "plan file", true);
     if (!n.IsDefined()) return named;
@@ -74,24 +91,26 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
     if (!path) return named;
     target = *path;
     const std::filesystem::path full = directory / *path;
-    if (std::optional<std::string> text = ReadTextFile(full)) {
-      named = Named{n, full.string(), std::move(*text)};
+    ReadResult read = ReadInputFile(full, max_bytes);
+    if (read.text) {
+      named = Named{n, full.string(), std::move(*read.text)};
     } else {
-      r.Error(n, std::string(key) + ": cannot read '" + full.string() + "', expected " + expected);
+      r.Error(n, std::string(key) + ": cannot read '" + full.string() + "' (" + read.error +
+                     "), expected " + expected);
     }
     return named;
   };
   // The scene first: the states are checked against its elements.
   std::optional<scene::Scene> scene;
-  if (const auto named =
-          read_named("scene", "a scene file path relative to the plan file", p.scene)) {
+  if (const auto named = read_named("scene", "a scene file path relative to the plan file",
+                                    kMaxYamlBytes, p.scene)) {
     SceneLoadResult loaded = LoadSceneText(named->text, named->full);
     result.diagnostics.Append(loaded.diagnostics);
     if (!loaded.scene) r.Error(named->node, "scene: '" + named->full + "' has errors (listed)");
     scene = std::move(loaded.scene);
   }
   if (const auto named = read_named("trajectory", "a trajectory CSV path relative to the plan file",
-                                    p.trajectory)) {
+                                    kMaxInputBytes, p.trajectory)) {
     TrajectoryLoadResult loaded = LoadTrajectoryText(named->text, named->full);
     result.diagnostics.Append(loaded.diagnostics);
     if (!loaded.trajectory)
@@ -140,15 +159,42 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
   return result;
 }
 
-PlanLoadResult LoadPlanFile(const std::filesystem::path& path) {
-  const std::optional<std::string> text = ReadTextFile(path);
-  if (!text) {
+PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
+                            const std::filesystem::path& directory) {
+  try {
+    return ReadPlanText(yaml_text, display_name, directory);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
     PlanLoadResult result;
-    result.diagnostics.Error(path.string(), 0, 0,
-                             "cannot read file, expected a readable YAML plan file");
+    Reader r(display_name, result.diagnostics);
+    r.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +
+                        " levels, expected a plan file (a few levels deep)");
+    return result;
+  } catch (const YAML::Exception& e) {
+    PlanLoadResult result;
+    Reader r(display_name, result.diagnostics);
+    r.Error(e.mark, e.msg + ", expected valid YAML");
+    return result;
+  } catch (const std::exception& e) {
+    // Not expected: the reader checks every node's type before converting it. Still a file
+    // problem for the user, never a crash.
+    PlanLoadResult result;
+    result.diagnostics.Error(display_name, 0, 0,
+                             std::string("could not read the plan: ") + e.what());
     return result;
   }
-  return LoadPlanText(*text, path.string(), path.parent_path());
+}
+
+PlanLoadResult LoadPlanFile(const std::filesystem::path& path) {
+  const ReadResult read = ReadInputFile(path, kMaxYamlBytes);
+  if (!read.text) {
+    PlanLoadResult result;
+    result.diagnostics.Error(
+        path.string(), 0, 0,
+        "cannot read file (" + read.error + "), expected a readable YAML plan file");
+    return result;
+  }
+  return LoadPlanText(*read.text, path.string(), path.parent_path());
 }
 
 }  // namespace tubeplan::io

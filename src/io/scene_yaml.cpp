@@ -12,6 +12,7 @@
 #include <sstream>
 #include <utility>
 
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <tubeplan/core/coupling.hpp>
@@ -310,7 +311,8 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   r.ExpectMap(root, "scene", top);
   if (const YAML::Node n = r.Get(root, "tubeplan", "scene", true); n.IsDefined()) {
     if (!n.IsScalar() || n.Scalar() != "1") {
-      r.Error(n, "unsupported format version " + (n.IsScalar() ? n.Scalar() : KindName(n)) +
+      r.Error(n, "unsupported format version " +
+                     (n.IsScalar() ? Abbreviate(n.Scalar()) : std::string(KindName(n))) +
                      ", expected 1");
     }
   }
@@ -441,9 +443,22 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
   SceneLoadResult result;
   Reader reader(display_name, result.diagnostics);
   scene::Scene s;
+  if (yaml_text.size() > kMaxYamlBytes) {
+    result.diagnostics.Error(display_name, 0, 0,
+                             "the file is " + std::to_string(yaml_text.size() >> 20) +
+                                 " MiB, expected a YAML scene file of at most " +
+                                 std::to_string(kMaxYamlBytes >> 20) + " MiB");
+    return result;
+  }
+  if (!CheckInputText(yaml_text, display_name, "a YAML scene file", result.diagnostics))
+    return result;
   try {
     const YAML::Node root = YAML::Load(std::string(yaml_text));
-    ReadScene(reader, root, s);
+    if (CheckYamlShape(reader, root, "a scene file")) ReadScene(reader, root, s);
+  } catch (const YAML::DeepRecursion& e) {
+    // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
+    reader.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +
+                             " levels, expected a scene file (a few levels deep)");
   } catch (const YAML::Exception& e) {
     reader.Error(e.mark, e.msg + ", expected valid YAML");
   } catch (const std::exception& e) {
@@ -457,14 +472,15 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
 }
 
 SceneLoadResult LoadSceneFile(const std::filesystem::path& path) {
-  const std::optional<std::string> text = ReadTextFile(path);
-  if (!text) {
+  const ReadResult read = ReadInputFile(path, kMaxYamlBytes);
+  if (!read.text) {
     SceneLoadResult result;
-    result.diagnostics.Error(path.string(), 0, 0,
-                             "cannot read file, expected a readable YAML scene file");
+    result.diagnostics.Error(
+        path.string(), 0, 0,
+        "cannot read file (" + read.error + "), expected a readable YAML scene file");
     return result;
   }
-  return LoadSceneText(*text, path.string());
+  return LoadSceneText(*read.text, path.string());
 }
 
 }  // namespace tubeplan::io

@@ -1,49 +1,256 @@
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <csignal>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <sstream>
-#include <system_error>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <tubeplan/io/text_file.hpp>
 
 namespace tubeplan::io {
+namespace {
+
+std::string MiB(std::uintmax_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
+// Closes a file descriptor when it goes out of scope.
+struct Fd {
+  int fd = -1;
+  ~Fd() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+}  // namespace
+
+ReadResult ReadInputFile(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  ReadResult result;
+  // O_NONBLOCK: opening a FIFO nobody writes to must not block; a regular file ignores it.
+  Fd in{::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
+  if (in.fd < 0) {
+    result.error = errno == ENOENT ? "no such file" : std::strerror(errno);
+    return result;
+  }
+  struct stat info {};
+  if (::fstat(in.fd, &info) != 0) {
+    result.error = std::strerror(errno);
+    return result;
+  }
+  if (S_ISDIR(info.st_mode)) {
+    result.error = "it is a directory";
+    return result;
+  }
+  if (!S_ISREG(info.st_mode)) {
+    result.error = "it is not a regular file (a device, FIFO or socket)";
+    return result;
+  }
+  const auto size = static_cast<std::uintmax_t>(info.st_size);
+  if (size > max_bytes) {
+    result.error = "it is " + MiB(size) + ", more than the " + MiB(max_bytes) + " allowed";
+    return result;
+  }
+  std::string text(static_cast<std::size_t>(size), '\0');
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::read(in.fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      result.error = std::strerror(errno);
+      return result;
+    }
+    if (n == 0) break;  // the file shrank while we read it: what is there is what we have
+    done += static_cast<std::size_t>(n);
+  }
+  text.resize(done);
+  result.text = std::move(text);
+  return result;
+}
 
 std::optional<std::string> ReadTextFile(const std::filesystem::path& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) return std::nullopt;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return std::nullopt;
-  std::ostringstream text;
-  text << in.rdbuf();  // an empty file sets failbit on `text`, which is fine: it is ""
-  if (in.bad()) return std::nullopt;
-  return text.str();
+  return ReadInputFile(path).text;
+}
+
+std::string Abbreviate(std::string_view text, std::size_t max_bytes) {
+  if (text.size() <= max_bytes) return std::string(text);
+  std::size_t cut = max_bytes;
+  // Back up over UTF-8 continuation bytes (10xxxxxx) so a multi-byte character stays whole.
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+  return std::string(text.substr(0, cut)) + "...";
+}
+
+bool CheckInputText(std::string_view text, const std::string& display_name,
+                    std::string_view expected, Diagnostics& diagnostics) {
+  const std::string expect(expected);
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
+    diagnostics.Error(display_name, 0, 0,
+                      std::string(text.empty() ? "the file is empty" : "the file is blank") +
+                          ", expected " + expect);
+    return false;
+  }
+  // Byte-order marks of the encodings a Windows editor may save in.
+  auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
+  const char* wide = nullptr;
+  if (starts(std::string_view("\xFF\xFE\x00\x00", 4)) ||
+      starts(std::string_view("\x00\x00\xFE\xFF", 4))) {
+    wide = "UTF-32";
+  } else if (starts("\xFF\xFE") || starts("\xFE\xFF")) {
+    wide = "UTF-16";
+  }
+  if (wide != nullptr) {
+    diagnostics.Error(display_name, 1, 1,
+                      std::string("the file is ") + wide +
+                          " (it starts with a byte-order mark), expected UTF-8 text: " + expect);
+    return false;
+  }
+  bool ok = true;
+  bool reported_nul = false, reported_utf8 = false, reported_long = false;
+  int line = 1;
+  std::size_t line_start = 0;
+  const auto column = [&](std::size_t at) { return static_cast<int>(at - line_start) + 1; };
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n;) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == '\n') {
+      ++line;
+      line_start = ++i;
+      continue;
+    }
+    if (!reported_long && i - line_start >= kMaxLineBytes) {
+      const std::size_t end = std::min(n, text.find('\n', i));
+      diagnostics.Error(display_name, line, 1,
+                        "line " + std::to_string(line) + " is " + std::to_string(end - line_start) +
+                            " bytes long, expected at most " + std::to_string(kMaxLineBytes) +
+                            " bytes per line in " + expect);
+      reported_long = true;
+      ok = false;
+    }
+    if (c == 0) {
+      if (!reported_nul) {
+        diagnostics.Error(display_name, line, column(i),
+                          "a NUL byte: this is a binary file, expected UTF-8 text: " + expect);
+        reported_nul = true;
+      }
+      ok = false;
+      ++i;
+      continue;
+    }
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    // A multi-byte UTF-8 sequence: its length from the lead byte, then the shortest-form and
+    // range rules (no overlong forms, no surrogates, nothing above U+10FFFF).
+    std::size_t length = 0;
+    unsigned lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
+    if (c >= 0xC2 && c <= 0xDF) {
+      length = 2;
+    } else if (c >= 0xE0 && c <= 0xEF) {
+      length = 3;
+      if (c == 0xE0) lo = 0xA0;
+      if (c == 0xED) hi = 0x9F;
+    } else if (c >= 0xF0 && c <= 0xF4) {
+      length = 4;
+      if (c == 0xF0) lo = 0x90;
+      if (c == 0xF4) hi = 0x8F;
+    }
+    bool valid = length > 0 && i + length <= n;
+    for (std::size_t k = 1; valid && k < length; ++k) {
+      const auto b = static_cast<unsigned char>(text[i + k]);
+      valid = k == 1 ? (b >= lo && b <= hi) : (b >= 0x80 && b <= 0xBF);
+    }
+    if (!valid) {
+      if (!reported_utf8) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", c);
+        diagnostics.Error(
+            display_name, line, column(i),
+            std::string("invalid UTF-8 (byte ") + hex + "), expected UTF-8 text: " + expect);
+        reported_utf8 = true;
+      }
+      ok = false;
+      ++i;
+      continue;
+    }
+    i += length;
+  }
+  return ok;
+}
+
+AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
+  // Same directory, so the rename is atomic (same file system); the pid and a counter keep two
+  // writers of one path (processes or threads) from sharing a temporary file.
+  static std::atomic<unsigned> counter{0};
+  temporary_ = path_;
+  temporary_ += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  // A write past RLIMIT_FSIZE raises SIGXFSZ, whose default action kills the process and leaves
+  // the temporary behind; ignored, the write fails with EFBIG and is reported like a full disk.
+  std::signal(SIGXFSZ, SIG_IGN);
+  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) error_ = "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_ && (fd_ >= 0 || !error_.empty())) ::unlink(temporary_.c_str());
+}
+
+void AtomicFile::Fail(const char* what, int error) {
+  if (!error_.empty()) return;
+  error_ = std::string(what) + " " + temporary_.string() + ": " + std::strerror(error);
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  ::unlink(temporary_.c_str());
+}
+
+bool AtomicFile::Write(std::string_view text) {
+  bytes_ += text.size();  // what was asked: the room a retry needs
+  if (!error_.empty()) return false;
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      Fail("cannot write", errno);
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+std::string AtomicFile::Commit() {
+  if (error_.empty()) {
+    // fsync before the rename: after a power cut the file is either the old one or the new one
+    // whole, never a new name for blocks that never reached the disk.
+    if (::fsync(fd_) != 0 && errno != EINVAL) {
+      Fail("cannot write", errno);
+    } else {
+      const int fd = fd_;
+      fd_ = -1;
+      if (::close(fd) != 0) {
+        Fail("cannot write", errno);
+      } else if (::rename(temporary_.c_str(), path_.c_str()) != 0) {
+        const int error = errno;
+        ::unlink(temporary_.c_str());
+        error_ = "cannot rename " + temporary_.string() + " to " + path_.string() + ": " +
+                 std::strerror(error);
+      } else {
+        committed_ = true;
+        return {};
+      }
+    }
+  }
+  return error_ + "; nothing was written (" + path_.string() +
+         " is as it was), expected a writable directory with room for " + std::to_string(bytes_) +
+         " bytes";
 }
 
 std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text) {
-  // Same directory, so the rename is atomic (same file system); the pid keeps two concurrent
-  // writers of one path from sharing a temporary file.
-  std::filesystem::path temporary = path;
-  temporary += ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) return "cannot create " + temporary.string() + ": " + std::strerror(errno);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      return "cannot write " + temporary.string() + ": " + std::strerror(errno);
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    return "cannot rename " + temporary.string() + " to " + path.string() + ": " + ec.message();
-  }
-  return {};
+  AtomicFile file(path);
+  file.Write(text);
+  return file.Commit();
 }
 
 StreamingTextFile::~StreamingTextFile() {

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -64,6 +66,17 @@ class Collector {
   int count_ = 0;
 };
 
+// YAML's spellings of NaN and infinity (.nan, .NaN, .inf, -.Inf, +.INF), which from_chars
+// does not know: worth a message of their own rather than "not a number".
+bool IsYamlNonFinite(std::string_view text) {
+  if (!text.empty() && (text.front() == '-' || text.front() == '+')) text.remove_prefix(1);
+  if (text.size() != 4 || text.front() != '.') return false;
+  std::string lower;
+  for (const char c : text.substr(1))
+    lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return lower == "nan" || lower == "inf";
+}
+
 std::string Number(double v) {
   std::ostringstream s;
   s << v;
@@ -75,8 +88,20 @@ std::string Number(double v) {
 TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string& display_name,
                                         const TrajectoryLoadOptions& options) {
   TrajectoryLoadResult result;
+  if (!CheckInputText(text, display_name, "a trajectory CSV (t,px,py,pz,qw,qx,qy,qz)",
+                      result.diagnostics))
+    return result;
+  // A spreadsheet may save CSV with a UTF-8 byte-order mark; editors hide it, so columns are
+  // counted after it.
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
   Collector errors(display_name, result.diagnostics);
   plan::Trajectory trajectory;
+  // At most one sample per line: reserving that bound once avoids the vector's doublings, each
+  // of which briefly holds the old and the new array (3x the samples' size at the peak).
+  // The shortest row ("0,0,0,0,1,0,0,0\n") is 16 bytes, which bounds a file of blank lines.
+  trajectory.samples.reserve(
+      std::min(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1,
+               text.size() / 16 + 1));
   double position_scale = 1.0;
   bool have_header = false;
   std::array<std::size_t, 8> pose_index{};
@@ -147,7 +172,7 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
           pose = true;
           if (found[c]) {
             errors.Error(line_number, fields[i].column,
-                         "column '" + std::string(fields[i].text) +
+                         "column '" + Abbreviate(fields[i].text) +
                              "' appears twice, expected each column once");
             rows_ok = false;
           }
@@ -167,8 +192,13 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
       for (std::size_t c = 0; c < kPoseColumns.size(); ++c)
         if (!found[c]) missing += (missing.empty() ? "" : ", ") + std::string(kPoseColumns[c]);
       if (!missing.empty()) {
+        // A scene or plan given where a trajectory belongs: say so rather than list columns.
+        const bool yaml = fields.size() == 1 && content.find(':') != std::string_view::npos;
         errors.Error(line_number, 1,
-                     "the header lacks column(s) " + missing +
+                     (yaml ? std::string("this looks like YAML (a scene or plan file?), not a "
+                                         "trajectory: the header lacks column(s) ")
+                           : std::string("the header lacks column(s) ")) +
+                         missing +
                          ", expected t,px,py,pz,qw,qx,qy,qz (in any order, more allowed)");
         rows_ok = false;
         break;  // rows cannot be read without their columns
@@ -192,10 +222,28 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
       const char* first = f.text.data();
       const char* last = first + f.text.size();
       if (!f.text.empty() && *first == '+') ++first;
-      const auto [ptr, ec] = std::from_chars(first, last, v);
-      if (f.text.empty() || ec != std::errc() || ptr != last) {
+      auto [ptr, ec] = std::from_chars(first, last, v);
+      if (ec == std::errc::result_out_of_range && ptr == last) {
+        // from_chars says out of range for overflow and underflow alike and leaves v unset: an
+        // underflow (a negative exponent) is zero, an overflow is not a finite number.
+        const std::string_view digits(first, static_cast<std::size_t>(last - first));
+        const std::size_t e = digits.find_first_of("eE");
+        if (e != std::string_view::npos && e + 1 < digits.size() && digits[e + 1] == '-') {
+          v = digits.front() == '-' ? -0.0 : 0.0;
+          ec = std::errc();
+        } else {
+          v = HUGE_VAL;  // reported below as not finite
+          ec = std::errc();
+        }
+      }
+      if (IsYamlNonFinite(f.text)) {
         errors.Error(line_number, f.column,
-                     "'" + std::string(f.text) + "' is not a number, expected a decimal number");
+                     "'" + Abbreviate(f.text) +
+                         "' is not a finite number, expected a finite decimal number");
+        row_ok = false;
+      } else if (f.text.empty() || ec != std::errc() || ptr != last) {
+        errors.Error(line_number, f.column,
+                     "'" + Abbreviate(f.text) + "' is not a number, expected a decimal number");
         row_ok = false;
       } else if (!std::isfinite(v)) {
         errors.Error(line_number, f.column, "the number is not finite, expected a finite number");
@@ -239,9 +287,12 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
     have_previous = true;
     previous_t = s.t_s;
     trajectory.samples.push_back(s);
-    std::vector<double> extra;
-    for (const std::size_t i : extra_index) extra.push_back(values[i]);
-    trajectory.extra_values.push_back(std::move(extra));
+    if (!extra_index.empty()) {
+      std::vector<double> extra;
+      extra.reserve(extra_index.size());
+      for (const std::size_t i : extra_index) extra.push_back(values[i]);
+      trajectory.extra_values.push_back(std::move(extra));
+    }
     if (newline == std::string_view::npos) break;
   }
   if (!have_header) {
@@ -258,14 +309,15 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
 
 TrajectoryLoadResult LoadTrajectoryFile(const std::filesystem::path& path,
                                         const TrajectoryLoadOptions& options) {
-  const std::optional<std::string> text = ReadTextFile(path);
-  if (!text) {
+  const ReadResult read = ReadInputFile(path);
+  if (!read.text) {
     TrajectoryLoadResult result;
-    result.diagnostics.Error(path.string(), 0, 0,
-                             "cannot read file, expected a readable CSV trajectory");
+    result.diagnostics.Error(
+        path.string(), 0, 0,
+        "cannot read file (" + read.error + "), expected a readable CSV trajectory");
     return result;
   }
-  return LoadTrajectoryText(*text, path.string(), options);
+  return LoadTrajectoryText(*read.text, path.string(), options);
 }
 
 }  // namespace tubeplan::io

@@ -7,10 +7,12 @@
 // A '/' divides only the factor right after it: "N/mm" = N mm^-1, "N s/m" = N s m^-1,
 // "kg/m/s" = kg m^-1 s^-1.
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <numbers>
 
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 
 namespace tubeplan::io {
@@ -179,9 +181,19 @@ QuantityResult Parse(std::string_view text, std::size_t& unit_offset) {
   if (ec == std::errc::invalid_argument || ptr == first) {
     std::size_t word_end = i;
     while (word_end < end && !IsSpace(text[word_end])) ++word_end;
-    return Fail(number_start, "expected a number, found '" +
-                                  std::string(text.substr(number_start, word_end - number_start)) +
-                                  "'");
+    const std::string_view word = text.substr(number_start, word_end - number_start);
+    // YAML's own spellings of NaN and infinity (.nan, .NaN, .inf, -.Inf) are not numbers to
+    // from_chars; they deserve the same message as nan and inf.
+    std::string_view bare = word;
+    if (!bare.empty() && (bare.front() == '-' || bare.front() == '+')) bare.remove_prefix(1);
+    if (bare.size() == 4 && bare.front() == '.') {
+      std::string lower;
+      for (const char c : bare.substr(1))
+        lower += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (lower == "nan" || lower == "inf")
+        return Fail(number_start, "the number is not finite, expected a finite number");
+    }
+    return Fail(number_start, "expected a number, found '" + Abbreviate(word) + "'");
   }
   if (ec == std::errc::result_out_of_range) {
     // from_chars says out of range for both overflow and underflow and leaves value unset. A
@@ -239,7 +251,7 @@ QuantityResult Parse(std::string_view text, std::size_t& unit_offset) {
     double factor = 1.0;
     const Symbol* symbol = FindSymbol(word, factor);
     if (symbol == nullptr) {
-      return Fail(word_start, "unknown unit '" + std::string(word) + "', expected one of " +
+      return Fail(word_start, "unknown unit '" + Abbreviate(word) + "', expected one of " +
                                   std::string(kKnownUnits));
     }
     int power = 1;
@@ -287,7 +299,7 @@ QuantityResult ParseQuantityAs(std::string_view text, Dimension expected) {
   if (q.dimension == expected) return result;
   std::string_view unit = text.substr(unit_offset);
   while (!unit.empty() && IsSpace(unit.back())) unit.remove_suffix(1);
-  return Fail(unit_offset, "has a unit of " + Describe(q.dimension) + " (" + std::string(unit) +
+  return Fail(unit_offset, "has a unit of " + Describe(q.dimension) + " (" + Abbreviate(unit) +
                                "), expected a " + Describe(expected) + " such as " +
                                ExampleUnit(expected));
 }

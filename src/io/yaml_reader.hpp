@@ -10,9 +10,11 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
 #include <tubeplan/io/diagnostics.hpp>
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
 #include <tubeplan/states/contact_formation.hpp>
@@ -106,12 +108,12 @@ class Reader {
       }
       const std::string key = entry.first.Scalar();
       if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-        Error(entry.first, "unknown key '" + key + "' in '" + where + "'" +
+        Error(entry.first, "unknown key '" + Abbreviate(key) + "' in '" + where + "'" +
                                Suggestion(key, allowed) + " (expected one of: " + Join(allowed) +
                                ")");
       } else if (!seen.insert(key).second) {
         Error(entry.first,
-              "duplicate key '" + key + "' in '" + where + "', expected each key once");
+              "duplicate key '" + Abbreviate(key) + "' in '" + where + "', expected each key once");
       }
     }
     return true;
@@ -223,7 +225,7 @@ class Reader {
       if (name == *text) return value;
       names.push_back(name);
     }
-    Error(node, what + " '" + *text + "' is not known" + Suggestion(*text, names) +
+    Error(node, what + " '" + Abbreviate(*text) + "' is not known" + Suggestion(*text, names) +
                     " (expected one of: " + Join(names) + ")");
     return std::nullopt;
   }
@@ -232,5 +234,47 @@ class Reader {
   const std::string& file_;
   Diagnostics& diag_;
 };
+
+/// Scenes and plans nest four levels deep and hold a few hundred nodes. yaml-cpp shares an
+/// aliased node instead of copying it, so loading a "billion laughs" (each anchor naming ten
+/// aliases of the one before) is cheap, but anything that walks the document visits every alias
+/// again: nine levels are a billion visits. These bounds refuse such documents before a reader
+/// walks them, in time proportional to the bounds, not to the expansion.
+inline constexpr int kMaxYamlDepth = 64;
+inline constexpr std::size_t kMaxYamlNodes = 100000;
+
+namespace detail {
+inline bool WalkYaml(Reader& r, const YAML::Node& node, int depth, std::size_t& visited,
+                     const std::string& expected) {
+  if (++visited > kMaxYamlNodes) {
+    r.Error(node, "the document expands to more than " + std::to_string(kMaxYamlNodes) +
+                      " nodes (aliases repeat what they name: a 'billion laughs'?), expected " +
+                      expected + " of ordinary size");
+    return false;
+  }
+  if (depth > kMaxYamlDepth) {
+    r.Error(node, "nesting deeper than " + std::to_string(kMaxYamlDepth) + " levels, expected " +
+                      expected + " (a few levels deep)");
+    return false;
+  }
+  if (node.IsSequence()) {
+    for (const YAML::Node& item : node)
+      if (!WalkYaml(r, item, depth + 1, visited, expected)) return false;
+  } else if (node.IsMap()) {
+    for (const auto& entry : node) {
+      if (!WalkYaml(r, entry.first, depth + 1, visited, expected)) return false;
+      if (!WalkYaml(r, entry.second, depth + 1, visited, expected)) return false;
+    }
+  }
+  return true;
+}
+}  // namespace detail
+
+/// Checks the loaded document against kMaxYamlDepth and kMaxYamlNodes (counting a node once
+/// for every alias that reaches it); reports the first bound exceeded and returns false.
+inline bool CheckYamlShape(Reader& r, const YAML::Node& root, const std::string& expected) {
+  std::size_t visited = 0;
+  return detail::WalkYaml(r, root, 0, visited, expected);
+}
 
 }  // namespace tubeplan::io

@@ -181,13 +181,16 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits) {
   const auto clock_start = std::chrono::steady_clock::now();
   const double T = scene.model.time_step_s;
-  const std::vector<HandSample> ticks = Resample(trajectory, T);
+  // One tick at a time (TickStream), not Resample: a long recording is not held twice.
+  TickStream ticks(trajectory, T);
   core::Core core(scene);
-  core.Reset(Pose(ticks.front()));
+  core.Reset(Pose(ticks.Tick(0)));
   Judging judging(states, limits, T);
   const auto text = [&core] { return core.FormationText(); };
-  for (const HandSample& sample : ticks)
+  for (std::size_t k = 0; k < ticks.count(); ++k) {
+    const HandSample sample = ticks.Tick(k);
     judging.Tick(sample.t_s, core.Step(sample.t_s, Pose(sample)), text);
+  }
   Judgement j = judging.Finish();
   j.run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return j;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -43,26 +44,32 @@ HandSample PoseAt(const Trajectory& trajectory, double t_s, std::size_t& cursor)
   return Interpolate(v[cursor], v[cursor + 1], t_s);
 }
 
-std::vector<HandSample> Resample(const Trajectory& trajectory, double step_s) {
+TickStream::TickStream(const Trajectory& trajectory, double step_s)
+    : trajectory_(trajectory), step_s_(step_s) {
   if (!(step_s > 0.0) || !std::isfinite(step_s))
     throw std::invalid_argument("Resample: the step must be a finite time greater than zero");
   if (trajectory.samples.size() < 2)
     throw std::invalid_argument("Resample: a trajectory needs at least two samples");
-  const double t0 = trajectory.samples.front().t_s;
-  const double duration = trajectory.samples.back().t_s - t0;
+  t0_ = trajectory.samples.front().t_s;
+  const double duration = trajectory.samples.back().t_s - t0_;
   // 1e-9 of a step: a recorder's time stamps are rounded; a last sample meant to be on the grid
   // must not be lost to that rounding.
-  const auto count = static_cast<std::size_t>(std::floor(duration / step_s + 1e-9)) + 1;
+  count_ = static_cast<std::size_t>(std::floor(duration / step_s + 1e-9)) + 1;
+}
+
+HandSample TickStream::Tick(std::size_t k) {
+  // t0 + k T rather than an accumulated sum: no drift over long recordings.
+  const double t = std::min(TimeOf(k), trajectory_.samples.back().t_s);
+  HandSample sample = PoseAt(trajectory_, t, cursor_);
+  sample.t_s = TimeOf(k);
+  return sample;
+}
+
+std::vector<HandSample> Resample(const Trajectory& trajectory, double step_s) {
+  TickStream ticks(trajectory, step_s);
   std::vector<HandSample> out;
-  out.reserve(count);
-  std::size_t cursor = 0;
-  for (std::size_t k = 0; k < count; ++k) {
-    // t0 + k T rather than an accumulated sum: no drift over long recordings.
-    const double t = std::min(t0 + static_cast<double>(k) * step_s, trajectory.samples.back().t_s);
-    HandSample sample = PoseAt(trajectory, t, cursor);
-    sample.t_s = t0 + static_cast<double>(k) * step_s;
-    out.push_back(sample);
-  }
+  out.reserve(ticks.count());
+  for (std::size_t k = 0; k < ticks.count(); ++k) out.push_back(ticks.Tick(k));
   return out;
 }
 

@@ -74,7 +74,15 @@ ParseResult Fail(std::size_t offset, std::string message) {
   return ParseResult{std::nullopt, ParseError{offset, std::move(message)}};
 }
 
-std::string Quote(std::string_view s) { return "\"" + std::string(s) + "\""; }
+// A word as it appears in a message; a word of a megabyte is cut (never inside a UTF-8
+// sequence) so that the message stays a line.
+std::string Quote(std::string_view s) {
+  constexpr std::size_t kMaxShown = 40;
+  if (s.size() <= kMaxShown) return "\"" + std::string(s) + "\"";
+  std::size_t cut = kMaxShown;
+  while (cut > 0 && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) --cut;
+  return "\"" + std::string(s.substr(0, cut)) + "...\"";
+}
 
 }  // namespace
 

@@ -261,5 +261,6 @@ TEST_CASE("check: trajectories are checked by their .csv extension", "[cli]") {
   const Outcome missing = RunTool({"check", "no/such.csv"});
   CHECK(missing.exit_code == 2);
   CHECK(missing.err ==
-        "no/such.csv: error: cannot read file, expected a readable CSV trajectory\n");
+        "no/such.csv: error: cannot read file (no such file), expected a readable CSV "
+        "trajectory\n");
 }

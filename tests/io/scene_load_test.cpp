@@ -236,7 +236,8 @@ TEST_CASE("An unreadable file is one error for the whole file", "[scene]") {
   const auto loaded = LoadSceneFile("no/such/scene.yaml");
   CHECK_FALSE(loaded.scene);
   CHECK(loaded.diagnostics.FormatAll() ==
-        "no/such/scene.yaml: error: cannot read file, expected a readable YAML scene file\n");
+        "no/such/scene.yaml: error: cannot read file (no such file), expected a readable YAML "
+        "scene file\n");
 }
 
 TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {

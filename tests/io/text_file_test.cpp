@@ -42,3 +42,48 @@ TEST_CASE("Reading: empty files are empty text, directories and missing files ar
   CHECK_FALSE(tubeplan::io::ReadTextFile(dir / "missing.txt").has_value());
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("An atomic file abandoned before its commit leaves nothing behind", "[files]") {
+  const auto dir = ScratchDir();
+  const auto path = dir / "series.csv";
+  {
+    tubeplan::io::AtomicFile file(path);
+    REQUIRE(file.error().empty());
+    CHECK(file.Write("a,b\n"));
+    CHECK(file.Write("1,2\n"));
+    // Destroyed without Commit: an error or an interruption in the middle of a series.
+  }
+  CHECK(std::filesystem::is_empty(dir));
+  {
+    tubeplan::io::AtomicFile file(path);
+    CHECK(file.Write("a,b\n"));
+    CHECK(file.Write("1,2\n"));
+    CHECK(file.Commit().empty());
+  }
+  CHECK(tubeplan::io::ReadTextFile(path) == std::optional<std::string>("a,b\n1,2\n"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("Reading refuses devices and files over the limit without reading them", "[files]") {
+  const auto dir = ScratchDir();
+  // /dev/zero never ends: read, it would fill the memory.
+  const tubeplan::io::ReadResult zero = tubeplan::io::ReadInputFile("/dev/zero");
+  CHECK_FALSE(zero.text);
+  CHECK(zero.error == "it is not a regular file (a device, FIFO or socket)");
+  const auto big = dir / "big.txt";
+  std::ofstream(big) << std::string(3u << 20, 'x');
+  const tubeplan::io::ReadResult refused = tubeplan::io::ReadInputFile(big, 1u << 20);
+  CHECK_FALSE(refused.text);
+  CHECK(refused.error == "it is 3 MiB, more than the 1 MiB allowed");
+  CHECK(tubeplan::io::ReadInputFile(big, 3u << 20).text->size() == 3u << 20);
+  CHECK(tubeplan::io::ReadInputFile(dir).error == "it is a directory");
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("Abbreviate cuts long words for messages, never inside a UTF-8 character", "[files]") {
+  using tubeplan::io::Abbreviate;
+  CHECK(Abbreviate("short") == "short");
+  CHECK(Abbreviate(std::string(50, 'x')) == std::string(40, 'x') + "...");
+  // 39 ASCII bytes then a two-byte micro sign: the cut at 40 would split it; it backs up to 39.
+  CHECK(Abbreviate(std::string(39, 'x') + "\u00B5m and more") == std::string(39, 'x') + "...");
+}

@@ -78,6 +78,29 @@ TEST_CASE("PoseAt holds the ends and moves its cursor forward", "[trajectory]") 
   CHECK(tubeplan::plan::PoseAt(trajectory, 9.0, cursor).p_WH_m.x() == 4.0);
 }
 
+TEST_CASE("TickStream gives Resample's ticks exactly, one at a time", "[trajectory]") {
+  // A recording with jitter and a rate that is not the step's: every tick must be bit for bit
+  // what Resample gives (simulate and evaluate stream it; the other callers resample).
+  Trajectory trajectory;
+  for (int i = 0; i <= 400; ++i) {
+    HandSample s;
+    s.t_s = 0.25 + i * 4e-3 + (i % 3 == 0 ? 3e-4 : 0.0);
+    s.p_WH_m = Eigen::Vector3d(std::sin(i * 0.01), 0.1 * i, -0.002 * i);
+    s.q_WH = AboutZ(0.003 * i);
+    trajectory.samples.push_back(s);
+  }
+  const std::vector<HandSample> all = tubeplan::plan::Resample(trajectory, 1e-3);
+  tubeplan::plan::TickStream ticks(trajectory, 1e-3);
+  REQUIRE(ticks.count() == all.size());
+  for (std::size_t k = 0; k < ticks.count(); ++k) {
+    const HandSample s = ticks.Tick(k);
+    REQUIRE(s.t_s == all[k].t_s);
+    REQUIRE(ticks.TimeOf(k) == all[k].t_s);
+    REQUIRE(s.p_WH_m == all[k].p_WH_m);
+    REQUIRE(s.q_WH.coeffs() == all[k].q_WH.coeffs());
+  }
+}
+
 TEST_CASE("A good trajectory file loads with exact values and metadata", "[trajectory]") {
   const auto loaded =
       LoadTrajectoryFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/trajectories/good.csv");

@@ -1,6 +1,7 @@
 #pragma once
 // The tubeplan command line. Exit codes (documented in README): 0 success, 1 the job ran and
-// found a negative answer (e.g. an infeasible plan), 2 bad input or bad usage, 3 internal error.
+// found a negative answer (e.g. an infeasible plan), 2 bad input or bad usage, 3 internal error,
+// 130 interrupted (SIGINT or SIGTERM; 128 + SIGINT as shells report it) with nothing written.
 
 #include <ostream>
 #include <span>
@@ -12,6 +13,7 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitNegative = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitInternal = 3;
+inline constexpr int kExitInterrupted = 130;
 
 /// Runs the command with `args` (without the program name); output to `out`, logs to `err`.
 int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err);

@@ -1,0 +1,182 @@
+// Outputs under trouble (docs/hardening.md): a full disk, a file-size limit, a read-only
+// directory and an interrupted batch each give a clear message and leave no partial file. The
+// troubles are made real in a child process (a file-size limit, a user without write
+// permission, a pending SIGINT), so the parent test process stays unaffected.
+#include <csignal>
+#include <cstring>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/cli/app.hpp>
+
+namespace {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string err;
+};
+
+std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+std::filesystem::path Scratch() {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("tubeplan-outputs-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+std::string ReadAll(int fd) {
+  std::string text;
+  char buffer[4096];
+  for (ssize_t n; (n = ::read(fd, buffer, sizeof buffer)) != 0;) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) break;
+    text.append(buffer, static_cast<std::size_t>(n));
+  }
+  return text;
+}
+
+// Runs the command in a forked child after `setup` (which limits the child); its stderr comes
+// back through a pipe.
+Outcome RunInChild(const std::function<void()>& setup, std::vector<std::string> args) {
+  int pipe_fds[2];
+  REQUIRE(::pipe(pipe_fds) == 0);
+  const pid_t pid = ::fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    ::close(pipe_fds[0]);
+    setup();
+    std::ostringstream out, err;
+    const int code = tubeplan::cli::Run(args, out, err);
+    const std::string text = err.str();
+    [[maybe_unused]] const ssize_t written = ::write(pipe_fds[1], text.data(), text.size());
+    ::_exit(code);
+  }
+  ::close(pipe_fds[1]);
+  Outcome outcome;
+  outcome.err = ReadAll(pipe_fds[0]);
+  ::close(pipe_fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  outcome.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return outcome;
+}
+
+std::vector<std::string> Entries(const std::filesystem::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    names.push_back(entry.path().filename().string());
+  return names;
+}
+
+std::string ReadFile(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+}  // namespace
+
+TEST_CASE("A full disk (a file-size limit) is an error that leaves the old file whole",
+          "[cli][outputs]") {
+  const auto dir = Scratch() / "full";
+  std::filesystem::create_directories(dir);
+  const std::string report = (dir / "report.json").string();
+  std::ofstream(report) << "the old report\n";
+  // 1 KiB: the evaluation report of one plan is several kilobytes. SIGXFSZ is ignored by the
+  // writer, so the write fails with EFBIG as it would with ENOSPC on a full disk.
+  const Outcome r = RunInChild(
+      [] {
+        const rlimit limit{1024, 1024};
+        ::setrlimit(RLIMIT_FSIZE, &limit);
+      },
+      {"evaluate", SourcePath("plans/groove-insert-coarse.yaml"), "--jobs", "1", "--report",
+       report});
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::StartsWith(report + ": error: cannot write " + report + ".tmp."));
+  CHECK_THAT(r.err, Catch::Contains(": File too large; nothing was written (" + report +
+                                    " is as it was), expected a writable directory with room for"));
+  CHECK(ReadFile(report) == "the old report\n");
+  CHECK(Entries(dir) == std::vector<std::string>{"report.json"});
+  std::filesystem::remove_all(Scratch());
+}
+
+TEST_CASE("A read-only directory is an error and no file appears in it", "[cli][outputs]") {
+  const auto dir = Scratch() / "read-only";
+  std::filesystem::create_directories(dir);
+  // Readable and searchable by all, writable by nobody: as root (who writes anywhere) the child
+  // becomes user nobody first.
+  std::filesystem::permissions(Scratch(), std::filesystem::perms::all);
+  std::filesystem::permissions(
+      dir, std::filesystem::perms::owner_read | std::filesystem::perms::owner_exec |
+               std::filesystem::perms::group_read | std::filesystem::perms::group_exec |
+               std::filesystem::perms::others_read | std::filesystem::perms::others_exec);
+  const std::string series = (dir / "series.csv").string();
+  const Outcome r = RunInChild(
+      [] {
+        if (::geteuid() == 0 && (::setgid(65534) != 0 || ::setuid(65534) != 0)) ::_exit(99);
+      },
+      {"simulate", SourcePath("scenes/groove.yaml"), SourcePath("plans/groove-insert.csv"), "--out",
+       series});
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::StartsWith(series + ": error: cannot create " + series + ".tmp."));
+  CHECK_THAT(r.err, Catch::Contains(": Permission denied; nothing was written (" + series +
+                                    " is as it was), expected a writable directory"));
+  CHECK(Entries(dir).empty());
+  std::filesystem::permissions(dir, std::filesystem::perms::owner_all);
+  std::filesystem::remove_all(Scratch());
+}
+
+TEST_CASE("SIGINT during a batch evaluation stops it and writes no report", "[cli][outputs]") {
+  const auto dir = Scratch() / "interrupted";
+  std::filesystem::create_directories(dir);
+  const std::string report = (dir / "report.json").string();
+  std::ofstream(report) << "the old report\n";
+  int pipe_fds[2];
+  REQUIRE(::pipe(pipe_fds) == 0);
+  // SIGINT blocked across fork and exec stays pending until evaluate installs its handler and
+  // unblocks it: the interruption arrives at a known point, whatever the machine's load. It is
+  // blocked before the fork, so the child never runs a moment without the block.
+  sigset_t set, old_set;
+  sigemptyset(&set);
+  sigaddset(&set, SIGINT);
+  REQUIRE(::pthread_sigmask(SIG_BLOCK, &set, &old_set) == 0);
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::dup2(pipe_fds[1], STDERR_FILENO);
+    ::close(pipe_fds[0]);
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, STDOUT_FILENO);
+    ::execl(TUBEPLAN_BINARY, TUBEPLAN_BINARY, "evaluate", SourcePath("plans").c_str(), "--jobs",
+            "1", "--report", report.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ::pthread_sigmask(SIG_SETMASK, &old_set, nullptr);
+  REQUIRE(pid > 0);
+  ::close(pipe_fds[1]);
+  REQUIRE(::kill(pid, SIGINT) == 0);
+  const std::string err = ReadAll(pipe_fds[0]);
+  ::close(pipe_fds[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(err == "tubeplan evaluate: interrupted after 0 of 5 plans; no report written (" + report +
+                   " is left as it was)\n");
+  CHECK(ReadFile(report) == "the old report\n");
+  CHECK(Entries(dir) == std::vector<std::string>{"report.json"});
+  std::filesystem::remove_all(Scratch());
+}
