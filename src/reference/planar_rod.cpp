@@ -47,6 +47,25 @@ void ContactForce(const PlanarRod& rod, const Loading& loading, const Obstacle& 
   switch (ob.kind) {
     case ObstacleKind::kPlaneEnd: {
       const Vector2d g = Normal(theta(N - 1));
+      if (loading.law.threshold_m == 0.0) {
+        // A hard contact (no band) is not the core's one-PC law: each corner of the end face
+        // that presses in carries its own force, as on a real wall. Without this the force
+        // would jump between the corners as they pass each other and Newton could not settle.
+        Vector2d total = Vector2d::Zero();
+        for (const double side : {-1.0, 1.0}) {
+          const Vector2d corner = nodes[std::size_t(N)] + side * rod.radius_m * g;
+          const double dc = ob.normal.dot(corner - ob.point_m);
+          d = std::min(d, dc);
+          const double lam = loading.law.stiffness_N_per_m * std::max(0.0, -dc);
+          if (lam <= 0.0) continue;
+          const Vector2d f = lam * ob.normal - ob.slide_sign * ob.kinetic_friction * lam * tangent;
+          ev.forces.push_back({N, 1.0, side * rod.radius_m, f});
+          total += f;
+        }
+        ev.obstacle_distance_m.push_back(d);
+        ev.obstacle_force_N.push_back(total);
+        return;
+      }
       for (const double side : {-1.0, 1.0}) {
         const Vector2d corner = nodes[std::size_t(N)] + side * rod.radius_m * g;
         const double dc = ob.normal.dot(corner - ob.point_m);
