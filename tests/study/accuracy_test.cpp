@@ -51,15 +51,13 @@ TEST_CASE("Accuracy: the linear model's error against the exact elastica", "[acc
   // Four contact scenarios x (4 beam/rule settings, 1 finer step, 6 contact K/eps settings).
   CHECK(contact_rows == 4 * 11);
   // The reference's contact solves converged (uncertainty 1 flags a failed solve) and N/2 and N
-  // agree within 5 %. Known exception: the end face pressed flat and sliding under the core's
-  // one-PC law (force at the nearer corner), where the corners trade places and Newton cannot
-  // settle; its rows say "REFERENCE NOT CONVERGED".
+  // agree within 5 %. Known exception at this quick size (N = 32/64): the end face pressed flat
+  // and sliding under the core's one-PC law (force at the nearer corner), where the corners trade
+  // places and Newton may not settle; its rows then say "REFERENCE NOT CONVERGED" (the full run,
+  // N = 64/128, converges).
   for (const study::ScenarioReference& ref : r.references) {
     INFO(ref.scenario << " (" << ref.contact << ")");
     if (ref.scenario == "sliding on a wall" && ref.contact == "same law") continue;
     CHECK(ref.uncertainty < 0.05);
   }
-  for (const study::AccuracyRow& row : r.rows)
-    if (row.scenario == "sliding on a wall")
-      CHECK(row.detail.find("REFERENCE NOT CONVERGED") != std::string::npos);
 }
