@@ -48,7 +48,8 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
       AddBenchCommand(app, streams),    AddSimulateCommand(app, streams),
       AddGraphCommand(app, streams),    AddPlansCommand(app, streams),
       AddEvaluateCommand(app, streams), AddMergeCommand(app, streams),
-      AddLiveCommand(app, streams)};
+      AddLiveCommand(app, streams),     AddAccuracyCommand(app, streams),
+      AddStabilityCommand(app, streams)};
 
   // CLI11 wants argv order reversed when given a vector.
   std::vector<std::string> reversed(args.rbegin(), args.rend());

@@ -35,6 +35,8 @@ Command AddPlansCommand(CLI::App& app, Streams streams);
 Command AddEvaluateCommand(CLI::App& app, Streams streams);
 Command AddMergeCommand(CLI::App& app, Streams streams);
 Command AddLiveCommand(CLI::App& app, Streams streams);
+Command AddAccuracyCommand(CLI::App& app, Streams streams);
+Command AddStabilityCommand(CLI::App& app, Streams streams);
 
 /// Parses "a,b,c" of quantities of one dimension (each a plain SI number or with a unit) with
 /// between min_count and max_count items. On failure returns nullopt and sets `error` to a
