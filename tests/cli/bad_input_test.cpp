@@ -12,23 +12,13 @@
 
 #include <tubeplan/cli/app.hpp>
 
+#include "run_tool.hpp"
+
 namespace {
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-Outcome RunTool(std::vector<std::string> args) {
-  std::ostringstream out, err;
-  const int code = tubeplan::cli::Run(args, out, err);
-  return {code, out.str(), err.str()};
-}
-
-std::string SourcePath(const std::string& relative) {
-  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
-}
+using tubeplan::testing::Outcome;
+using tubeplan::testing::RunTool;
+using tubeplan::testing::SourcePath;
 
 // A directory of its own for each test process (ctest runs cases in parallel).
 std::filesystem::path Scratch() {

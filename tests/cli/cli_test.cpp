@@ -13,23 +13,13 @@
 
 #include <tubeplan/cli/app.hpp>
 
+#include "run_tool.hpp"
+
 namespace {
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-Outcome RunTool(std::vector<std::string> args) {
-  std::ostringstream out, err;
-  const int code = tubeplan::cli::Run(args, out, err);
-  return {code, out.str(), err.str()};
-}
-
-std::string SourcePath(const std::string& relative) {
-  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
-}
+using tubeplan::testing::Outcome;
+using tubeplan::testing::RunTool;
+using tubeplan::testing::SourcePath;
 
 // A steel tube well inside the linear range: r1 3 mm, r2 2.5 mm, l 300 mm, E 200 GPa.
 const std::vector<std::string> kSteelTube = {

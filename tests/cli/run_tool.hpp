@@ -1,0 +1,29 @@
+#pragma once
+// The command line as the tests drive it: argument strings in, exit code and both streams out,
+// through the same tubeplan::cli::Run the executable calls.
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <tubeplan/cli/app.hpp>
+
+namespace tubeplan::testing {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+inline Outcome RunTool(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  const int code = tubeplan::cli::Run(args, out, err);
+  return {code, out.str(), err.str()};
+}
+
+/// A file of the source tree (scenes, plans, test data) by its path from the top.
+inline std::string SourcePath(const std::string& relative) {
+  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
+}
+
+}  // namespace tubeplan::testing
