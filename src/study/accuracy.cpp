@@ -13,6 +13,8 @@
 #include <tubeplan/model/tube.hpp>
 #include <tubeplan/study/accuracy.hpp>
 
+#include "format.hpp"
+
 namespace tubeplan::study {
 namespace {
 
@@ -20,16 +22,6 @@ using Clock = std::chrono::steady_clock;
 using Eigen::Vector2d;
 
 double Micros(Clock::duration d) { return std::chrono::duration<double, std::micro>(d).count(); }
-
-// printf into a string; the attribute lets the compiler check every call's arguments.
-__attribute__((format(printf, 1, 2))) std::string Fmt(const char* format, ...) {
-  char buf[160];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buf, sizeof buf, format, args);
-  va_end(args);
-  return buf;
-}
 
 // ---- Tip loads ----------------------------------------------------------------------------------
 

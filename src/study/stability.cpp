@@ -12,20 +12,12 @@
 #include <tubeplan/model/tube.hpp>
 #include <tubeplan/study/stability.hpp>
 
+#include "format.hpp"
+
 namespace tubeplan::study {
 namespace {
 
 using Eigen::Vector3d;
-
-// printf into a string; the attribute lets the compiler check every call's arguments.
-__attribute__((format(printf, 1, 2))) std::string Fmt(const char* format, ...) {
-  char buf[200];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buf, sizeof buf, format, args);
-  va_end(args);
-  return buf;
-}
 
 scene::BoxPart Box(const std::string& name, const Vector3d& size, const Vector3d& centre) {
   scene::BoxPart b;
