@@ -164,16 +164,54 @@ bool CylinderBoxFaceDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return false;
 }
 
+bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                            const Eigen::Vector3d& half, double& depth, Eigen::Vector3d& p_cylinder,
+                            Eigen::Vector3d& q_box, Eigen::Vector3d& normal) {
+  const Eigen::Vector3d axis = b - a;
+  const double length = axis.norm();
+  if (!(length > 0.0)) return false;
+  const Eigen::Vector3d u = axis / length;
+  depth = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 3; ++k) {
+    for (const double side : {-1.0, 1.0}) {
+      // The support point along -n (as in CylinderBoxFaceDistance); moving the cylinder out by
+      // how far it lies below the face's plane separates the two, since the plane bounds the box.
+      const double n_u = side * u[k];
+      Eigen::Vector3d s = n_u > 0.0 ? a : b;
+      Eigen::Vector3d radial = n_u * u;
+      radial[k] -= side;
+      const double radial_norm = radial.norm();
+      if (radial_norm > 1e-12) s += (radius / radial_norm) * radial;
+      const double below = half[k] - side * s[k];
+      if (below < depth) {
+        depth = below;
+        p_cylinder = s;
+        q_box = s;
+        q_box[k] = side * half[k];
+        normal = side * Eigen::Vector3d::Unit(k);
+      }
+    }
+  }
+  return depth >= 0.0 && depth < radius;
+}
+
 bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P,
                                    const Eigen::Vector3d& b_P, double& distance_m,
-                                   Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W) const {
+                                   Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W,
+                                   Eigen::Vector3d& normal_W) const {
   double t = 0.0;
   const double axis_m = std::sqrt(SegmentBoxDistanceSquared(a_P, b_P, part.half_m, t));
   const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
   const Eigen::Vector3d q_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
-  if (!(axis_m > radius_m_)) return false;  // overlap (or the axis inside the box)
+  // Below a micrometre the direction from the box to the axis is not defined well enough: that
+  // is the axis inside the box, for which no signed distance is given.
+  if (!(axis_m > 1e-6 * radius_m_)) return false;
+  // Signed: with the axis outside the box the capsule's surface may still dip into it; the
+  // depth r1 - |c - q| is then exact (the nearest box point q is the foot of the deepest point's
+  // normal), so the penalty keeps growing past K eps instead of saturating at the surface.
   distance_m = axis_m - radius_m_;
   q_part_W = part.ToWorld(q_P);
+  normal_W = part.R_WP * ((c_P - q_P) / axis_m);
   p_tube_W = part.ToWorld(c_P + (q_P - c_P) * (radius_m_ / axis_m));
   return true;
 }
@@ -259,17 +297,20 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // The capsule on the end piece's axis contains the cylinder: if it is farther than the
         // band, so is the cylinder, and FCL's GJK (microseconds) is not needed.
         double bound_m = 0.0;
-        Eigen::Vector3d unused_p, unused_q;
-        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q) && bound_m >= band_m)
+        Eigen::Vector3d unused_p, unused_q, unused_n;
+        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_n) &&
+            bound_m >= band_m)
           continue;
       }
 
       double d = 0.0;
-      Eigen::Vector3d p_tube_W, q_part_W;
+      Eigen::Vector3d p_tube_W, q_part_W, capsule_normal_W;
       ++narrow_calls_;
       bool separated = false;
+      bool signed_depth = false;  // overlapping with a trusted depth: d < 0, normal given
       if (!is_end) {
-        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W);
+        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W, capsule_normal_W);
+        signed_depth = separated && d <= 0.0;
       } else if (Eigen::Vector3d p_P, q_P;
                  CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
         // The end piece nearest to a face (the usual case: the tip on the floor, the end against
@@ -280,12 +321,28 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       } else {
         separated = solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box, part.X_WP, &d,
                                           &p_tube_W, &q_part_W);
+        // Overlapping: the shallowest way out through a face of the part (exact for an end
+        // pressed into a face, an upper bound of the depth elsewhere), while less than r1.
+        Eigen::Vector3d p_in_P, q_in_P, n_P;
+        if ((!separated || !(d > 0.0)) &&
+            CylinderBoxPenetration(a_P, b_P, radius_m_, part.half_m, d, p_in_P, q_in_P, n_P)) {
+          signed_depth = true;
+          d = -d;
+          p_tube_W = part.ToWorld(p_in_P);
+          q_part_W = part.ToWorld(q_in_P);
+          capsule_normal_W = part.R_WP * n_P;
+        }
       }
       RawContact c;
       c.part = part.index;
       if (separated && d >= band_m) continue;
       const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
-      if (separated && d > 0.0) {
+      if (signed_depth) {
+        c.distance_m = d;
+        c.q_W_m = q_part_W;
+        c.normal_W = capsule_normal_W;
+        c.overlap = true;
+      } else if (separated && d > 0.0) {
         c.distance_m = d;
         c.q_W_m = q_part_W;
         c.normal_W = (p_tube_W - q_part_W) / d;

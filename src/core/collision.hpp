@@ -24,9 +24,11 @@ struct RawContact {
   states::TubeElement tube = states::TubeElement::kSide;
   int part_element = -1;  ///< index into the core's element list
   std::uint8_t face_mask = 0;
-  std::uint32_t part = 0;   ///< index into scene.parts
-  double s_m = 0.0;         ///< arc position of the centreline point under the contact
-  double distance_m = 0.0;  ///< >= 0; 0 when the shapes overlap (then `overlap` is set)
+  std::uint32_t part = 0;  ///< index into scene.parts
+  double s_m = 0.0;        ///< arc position of the centreline point under the contact
+  /// >= 0 when apart; when the shapes overlap (`overlap` set) the signed depth (< 0) of a capsule
+  /// whose axis is outside the part, else 0.
+  double distance_m = 0.0;
   bool overlap = false;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
@@ -55,6 +57,16 @@ double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d
 bool CylinderBoxFaceDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
                              const Eigen::Vector3d& half, double& distance,
                              Eigen::Vector3d& p_cylinder, Eigen::Vector3d& q_box);
+
+/// How deep the flat-ended cylinder on the axis a-b overlaps the box [-half, half] (box frame):
+/// the smallest distance by which its support point lies below a face plane, with that face's
+/// outward normal, the support point and its foot. Moving the cylinder out by that depth along
+/// the normal separates the two (the plane bounds the box), so the depth is exact when a face
+/// is the way out (an end pressed into a face) and an upper bound otherwise. False when the
+/// shapes do not overlap or the depth is r1 or more (then no direction is trusted).
+bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius,
+                            const Eigen::Vector3d& half, double& depth, Eigen::Vector3d& p_cylinder,
+                            Eigen::Vector3d& q_box, Eigen::Vector3d& normal);
 
 class Collision {
  public:
@@ -94,10 +106,13 @@ class Collision {
   // Points in the part's frame from here on.
   bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
                         double band_m) const;
-  // Capsule (segment a-b swept by r1) against the box, in closed form; false when they overlap.
+  // Capsule (segment a-b swept by r1) against the box, in closed form: the signed distance
+  // (negative when the capsule dips into the box with its axis outside; then exact too), the
+  // deepest or nearest tube point, the nearest box point and the normal from the part into the
+  // tube. False only when the axis reaches into the box (no defined direction).
   bool CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
-                          double& distance_m, Eigen::Vector3d& p_tube_W,
-                          Eigen::Vector3d& q_part_W) const;
+                          double& distance_m, Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W,
+                          Eigen::Vector3d& normal_W) const;
   void Overlapping(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
                    RawContact& c) const;
 

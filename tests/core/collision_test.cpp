@@ -104,3 +104,63 @@ TEST_CASE("Segment to box: the closed form against dense sampling", "[core][coll
   }
   CHECK(one_face == 1000);
 }
+
+TEST_CASE("End cylinder pressed into a box: the depth through a face", "[core][collision]") {
+  // The groove scene's end piece (r1 = 8 mm, 12.5 mm long) pressed into a 60 x 200 x 10 mm floor.
+  const double r = 0.008, length = 0.0125;
+  const Eigen::Vector3d half(0.03, 0.1, 0.005);
+  double depth = 0.0;
+  Eigen::Vector3d p, q, n;
+
+  SECTION("end face flat on the top face: the depth is how far it is pressed in") {
+    // Axis along -z, end face 0.3 mm below the top face: exact (the plane is the only way out).
+    const Eigen::Vector3d b(0.004, -0.02, half.z() - 0.0003), a = b + Eigen::Vector3d(0, 0, length);
+    REQUIRE(core::CylinderBoxPenetration(a, b, r, half, depth, p, q, n));
+    CHECK(depth == Approx(0.0003).margin(1e-15));  // one subtraction of doubles
+    CHECK(n == Eigen::Vector3d::UnitZ());
+    CHECK(q.z() == half.z());
+  }
+  SECTION("tilted end: the rim point lowest along the normal sets the depth") {
+    // Axis tilted 30 degrees from -z about y: the lowest rim point is r sin 30 below the end's
+    // centre; centre placed so that point is 0.5 mm under the top face.
+    const double tilt = std::acos(-1.0) / 6.0;
+    const Eigen::Vector3d u(std::sin(tilt), 0.0, -std::cos(tilt));
+    const Eigen::Vector3d b(0.0, 0.0, half.z() - 0.0005 + r * std::sin(tilt));
+    REQUIRE(core::CylinderBoxPenetration(b - length * u, b, r, half, depth, p, q, n));
+    CHECK(depth == Approx(0.0005).margin(1e-12));  // sin and cos to their last bits
+    CHECK(n == Eigen::Vector3d::UnitZ());
+  }
+  SECTION("apart or deeper than r1: no depth is given") {
+    const Eigen::Vector3d b(0.0, 0.0, half.z() + 0.001), a = b + Eigen::Vector3d(0, 0, length);
+    CHECK_FALSE(core::CylinderBoxPenetration(a, b, r, half, depth, p, q, n));
+    const Eigen::Vector3d deep(0.0, 0.0, half.z() - 1.5 * r);
+    CHECK_FALSE(core::CylinderBoxPenetration(deep + Eigen::Vector3d(0, 0, length), deep, r, half,
+                                             depth, p, q, n));
+  }
+  SECTION("random overlaps: moving out by the depth along the normal separates them (GJK)") {
+    // The depth is a way out, so it bounds the true penetration from above; GJK, an independent
+    // method, confirms the moved cylinder no longer overlaps the box.
+    fcl::detail::GJKSolver_indep<double> gjk;
+    gjk.gjk_tolerance = 1e-12;
+    gjk.gjk_max_iterations = 128;
+    const fcl::Boxd box(2.0 * half);
+    const fcl::Cylinderd cylinder(r, length);
+    std::mt19937_64 rng(20261123);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    int checked = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+      const Eigen::Vector3d centre(unit(rng) * 0.04, unit(rng) * 0.11, unit(rng) * 0.02);
+      const Eigen::Vector3d u = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+      const Eigen::Vector3d a = centre - 0.5 * length * u, b = centre + 0.5 * length * u;
+      if (!core::CylinderBoxPenetration(a, b, r, half, depth, p, q, n)) continue;
+      ++checked;
+      const Eigen::Vector3d out = (depth + 1e-9) * n;  // 1 nm beyond: GJK's own resolution
+      double d = 0.0;
+      const bool apart = gjk.shapeDistance(cylinder, SegmentPose(a + out, b + out), box,
+                                           Eigen::Isometry3d::Identity(), &d, nullptr, nullptr);
+      INFO("trial " << trial << " depth " << depth);
+      CHECK(apart);
+    }
+    CHECK(checked > 300);  // the sampling overlaps the box often enough to mean something
+  }
+}
