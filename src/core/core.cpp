@@ -101,6 +101,13 @@ struct Core::Impl {
   std::array<ElasticaSegment, kMaxLoads> segments{};
   int beam_count = 0, segment_count = 0;
   bool elastica_shape = false;
+  // The elastica held off: its shape under a tick's solved loads put a load point far from where
+  // the tick's system put it (a loading past a buckling load, whose first mode is not the state
+  // the contacts hold). The linear model carries the tube until the loads fall below half of
+  // those it failed at, or leave.
+  bool elastica_held_off = false;
+  double held_off_load_N = 0.0;
+  std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
   // The elastica's tangent compliance per segment and the loads it was computed for.
   std::array<Eigen::Matrix3d, kMaxLoads> tangent{};
   std::array<Eigen::Vector3d, kMaxLoads> tangent_force{};
@@ -177,6 +184,8 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.beam_count = m.segment_count = 0;
   m.tangent_count = 0;
   m.elastica_shape = false;
+  m.elastica_held_off = false;
+  m.held_off_load_N = 0.0;
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
   out_.X_WH = X_WH;
@@ -226,9 +235,23 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
 
   // 2. Collision, in a band of 2 epsilon: a contact that closes during this tick is then in this
   // tick's system (its force comes out zero if it stays open), and one that opens fades out.
+  // The band also grows by how far the tube can move rigidly this tick (speculative contacts, as
+  // Box2D v3 does it): the proxy moves at most as far as it would with no contact (the coupling
+  // pulling it towards the hand, its damper against the motion: the displacement of step 6's
+  // system without loads), and the grip turns the tube by at most the hand's turn, which moves a
+  // point at most (l + r1) times that angle. A part that the tube could reach during the tick is
+  // then in the tick's system with its distance linearised along its normal, so a fast hand
+  // (2 m/s: 2 mm a tick) cannot carry the tube through a wall thinner than its step; at hand
+  // speeds the growth is micrometres and costs nothing.
+  const double turn_bound_rad = Eigen::AngleAxisd(R_W_hand * R_WH.transpose()).angle();
+  const double sweep_m = (coupling_stiffness_ * (p_hand_W - m.p_held_prev_W) +
+                          (coupling_damping_ / T) * (p_hand_W - m.p_hand_prev_W))
+                                 .norm() /
+                             (coupling_stiffness_ + coupling_damping_ / T) +
+                         turn_bound_rad * (l + scene_.tube.outer_radius_m);
   const int raw_count = m.collision.Query(
       std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
-      2.0 * eps, std::span<RawContact>(m.raw.data(), m.raw.size()));
+      2.0 * eps + sweep_m, std::span<RawContact>(m.raw.data(), m.raw.size()));
 
   // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
   // one's PC (an edge of the face a side lies on, the rim of an end face lying flat).
@@ -389,7 +412,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
     int members = 0;
     const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
-    use_elastica = want_elastica && members > 0 &&
+    use_elastica = want_elastica && !m.elastica_held_off && members > 0 &&
                    m.beam.ElasticaCovers(m.beam_loads, m.order, members, groups);
     for (int i = 0; i < load_count; ++i)
       for (int j = 0; j < load_count; ++j)
@@ -481,7 +504,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   std::array<int, kMaxLoads> slot{};
   Eigen::Vector3d p_W = p_start_W;
   Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
-  bool solved = false, saturated = false;
+  bool solved = false, saturated = false, force_saturated = false;
   // Assembles and solves the tick's system for the current decisions; false if not finite.
   const auto solve_system = [&]() {
     int n_active = 0;
@@ -605,7 +628,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       // The contact set changed: saturation is decided again on the new solution.
       A = A_free;
       torque_saturated = false;
-      saturated = false;
+      saturated = force_saturated = false;
     } else if (!torque_saturated) {
       Eigen::Vector3d moment_W = Eigen::Vector3d::Zero();
       for (int i = 0; i < load_count; ++i) {
@@ -629,7 +652,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         // The spring cannot pull harder than the device can push: its hand end moves towards
         // the proxy until it carries exactly the device's maximum; the proxy separates.
         A = Kc_eff * p_W + coupling_W * (max_force / magnitude);
-        saturated = true;
+        saturated = force_saturated = true;
         changed = true;
       }
     }
@@ -641,7 +664,19 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // Decisions that keep changing (a contact cycling between open and closed within one tick,
   // which only pinched, stiff states do) stop after kMaxPasses: the last decisions stand and the
   // system is solved once more for them.
-  if (!solved && finite) solved = solve_system();
+  if (!solved && finite) {
+    solved = solve_system();
+    // The device's force still bounds the coupling, whatever the contacts decided: saturate on
+    // these decisions (a few passes: each moves the proxy, which changes the stretch).
+    for (int pass = 0; solved && pass < 4; ++pass) {
+      const Eigen::Vector3d coupling_W = A - Kc_eff * p_W;
+      const double magnitude = coupling_W.norm();
+      if (!(magnitude > max_force * (1.0 + 1e-12))) break;
+      A = Kc_eff * p_W + coupling_W * (max_force / magnitude);
+      saturated = force_saturated = true;
+      solved = solve_system();
+    }
+  }
   if (saturated) out.flags |= kProxySeparated;
   if (!solved) {
     // Singular, not finite or undecided: nothing moves and nothing is sent this tick.
@@ -654,18 +689,53 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return out;
   }
 
+  // The held end's new orientation: last tick's turned by omega.
+  const double turn = omega_W.norm();
+  const Eigen::Matrix3d R_WH_new =
+      Eigen::Quaterniond((turn > 0.0 ? Eigen::AngleAxisd(turn, omega_W / turn).toRotationMatrix()
+                                     : Eigen::Matrix3d::Identity()) *
+                         R_WH)
+          .normalized()
+          .toRotationMatrix();
+
+  // Last guards, for decisions that did not settle (a settled tick passes both unchanged).
+  // A stuck load left beyond its friction limit has its friction cut to the limit. Then, if the
+  // sum of the contact forces (the operator's force) is above the device's maximum that the
+  // saturation aims at, every contact force is scaled down by one factor: the wrench stays the
+  // sum of the contact wrenches, each normal force within its penalty law and each friction
+  // within its limit (f_max grows no faster than N when beta <= 1). Flagged kForceClamped.
+  std::array<Eigen::Vector3d, kMaxLoads> f_load_W;
+  Eigen::Vector3d total_W = Eigen::Vector3d::Zero();
+  for (int i = 0; i < load_count; ++i) {
+    const Load& ld = m.loads[std::size_t(i)];
+    const int si = slot[std::size_t(i)];
+    Eigen::Vector3d& F = f_load_W[std::size_t(i)];
+    F = si >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * si)) : Eigen::Vector3d::Zero();
+    if (ld.friction && si >= 0) {
+      const double normal_N = std::max(0.0, ld.normal_W.dot(F));
+      const Eigen::Vector3d Ft = F - ld.normal_W.dot(F) * ld.normal_W;
+      const double limit_N = FrictionLimit(*ld.friction, ld.friction->static_coefficient, normal_N);
+      if (Ft.norm() > limit_N) F -= Ft * (1.0 - limit_N / Ft.norm());
+    }
+    total_W += F;
+  }
+  if (total_W.norm() > max_force * (1.0 + 1e-9)) {
+    const double scale = max_force / total_W.norm();
+    for (int i = 0; i < load_count; ++i) f_load_W[std::size_t(i)] *= scale;
+    force_saturated = true;
+  }
+
   // 7. Results per load; a sliding load's anchor follows it (the spring then carries f_k).
   Eigen::Vector3d force_W = Eigen::Vector3d::Zero(), torque_W = Eigen::Vector3d::Zero();
   int beam_count = 0;
   for (int i = 0; i < load_count; ++i) {
     Load& ld = m.loads[std::size_t(i)];
-    const int si = slot[std::size_t(i)];
     ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
     for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
       if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
     }
-    ld.force_W = si >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * si)) : Eigen::Vector3d::Zero();
+    ld.force_W = f_load_W[std::size_t(i)];
     ld.distance_m += ld.normal_W.dot(ld.x_W - ld.x0_W);
     if (!ld.active || !ld.friction) {
       ld.anchor_W = ld.x_W;
@@ -676,6 +746,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (!ld.active) continue;
     force_W += ld.force_W;
     torque_W += (ld.x_W - p_W).cross(ld.force_W);
+    m.predicted_H[std::size_t(beam_count)] = R_WH_new.transpose() * (ld.x_W - p_W) - ld.r_H_m;
     m.beam_loads[std::size_t(beam_count++)] =
         BeamLoad{ld.s_m, R_WH.transpose() * ld.force_W, ld.r_H_m, 0.0, 0, ld.pc};
   }
@@ -736,8 +807,31 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   all.fill(true);
   int members = 0;
   const int groups = m.beam.Assign(m.beam_loads, beam_count, all, m.order, members);
-  m.elastica_shape = want_elastica && beam_count > 0 &&
+  double load_N = 0.0;
+  for (int j = 0; j < beam_count; ++j) load_N += m.beam_loads[std::size_t(j)].f_H_N.norm();
+  if (m.elastica_held_off && load_N < 0.5 * m.held_off_load_N) m.elastica_held_off = false;
+  m.elastica_shape = want_elastica && !m.elastica_held_off && beam_count > 0 &&
                      m.beam.ElasticaCovers(m.beam_loads, m.order, beam_count, groups);
+  if (m.elastica_shape) {
+    m.segment_count = m.beam.SolveElasticaChain(m.beam_loads, beam_count, m.order, m.segments);
+    m.beam.ElasticaNodes(m.segments, m.segment_count,
+                         std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
+    // The tick's system moved each load point with the elastica's tangent; the elastica itself
+    // must put it there too, within the contact band. Past a buckling load (the tube pushed
+    // along its axis onto a wall, or pinched) the first mode the elastica solves for is not the
+    // state the contacts hold: it swings the tip away by centimetres, the contact opens, the
+    // tube springs back straight through the wall and the cycle repeats. The linear model, which
+    // carries an axial push as a strut, takes over (flagged) until the loads fall back.
+    const double tolerance_m = std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m);
+    for (int j = 0; j < beam_count && m.elastica_shape; ++j) {
+      const double s_j = m.beam_loads[std::size_t(j)].s_m;
+      if ((interpolate_node(s_j) - m.predicted_H[std::size_t(j)]).norm() > tolerance_m) {
+        m.elastica_shape = false;
+        m.elastica_held_off = true;
+        m.held_off_load_N = load_N;
+      }
+    }
+  }
   const double EI = m.beam.bending_stiffness_Nm2();
   const double r1 = scene_.tube.outer_radius_m;
   double energy_J = 0.0, strain = 0.0;
@@ -754,9 +848,6 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     return bend;
   };
   if (m.elastica_shape) {
-    m.segment_count = m.beam.SolveElasticaChain(m.beam_loads, beam_count, m.order, m.segments);
-    m.beam.ElasticaNodes(m.segments, m.segment_count,
-                         std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
     m.tip_tangent_H = m.beam.ElasticaTipTangent(m.segments, m.segment_count);
     for (int g = 0; g < m.segment_count; ++g) {
       const ElasticaSegment& seg = m.segments[std::size_t(g)];
@@ -798,6 +889,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
   }
   if (want_elastica && beam_count > 0 && !m.elastica_shape) out.flags |= kLinearFallback;
+  if (beam_count == 0) m.elastica_held_off = false;
   out.energy_J = energy_J;
   out.max_strain = strain;
   out.tip_deflection_m = m.nodes_H[std::size_t(N)].head<2>().norm();
@@ -834,20 +926,12 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
 
   // 9. The operator's wrench, and the state for the next tick.
-  const double turn = omega_W.norm();
-  const Eigen::Matrix3d R_WH_new =
-      Eigen::Quaterniond((turn > 0.0 ? Eigen::AngleAxisd(turn, omega_W / turn).toRotationMatrix()
-                                     : Eigen::Matrix3d::Identity()) *
-                         R_WH)
-          .normalized()
-          .toRotationMatrix();
   out.X_WH = Eigen::Isometry3d::Identity();
   out.X_WH.linear() = R_WH_new;
   out.X_WH.translation() = p_W;
   out.force_W_N = force_W;
   out.torque_W_Nm = torque_W;
-  if (force_W.norm() > max_force * (1.0 + 1e-9) || torque_W.norm() > scene_.device.max_torque_Nm)
-    out.flags |= kForceClamped;
+  if (force_saturated || torque_W.norm() > scene_.device.max_torque_Nm) out.flags |= kForceClamped;
   const bool all_finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
                           std::isfinite(energy_J) && std::isfinite(strain);
   if (!all_finite) {
