@@ -49,7 +49,9 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       part_tolerance_m_(0.01 * scene.contact.threshold_m),
       // The end face counts as flat on a face, or the last piece's side as flat on it, when its
       // far side is within a tenth of epsilon of its near side.
-      tube_tolerance_m_(0.1 * scene.contact.threshold_m) {
+      tube_tolerance_m_(0.1 * scene.contact.threshold_m),
+      eps_m_(scene.contact.threshold_m),
+      inner_radius_m_(scene.tube.inner_radius_m) {
   // FCL's default 1e-6 leaves micrometres of error in d, i.e. 1e-2 N at K = 1e4 N/m.
   solver_.gjk_tolerance = 1e-12;
   solver_.gjk_max_iterations = 128;
@@ -365,12 +367,42 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
         const double tilt = axis_W.cross(c.normal_W).norm();  // sin of end face to contact plane
         const bool side_flat = std::abs(axis_W.dot(c.normal_W)) * end_m_ < tube_tolerance_m_;
-        if (radial_W.norm() < radius_m_ - tube_tolerance_m_ ||
-            (!side_flat && 2.0 * radius_m_ * tilt < tube_tolerance_m_)) {
+        // The end face pressed on a face of the part, slightly tilted: the penalty presses the
+        // annulus like a bed of springs, K (eps - d) growing linearly towards the lowest rim
+        // point. While the whole annulus is within eps the centre of pressure lies at
+        //     e = sin(tilt) (r1^2 + r2^2) / (4 (eps - d_centre))
+        // from the face's centre towards that point (the pressure's first moment over its
+        // resultant); it is an end-face contact loaded there until e reaches the rim, and a rim
+        // contact beyond. So the load point moves continuously from the centre to the rim as
+        // the face tilts, instead of jumping by r1 (a jump of the offset moment r1 N that
+        // swung the rubber tube's tip by 4 cm and back, tick after tick).
+        const double radial_m = radial_W.norm();
+        const double indent_centre_m = eps_m_ - (c.distance_m + radius_m_ * tilt);
+        const double pressure_centre_m =
+            indent_centre_m > 0.0
+                ? tilt * (radius_m_ * radius_m_ + inner_radius_m_ * inner_radius_m_) /
+                      (4.0 * indent_centre_m)
+                : std::numeric_limits<double>::infinity();
+        bool at_pressure_centre = false;
+        if (radial_m < radius_m_ - tube_tolerance_m_) {
+          c.tube = states::TubeElement::kEndFace;
+        } else if (!side_flat && IsFaceMask(c.face_mask) && !c.overlap &&
+                   pressure_centre_m < radius_m_) {
+          c.tube = states::TubeElement::kEndFace;
+          at_pressure_centre = c.pressure_centre = true;
+          // The load point: the face's centre moved by e towards the lowest rim point.
+          p_tube_W = centre_W + half_m * axis_W +
+                     (radial_m > 0.0 ? (pressure_centre_m / radial_m) * radial_W
+                                     : Eigen::Vector3d::Zero().eval());
+          c.distance_m += radius_m_ * tilt - pressure_centre_m * tilt;  // d where it presses
+        } else if (!side_flat && 2.0 * radius_m_ * tilt < tube_tolerance_m_) {
           c.tube = states::TubeElement::kEndFace;
         } else if (!side_flat) {
           c.tube = states::TubeElement::kEndRim;
         }
+        if (c.tube == states::TubeElement::kEndFace && !at_pressure_centre)
+          p_tube_W = centre_W + half_m * axis_W;  // lying flat, or on an edge: the face's centre
+        c.p_W_m = p_tube_W;
         if (c.tube != states::TubeElement::kSide) c.s_m = length_m_;
       }
       if (is_end && c.tube == states::TubeElement::kSide && !c.overlap && IsFaceMask(c.face_mask)) {

@@ -30,6 +30,8 @@ struct RawContact {
   /// whose axis is outside the part, else 0.
   double distance_m = 0.0;
   bool overlap = false;
+  /// An end face pressed on a face, tilted: p_W_m is its centre of pressure (collision.cpp).
+  bool pressure_centre = false;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
   Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the tube
@@ -128,6 +130,8 @@ class Collision {
   double end_m_ = 0.0;    // its length, end_pieces_ * piece_m_ >= r1
   double part_tolerance_m_ = 0.0;
   double tube_tolerance_m_ = 0.0;
+  double eps_m_ = 0.0;           // the contact threshold epsilon
+  double inner_radius_m_ = 0.0;  // r2: the end face is an annulus
   mutable int narrow_calls_ = 0;
   mutable std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_P_{};  // scratch
 };

@@ -79,6 +79,10 @@ struct Core::Impl {
     Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();    // surface point - centre, frame H
     bool active = true, released = false, sliding = false, shifted = false;
     bool matched = false, ghost = false;
+    // An end face's centre of pressure: its offset from the face's centre (frame H), relaxed
+    // from tick to tick (below).
+    bool pressure_centre = false;
+    Eigen::Vector3d cop_H_m = Eigen::Vector3d::Zero();
     bool SameKey(const Load& o) const {
       return tube == o.tube && part_element == o.part_element && end == o.end;
     }
@@ -320,9 +324,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     ld.s_m = r.tube == states::TubeElement::kSide ? std::clamp(r.s_m, 0.0, l) : l;
     ld.distance_m = r.distance_m;
     ld.normal_W = r.normal_W;
-    // An end face lying flat presses over its whole annulus, whose centre of pressure is on the
-    // axis: its load point is the face's centre, wherever on the face GJK put its nearest point.
-    ld.x0_W = r.tube == states::TubeElement::kEndFace ? m.nodes_W[std::size_t(N)] : r.p_W_m;
+    // An end face pressed on a face presses at its centre of pressure (collision.cpp: the face's
+    // centre when it lies flat, moving towards the rim as it tilts), wherever GJK put its
+    // nearest point.
+    ld.x0_W = r.p_W_m;
+    ld.pressure_centre = r.pressure_centre;
     const scene::Friction& friction =
         scene::FrictionAt(scene_, elements_[std::size_t(r.part_element)].part_index);
     ld.friction = friction.IsFrictionless() ? nullptr : &friction;
@@ -366,6 +372,40 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       ld.matched = true;
       if (before.active && ld.friction) ld.anchor_W = before.anchor_W;
       ld.f_lin_W = before.force_W;
+      if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
+    }
+  }
+  // An end face's centre of pressure follows its tilt, and the offset moment it carries tilts
+  // the end in turn: computed from last tick's tilt that loop has the gain
+  //     g = K (r1^2 + r2^2) / 4 * l / (E I)
+  // (the face's rotational stiffness under the penalty over the tube's at its end: 4 for the
+  // rubber tube), and with g > 1 it oscillates with a growing amplitude. Moving the load point
+  // only 1 / (1 + g) of the way from last tick's offset to this tick's target is the Newton
+  // step of that linear loop: it settles in one tick when g is right, and stays stable for any
+  // true gain up to 1 + 2 g.
+  {
+    const double r1 = scene_.tube.outer_radius_m, r2 = scene_.tube.inner_radius_m;
+    const double gain = K * (r1 * r1 + r2 * r2) / 4.0 * l / m.beam.bending_stiffness_Nm2();
+    const double relax = 1.0 / (1.0 + gain);
+    const Eigen::Vector3d& tip_W = m.nodes_W[std::size_t(N)];
+    for (int i = 0; i < load_count; ++i) {
+      Load& ld = m.loads[std::size_t(i)];
+      if (!ld.pressure_centre || ld.ghost) continue;
+      const Eigen::Vector3d target_H = R_WH.transpose() * (ld.x0_W - tip_W);
+      const Eigen::Vector3d step_H = relax * (target_H - ld.cop_H_m);
+      ld.cop_H_m += step_H;
+      const Eigen::Vector3d x0_W = tip_W + R_WH * ld.cop_H_m;
+      // The end face is planar: the distance at the new point differs along the normal.
+      ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W);
+      if (ld.anchor_W == ld.x0_W) {
+        ld.anchor_W = x0_W;  // a new anchor, not last tick's
+      } else {
+        // The pressure moves over the face, the material does not: a stuck anchor moves with
+        // it, or the tangential spring would carry the shift as a force.
+        const Eigen::Vector3d shift_W = R_WH * step_H;
+        ld.anchor_W += shift_W - ld.normal_W * ld.normal_W.dot(shift_W);
+      }
+      ld.x0_W = x0_W;
     }
   }
   // A load of last tick that nothing continues but that carried force is still in the shape:
