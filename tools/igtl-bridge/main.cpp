@@ -3,7 +3,8 @@
 // streams the poses of a trajectory CSV (the repository's trajectory format) as TRANSFORM
 // messages at a fixed rate on absolute deadlines, and reads the wrenches back (SENSOR messages
 // "tubeplan_force" in N and "tubeplan_torque" in N m), recording them and the round trip from
-// each pose to the wrench computed from it (the wrench echoes the pose's timestamp).
+// each pose's sample time to the wrench computed from it (the wrench echoes the pose's
+// timestamp).
 //
 // It packs and unpacks with libOpenIGTLink's C++ message classes, while tubeplan's device packs
 // its wrenches with the library's C calls: the tests thus check the two against each other (the
@@ -145,6 +146,7 @@ int Run(const Options& o) {
   long poses = 0, bad_crc = 0, other = 0;
   const auto period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
   const std::int64_t start_ns = NowNs(CLOCK_MONOTONIC);
+  const std::int64_t start_realtime_ns = NowNs(CLOCK_REALTIME);
   std::int64_t next_ns = start_ns;
   std::size_t cursor = 0;
   const double t0 = trajectory.samples.front().t_s;
@@ -179,8 +181,11 @@ int Run(const Options& o) {
         }
         m[3][3] = 1.0f;
         transform->SetMatrix(m);
+        // Stamped with its sample time, start + n / rate, as a device stamps its samples: the
+        // client's finite-difference velocity then sees the trajectory's, not this process's
+        // scheduling; the round trip counts from it, so any lateness of this send is in it.
         unsigned seconds = 0, fraction = 0;
-        SplitNs(NowNs(CLOCK_REALTIME), seconds, fraction);
+        SplitNs(start_realtime_ns + poses * period_ns, seconds, fraction);
         transform->SetTimeStamp(seconds, fraction);
         transform->Pack();
         if (!SendAll(fd, transform->GetPackPointer(), std::size_t(transform->GetPackSize()))) {
