@@ -3,8 +3,10 @@
 // step against the device (device::ServoLoop); this thread judges every tick with the same judge
 // as `evaluate`, writes the recording and draws the display, from the servo's lock-free
 // hand-offs. At the end the verdicts in evaluate's format, plus the servo's timing.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -16,6 +18,8 @@
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/emulator.hpp>
+#include <tubeplan/device/openhaptics.hpp>
+#include <tubeplan/device/openigtlink.hpp>
 #include <tubeplan/device/servo.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
@@ -44,61 +48,143 @@ struct EmulatorArgs {
   device::HandModel hand;
 };
 
-bool ParseDevice(const std::string& text, EmulatorArgs& args, std::string& error) {
-  const std::string kind = text.substr(0, text.find(':'));
-  if (kind != "emulator") {
-    error = "--device \"" + text + "\": unknown device kind \"" + kind +
-            "\", expected emulator[:ARGS] (openigtlink:// and openhaptics are not built in this "
-            "version, see docs/live.md)";
+// What `--device KIND[:ARGS]` asks for.
+struct DeviceChoice {
+  enum class Kind { kEmulator, kOpenIGTLink, kOpenHaptics } kind = Kind::kEmulator;
+  EmulatorArgs emulator;
+  device::OpenIGTLinkOptions igtl;
+  std::string openhaptics_name;  // empty: the default device
+};
+
+// A `key=value` argument with a unit, into `target` (SI); false and `error` when bad.
+bool ParseQuantityArg(const std::string& key, const std::string& value, io::Dimension dimension,
+                      double& target, std::string& error) {
+  const io::QuantityResult q = io::ParseQuantityAs(value, dimension);
+  if (!q.quantity || !(q.quantity->value_si > 0.0)) {
+    error = "--device: " + key + "=\"" + value +
+            "\": " + (q.quantity ? "must be greater than zero" : q.error->message);
     return false;
   }
-  if (text.size() == kind.size()) return true;
-  std::string rest = text.substr(kind.size() + 1);
+  target = q.quantity->value_si;
+  return true;
+}
+
+// Calls `each` on every comma-separated item of `list`; stops at the first false.
+template <class F>
+bool ForEachItem(const std::string& list, F each) {
   std::size_t start = 0;
-  while (start <= rest.size()) {
-    const std::size_t comma = rest.find(',', start);
+  while (start <= list.size()) {
+    const std::size_t comma = list.find(',', start);
     const std::string item =
-        rest.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    start = comma == std::string::npos ? rest.size() + 1 : comma + 1;
-    if (item.empty()) continue;
+        list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    start = comma == std::string::npos ? list.size() + 1 : comma + 1;
+    if (!item.empty() && !each(item)) return false;
+  }
+  return true;
+}
+
+bool ParseEmulator(const std::string& rest, EmulatorArgs& args, std::string& error) {
+  return ForEachItem(rest, [&](const std::string& item) {
     const std::size_t eq = item.find('=');
     if (item == "fast") {
       args.stepped = true;
-      continue;
+      return true;
     }
     if (eq == std::string::npos) {
       args.trajectory = item;
-      continue;
+      return true;
     }
     const std::string key = item.substr(0, eq), value = item.substr(eq + 1);
+    if (key == "trajectory") {
+      args.trajectory = value;
+      return true;
+    }
+    if (key == "mass")
+      return ParseQuantityArg(key, value, io::dim::kMass, args.hand.mass_kg, error);
+    if (key == "stiffness")
+      return ParseQuantityArg(key, value, io::dim::kStiffness, args.hand.stiffness_N_per_m, error);
+    if (key == "damping")
+      return ParseQuantityArg(key, value, io::dim::kDamping, args.hand.damping_Ns_per_m, error);
+    error = "--device: unknown emulator argument \"" + key +
+            "\", expected FILE.csv, trajectory=FILE, fast, mass=, stiffness= or damping=";
+    return false;
+  });
+}
+
+// `HOST:PORT[,key=value...]`; HOST may be an IPv6 address in brackets.
+bool ParseOpenIGTLink(const std::string& text, const std::string& rest,
+                      device::OpenIGTLinkOptions& o, std::string& error) {
+  const std::string address = rest.substr(0, rest.find(','));
+  std::size_t colon = address.rfind(':');
+  if (!address.empty() && address.front() == '[') {
+    const std::size_t close = address.find(']');
+    colon = close == std::string::npos ? std::string::npos : address.find(':', close);
+    o.host = address.substr(1, close == std::string::npos ? std::string::npos : close - 1);
+  } else {
+    o.host = address.substr(0, colon);
+  }
+  const std::string port = colon == std::string::npos ? "" : address.substr(colon + 1);
+  char* end = nullptr;
+  const long number = std::strtol(port.c_str(), &end, 10);
+  if (o.host.empty() || port.empty() || *end != '\0' || number < 1 || number > 65535) {
+    error = "--device \"" + text +
+            "\": expected openigtlink://HOST:PORT with a port from 1 to 65535 (OpenIGTLink's is "
+            "18944)";
+    return false;
+  }
+  o.port = int(number);
+  bool limits_given = false;
+  const bool ok = ForEachItem(rest.substr(address.size()), [&](const std::string& item) {
+    const std::size_t eq = item.find('=');
+    const std::string key = item.substr(0, eq);
+    const std::string value = eq == std::string::npos ? "" : item.substr(eq + 1);
     struct Param {
       const char* name;
       io::Dimension dimension;
       double* target;
+      bool limit;
     };
-    const Param params[] = {{"mass", io::dim::kMass, &args.hand.mass_kg},
-                            {"stiffness", io::dim::kStiffness, &args.hand.stiffness_N_per_m},
-                            {"damping", io::dim::kDamping, &args.hand.damping_Ns_per_m}};
-    bool known = key == "trajectory";
-    if (known) args.trajectory = value;
+    const Param params[] = {
+        {"timeout", io::dim::kTime, &o.connect_timeout_s, false},
+        {"stale", io::dim::kTime, &o.stale_after_s, false},
+        {"max_force", io::dim::kForce, &o.spec.max_force_N, true},
+        {"max_torque", io::dim::kTorque, &o.spec.max_torque_Nm, true},
+        {"max_stiffness", io::dim::kStiffness, &o.spec.max_stiffness_N_per_m, true},
+        {"damping", io::dim::kDamping, &o.spec.damping_Ns_per_m, true}};
     for (const Param& p : params) {
       if (key != p.name) continue;
-      known = true;
-      const io::QuantityResult q = io::ParseQuantityAs(value, p.dimension);
-      if (!q.quantity || !(q.quantity->value_si > 0.0)) {
-        error = "--device: " + key + "=\"" + value +
-                "\": " + (q.quantity ? "must be greater than zero" : q.error->message);
-        return false;
-      }
-      *p.target = q.quantity->value_si;
+      limits_given = limits_given || p.limit;
+      return ParseQuantityArg(key, value, p.dimension, *p.target, error);
     }
-    if (!known) {
-      error = "--device: unknown emulator argument \"" + key +
-              "\", expected FILE.csv, trajectory=FILE, fast, mass=, stiffness= or damping=";
-      return false;
-    }
+    error = "--device: unknown openigtlink argument \"" + key +
+            "\", expected timeout=, stale=, max_force=, max_torque=, max_stiffness= or damping=";
+    return false;
+  });
+  // The bridge reports no limits: name whose they are.
+  if (limits_given) o.spec.name = "haptic device (limits from --device)";
+  return ok;
+}
+
+bool ParseDevice(const std::string& text, DeviceChoice& choice, std::string& error) {
+  static const std::string kIgtl = "openigtlink://";
+  if (text.compare(0, kIgtl.size(), kIgtl) == 0) {
+    choice.kind = DeviceChoice::Kind::kOpenIGTLink;
+    return ParseOpenIGTLink(text, text.substr(kIgtl.size()), choice.igtl, error);
   }
-  return true;
+  const std::string kind = text.substr(0, text.find(':'));
+  const std::string rest = text.size() == kind.size() ? "" : text.substr(kind.size() + 1);
+  if (kind == "emulator") {
+    choice.kind = DeviceChoice::Kind::kEmulator;
+    return ParseEmulator(rest, choice.emulator, error);
+  }
+  if (kind == "openhaptics") {
+    choice.kind = DeviceChoice::Kind::kOpenHaptics;
+    choice.openhaptics_name = rest;
+    return true;
+  }
+  error = "--device \"" + text + "\": unknown device kind \"" + kind +
+          "\", expected emulator[:ARGS], openigtlink://HOST:PORT[,ARGS] or openhaptics[:NAME]";
+  return false;
 }
 
 // The CF's canonical text from a tick's contacts, as core::Core::Formation makes it (the judge
@@ -160,14 +246,17 @@ int RunLive(const LiveOptions& o, Streams io) {
   io::PlanLoadResult loaded = io::LoadPlanFile(o.plan);
   io.err << loaded.diagnostics.FormatAll();
   if (!loaded.plan) return kExitBadInput;
-  EmulatorArgs args;
+  DeviceChoice choice;
   std::string error;
-  if (!ParseDevice(o.device, args, error)) {
+  if (!ParseDevice(o.device, choice, error)) {
     io.err << "tubeplan live: error: " << error << "\n";
     return kExitBadInput;
   }
+  const EmulatorArgs& args = choice.emulator;
+  const bool emulated = choice.kind == DeviceChoice::Kind::kEmulator;
+  const bool stepped = emulated && args.stepped;
   plan::Trajectory target = *loaded.trajectory;
-  if (!args.trajectory.empty()) {
+  if (emulated && !args.trajectory.empty()) {
     io::TrajectoryLoadResult t = io::LoadTrajectoryFile(args.trajectory);
     io.err << t.diagnostics.FormatAll();
     if (!t.trajectory) return kExitBadInput;
@@ -178,26 +267,58 @@ int RunLive(const LiveOptions& o, Streams io) {
   const double T = scene.model.time_step_s;
 
   std::unique_ptr<device::Clock> clock;
-  if (args.stepped)
+  if (stepped)
     clock = std::make_unique<device::SteppedClock>();
   else
     clock = std::make_unique<device::MonotonicClock>();
-  device::EmulatorDevice dev(*clock, target, args.hand);
+  std::unique_ptr<device::HapticDevice> dev;
+  device::EmulatorDevice* emulator = nullptr;
+  device::OpenIGTLinkDevice* igtl = nullptr;
+  switch (choice.kind) {
+    case DeviceChoice::Kind::kEmulator:
+      dev = std::make_unique<device::EmulatorDevice>(*clock, target, args.hand);
+      emulator = static_cast<device::EmulatorDevice*>(dev.get());
+      break;
+    case DeviceChoice::Kind::kOpenIGTLink:
+      dev = std::make_unique<device::OpenIGTLinkDevice>(choice.igtl);
+      igtl = static_cast<device::OpenIGTLinkDevice*>(dev.get());
+      break;
+    case DeviceChoice::Kind::kOpenHaptics:
+      dev = device::MakeOpenHapticsDevice(choice.openhaptics_name, error);
+      if (!dev) {
+        io.err << "tubeplan live: error: --device \"" << o.device << "\": " << error << "\n";
+        return kExitBadInput;
+      }
+      break;
+  }
   core::Core core(scene);
-  // The coupling must be passive on this device (physics.md): refuse a stiffer one.
-  if (core.coupling_stiffness_N_per_m() > dev.spec().max_stiffness_N_per_m) {
+  // The coupling must be passive on this device (physics.md): refuse a stiffer one. A device
+  // that reports its limits at Open (openhaptics) is checked again after it.
+  auto too_stiff = [&] {
+    if (core.coupling_stiffness_N_per_m() <= dev->spec().max_stiffness_N_per_m) return false;
     io.err << o.plan << ": error: the scene's coupling stiffness "
-           << core.coupling_stiffness_N_per_m() << " N/m is more than " << dev.spec().name
-           << " renders stably (" << dev.spec().max_stiffness_N_per_m
+           << core.coupling_stiffness_N_per_m() << " N/m is more than " << dev->spec().name
+           << " renders stably (" << dev->spec().max_stiffness_N_per_m
            << " N/m), expected a softer device.coupling_stiffness\n";
+    return true;
+  };
+  if (choice.kind != DeviceChoice::Kind::kOpenHaptics && too_stiff()) return kExitBadInput;
+  // The emulator's trajectory, then 0.5 s for the last state to settle and count (many
+  // dwells); a real device runs until --duration or Ctrl-C.
+  const double duration_s = o.duration_s > 0.0 ? o.duration_s
+                            : emulator         ? emulator->target_duration_s() + 0.5
+                                               : 0.0;
+  const long ticks = duration_s > 0.0 ? std::lround(duration_s / T) + 1 : 0;
+
+  if (std::string e = dev->Open(); !e.empty()) {
+    io.err << "tubeplan live: error: cannot open the device: " << e << "\n";
     return kExitBadInput;
   }
-  const double duration_s = o.duration_s > 0.0 ? o.duration_s
-                                               // the trajectory, then 0.5 s for the last state
-                                               // to settle and count (many dwells)
-                                               : dev.target_duration_s() + 0.5;
-  const long ticks = std::lround(duration_s / T) + 1;
-
+  if (std::string e = dev->Calibrate(); !e.empty()) {
+    io.err << "tubeplan live: error: cannot calibrate the device: " << e << "\n";
+    return kExitBadInput;
+  }
+  if (choice.kind == DeviceChoice::Kind::kOpenHaptics && too_stiff()) return kExitBadInput;
   io::StreamingTextFile recording;
   if (!o.record.empty()) {
     if (const std::string e = recording.Open(o.record); !e.empty()) {
@@ -205,25 +326,21 @@ int RunLive(const LiveOptions& o, Streams io) {
       return kExitBadInput;
     }
     recording.Append(
-        io::TrajectoryCsvHeader(dev.spec().name + ", tubeplan live " + plan.name, 1.0 / T));
-  }
-  if (std::string e = dev.Open(); !e.empty()) {
-    io.err << "tubeplan live: error: cannot open the device: " << e << "\n";
-    return kExitBadInput;
-  }
-  if (std::string e = dev.Calibrate(); !e.empty()) {
-    io.err << "tubeplan live: error: cannot calibrate the device: " << e << "\n";
-    return kExitBadInput;
+        io::TrajectoryCsvHeader(dev->spec().name + ", tubeplan live " + plan.name, 1.0 / T));
   }
 
   // A stepped run can outpace this thread: its ring holds the whole run. In real time 16 s of
   // ticks: far more than this thread ever lags.
-  device::SpscRing<device::TickRecord> ring(args.stepped ? std::size_t(ticks) + 16 : 16384);
+  device::SpscRing<device::TickRecord> ring(stepped ? std::size_t(ticks) + 16 : 16384);
   device::Seqlock<device::ServoStatus> status;
   device::ServoConfig config;
   config.max_ticks = ticks;
-  config.realtime = !o.no_realtime && !args.stepped;
-  device::ServoLoop servo(core, dev, *clock, device::LimitsFor(dev.spec(), scene.device), config,
+  config.realtime = !o.no_realtime && !stepped;
+  // A bridge's poses come over a network, at about the servo's rate but with jitter: stale
+  // after its window (docs/live.md), not after one tick.
+  if (igtl)
+    config.max_stale_ticks = std::max(1, int(std::lround(igtl->options().stale_after_s / T)));
+  device::ServoLoop servo(core, *dev, *clock, device::LimitsFor(dev->spec(), scene.device), config,
                           &ring, &status);
   plan::Judging judging(plan.states, plan.limits, T);
   const std::vector<scene::PartElement>& elements = core.elements();
@@ -232,7 +349,7 @@ int RunLive(const LiveOptions& o, Streams io) {
   // With --json stdout carries the report alone: the display goes to stderr on a terminal.
   const bool show = o.json ? isatty(STDERR_FILENO) != 0 : true;
   Display display(o.json ? io.err : io.out, o.json ? true : stdout_terminal,
-                  std::min(plan.limits.max_force_N, dev.spec().max_force_N));
+                  std::min(plan.limits.max_force_N, dev->spec().max_force_N));
 
   device::ScopedStopSignals signals;
   device::ServoStats stats;
@@ -287,7 +404,14 @@ int RunLive(const LiveOptions& o, Streams io) {
   }
   servo_thread.join();
   drain();
-  dev.Close();
+  dev->Close();
+  if (igtl) {
+    const device::OpenIGTLinkCounters c = igtl->counters();
+    io.err << "tubeplan live: openigtlink: " << c.poses << " poses received, " << c.wrenches_sent
+           << " wrenches sent, " << c.wrenches_skipped << " skipped (socket full)";
+    if (const std::string e = igtl->link_error(); !e.empty()) io.err << "; the link failed: " << e;
+    io.err << "\n";
+  }
 
   if (!stats.realtime_note.empty())
     io.err << "tubeplan live: note: " << stats.realtime_note << "\n";
@@ -322,15 +446,15 @@ int RunLive(const LiveOptions& o, Streams io) {
                      {"dropped", stats.dropped},
                      {"stop", device::ToString(stats.stop)},
                      {"realtime", stats.realtime_note.empty()},
-                     {"device", dev.spec().name},
-                     {"clock", args.stepped ? "stepped" : "monotonic"}};
+                     {"device", dev->spec().name},
+                     {"clock", stepped ? "stepped" : "monotonic"}};
   if (o.json) {
     io.out << report.dump(2) << "\n";
   } else {
     std::ostringstream t;
     PrintVerdicts(t, e, stdout_terminal);
     t << std::fixed << std::setprecision(1) << "servo: " << stats.ticks << " ticks at "
-      << stats.rate_hz << " Hz (" << (args.stepped ? "stepped clock" : "real time") << "), "
+      << stats.rate_hz << " Hz (" << (stepped ? "stepped clock" : "real time") << "), "
       << stats.overruns << " overruns; tick median " << stats.median_us << " us, p99.9 "
       << stats.p999_us << " us, worst " << stats.max_us
       << " us; ended: " << device::ToString(stats.stop) << "\n";
@@ -358,13 +482,19 @@ Command AddLiveCommand(CLI::App& app, Streams streams) {
   sub->add_option("--device", options->device,
                   "emulator[:FILE.csv][,fast][,mass=M][,stiffness=K][,damping=D]: a simulated "
                   "PHANToM Premium 1.5/6DOF held by a simulated hand following FILE (default: the "
-                  "plan's trajectory); fast: a stepped clock, faster than real time")
+                  "plan's trajectory); fast: a stepped clock, faster than real time. "
+                  "openigtlink://HOST:PORT[,timeout=T][,stale=T][,max_force=F][,max_torque=M]"
+                  "[,max_stiffness=K][,damping=D]: a device behind an OpenIGTLink bridge (pose in "
+                  "as TRANSFORM, wrench out as SENSOR; limits default to the PHANToM Premium's). "
+                  "openhaptics[:NAME]: a PHANToM through the OpenHaptics SDK (only in a build "
+                  "with -DTUBEPLAN_OPENHAPTICS=ON)")
       ->capture_default_str();
   sub->add_option("--record", options->record,
                   "write the hand trajectory to FILE (trajectory CSV), completed by rename");
   sub->add_flag("--json", options->json, "print the report as one JSON document");
   sub->add_option("--duration", options->duration_s,
-                  "seconds to run (default: the emulator's trajectory and 0.5 s)")
+                  "seconds to run (default: the emulator's trajectory and 0.5 s; other devices "
+                  "until Ctrl-C)")
       ->check(CLI::Range(0.001, 86400.0));
   sub->add_flag("--no-realtime", options->no_realtime,
                 "do not ask for SCHED_FIFO for the servo thread");

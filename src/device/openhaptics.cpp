@@ -1,4 +1,5 @@
 #include <HD/hd.h>
+#include <utility>
 
 #include <tubeplan/device/openhaptics.hpp>
 
@@ -54,12 +55,13 @@ HDCallbackCode HDCALLBACK WriteCallback(void* user) {
 
 }  // namespace
 
-OpenHapticsDevice::OpenHapticsDevice() : state_(std::make_unique<State>()) {}
+OpenHapticsDevice::OpenHapticsDevice(std::string configuration)
+    : configuration_(std::move(configuration)), state_(std::make_unique<State>()) {}
 OpenHapticsDevice::~OpenHapticsDevice() { Close(); }
 
 std::string OpenHapticsDevice::Open() {
   State& s = *state_;
-  s.device = hdInitDevice(HD_DEFAULT_DEVICE);
+  s.device = hdInitDevice(configuration_.empty() ? HD_DEFAULT_DEVICE : configuration_.c_str());
   if (std::string e = ErrorText("hdInitDevice"); !e.empty()) return e;
   hdMakeCurrentDevice(s.device);
   // The device's own nominal limits (physics.md: prefer them to any table).

@@ -51,6 +51,18 @@ class Seqlock {
     std::memcpy(static_cast<void*>(&value), words.data(), sizeof(T));
     return value;
   }
+  /// One attempt, never waits: false (and `value` unchanged) before the first Store or when a
+  /// write overlapped. For a reader that must not spin on a writer that was preempted mid-write
+  /// (the servo thread reading a network device's receiver).
+  bool TryLoad(T& value) const {
+    std::array<std::uint64_t, kWords> words{};
+    const std::uint64_t before = sequence_.load(std::memory_order_acquire);
+    if (before == 0 || (before & 1u)) return false;
+    for (std::size_t i = 0; i < kWords; ++i) words[i] = words_[i].load(std::memory_order_acquire);
+    if (sequence_.load(std::memory_order_relaxed) != before) return false;
+    std::memcpy(static_cast<void*>(&value), words.data(), sizeof(T));
+    return true;
+  }
 
  private:
   std::atomic<std::uint64_t> sequence_{0};

@@ -7,6 +7,7 @@
 // nominal ones, read at Open. The device frame is taken as the world frame, mm turned into m.
 
 #include <memory>
+#include <string>
 
 #include <tubeplan/device/device.hpp>
 
@@ -14,7 +15,9 @@ namespace tubeplan::device {
 
 class OpenHapticsDevice final : public HapticDevice {
  public:
-  OpenHapticsDevice();
+  /// `configuration`: the device's name in the Phantom configuration utility; empty for the
+  /// default device.
+  explicit OpenHapticsDevice(std::string configuration = {});
   ~OpenHapticsDevice() override;
 
   std::string Open() override;
@@ -29,8 +32,16 @@ class OpenHapticsDevice final : public HapticDevice {
   void SendWrench(const Eigen::Vector3d& force_W_N, const Eigen::Vector3d& torque_W_Nm) override;
 
  private:
+  std::string configuration_;
   DeviceSpec spec_;
   std::unique_ptr<State> state_;
 };
+
+/// True when this tubeplan was built with the OpenHaptics SDK (-DTUBEPLAN_OPENHAPTICS=ON).
+bool OpenHapticsBuiltIn();
+/// The openhaptics device (`live --device openhaptics[:NAME]`), or null and `error` saying how to
+/// get one when the SDK was not built in. Compiled in every build, so that its callers are too.
+std::unique_ptr<HapticDevice> MakeOpenHapticsDevice(const std::string& configuration,
+                                                    std::string& error);
 
 }  // namespace tubeplan::device

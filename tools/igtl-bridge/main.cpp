@@ -1,0 +1,327 @@
+// igtl-bridge: an emulated OpenIGTLink haptic bridge, the other end of `tubeplan live --device
+// openigtlink://HOST:PORT` (docs/live.md). It listens (127.0.0.1 by default), takes one client,
+// streams the poses of a trajectory CSV (the repository's trajectory format) as TRANSFORM
+// messages at a fixed rate on absolute deadlines, and reads the wrenches back (SENSOR messages
+// "tubeplan_force" in N and "tubeplan_torque" in N m), recording them and the round trip from
+// each pose's sample time to the wrench computed from it (the wrench echoes the pose's
+// timestamp).
+//
+// It packs and unpacks with libOpenIGTLink's C++ message classes, while tubeplan's device packs
+// its wrenches with the library's C calls: the tests thus check the two against each other (the
+// CRC of every wrench is checked here).
+//
+// Faults for the tests: --stop-after S stops the poses (the link stays up: stale data),
+// --close-after S closes the connection.
+#include <algorithm>
+#include <arpa/inet.h>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <igtlMessageHeader.h>
+#include <igtlSensorMessage.h>
+#include <igtlTransformMessage.h>
+#include <igtl_header.h>
+#include <igtl_util.h>
+#include <iostream>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
+#include <string>
+#include <sys/socket.h>
+#include <unistd.h>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/trajectory.hpp>
+
+namespace {
+
+std::atomic<int> g_signal{0};
+extern "C" void OnSignal(int s) { g_signal.store(s); }
+
+std::int64_t NowNs(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return std::int64_t(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// The wall clock in OpenIGTLink's timestamp form (the protocol's timestamps are UTC).
+void SplitNs(std::int64_t ns, unsigned& seconds, unsigned& fraction) {
+  seconds = unsigned(ns / 1'000'000'000);
+  fraction = igtl_nanosec_to_frac(igtl_uint32(ns % 1'000'000'000));
+}
+
+bool SendAll(int fd, const void* data, std::size_t n) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  while (n > 0) {
+    const ssize_t sent = send(fd, bytes, n, MSG_NOSIGNAL);
+    if (sent < 0 && errno == EINTR) continue;
+    if (sent <= 0) return false;
+    bytes += sent;
+    n -= std::size_t(sent);
+  }
+  return true;
+}
+
+struct Options {
+  std::string trajectory;
+  std::string bind = "127.0.0.1";
+  int port = 18944;
+  double rate_hz = 1000.0;
+  double stop_after_s = 0.0;   // 0: never
+  double close_after_s = 0.0;  // 0: never
+  double accept_timeout_s = 30.0;
+  double max_time_s = 600.0;
+  std::string wrenches;
+};
+
+struct Wrench {
+  double t_s;  // since the first pose
+  bool force;  // else torque
+  double x, y, z;
+  double round_trip_us;  // -1 when the wrench echoed no timestamp
+};
+
+double Percentile(std::vector<double> values, double fraction) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const auto rank = std::size_t(std::ceil(fraction * double(values.size())));
+  return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
+}
+
+int Run(const Options& o) {
+  const tubeplan::io::TrajectoryLoadResult loaded = tubeplan::io::LoadTrajectoryFile(o.trajectory);
+  std::cerr << loaded.diagnostics.FormatAll();
+  if (!loaded.trajectory) return 2;
+  const tubeplan::plan::Trajectory& trajectory = *loaded.trajectory;
+
+  const int listener = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  const int one = 1;
+  setsockopt(listener, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(std::uint16_t(o.port));
+  if (inet_pton(AF_INET, o.bind.c_str(), &address.sin_addr) != 1) {
+    std::cerr << "igtl-bridge: error: --bind \"" << o.bind << "\" is not an IPv4 address\n";
+    return 2;
+  }
+  if (bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
+      listen(listener, 1) != 0) {
+    std::cerr << "igtl-bridge: error: cannot listen on " << o.bind << ":" << o.port << ": "
+              << std::strerror(errno) << "\n";
+    return 2;
+  }
+  socklen_t length = sizeof address;
+  getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length);
+  // The first line of stdout: the port (a test asks for port 0 and reads which it got).
+  std::cout << "igtl-bridge: listening on " << o.bind << ":" << ntohs(address.sin_port)
+            << std::endl;
+
+  pollfd wait{listener, POLLIN, 0};
+  if (poll(&wait, 1, int(o.accept_timeout_s * 1000)) <= 0) {
+    std::cerr << "igtl-bridge: error: no client within " << o.accept_timeout_s << " s\n";
+    return 1;
+  }
+  const int fd = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
+  close(listener);
+  if (fd < 0) {
+    std::cerr << "igtl-bridge: error: accept: " << std::strerror(errno) << "\n";
+    return 1;
+  }
+  setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+
+  igtl::TransformMessage::Pointer transform = igtl::TransformMessage::New();
+  transform->SetDeviceName("igtl-bridge");
+  igtl::MessageHeader::Pointer header = igtl::MessageHeader::New();
+  igtl::SensorMessage::Pointer sensor = igtl::SensorMessage::New();
+  std::vector<unsigned char> in;
+  std::vector<Wrench> wrenches;
+  long poses = 0, bad_crc = 0, other = 0;
+  const auto period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
+  const std::int64_t start_ns = NowNs(CLOCK_MONOTONIC);
+  const std::int64_t start_realtime_ns = NowNs(CLOCK_REALTIME);
+  std::int64_t next_ns = start_ns;
+  std::size_t cursor = 0;
+  const double t0 = trajectory.samples.front().t_s;
+  std::string ended = "the client closed the connection";
+  for (;;) {
+    if (g_signal.load() != 0) {
+      ended = "a signal";
+      break;
+    }
+    const std::int64_t now_ns = NowNs(CLOCK_MONOTONIC);
+    const double elapsed_s = double(now_ns - start_ns) * 1e-9;
+    if (o.close_after_s > 0.0 && elapsed_s >= o.close_after_s) {
+      ended = "--close-after";
+      break;
+    }
+    if (elapsed_s >= o.max_time_s) {
+      ended = "--max-time";
+      break;
+    }
+    if (now_ns >= next_ns) {
+      const bool streaming = !(o.stop_after_s > 0.0 && elapsed_s >= o.stop_after_s);
+      if (streaming) {
+        // The pose of the trajectory at this tick's time; held at its last pose after its end.
+        const tubeplan::plan::HandSample s =
+            tubeplan::plan::PoseAt(trajectory, t0 + double(poses) / o.rate_hz, cursor);
+        igtl::Matrix4x4 m;
+        const Eigen::Matrix3d R = s.q_WH.normalized().toRotationMatrix();
+        for (int i = 0; i < 3; ++i) {
+          for (int j = 0; j < 3; ++j) m[i][j] = float(R(i, j));
+          m[i][3] = float(s.p_WH_m[i] * 1e3);  // mm, as OpenIGTLink has it
+          m[3][i] = 0.0f;
+        }
+        m[3][3] = 1.0f;
+        transform->SetMatrix(m);
+        // Stamped with its sample time, start + n / rate, as a device stamps its samples: the
+        // client's finite-difference velocity then sees the trajectory's, not this process's
+        // scheduling; the round trip counts from it, so any lateness of this send is in it.
+        unsigned seconds = 0, fraction = 0;
+        SplitNs(start_realtime_ns + poses * period_ns, seconds, fraction);
+        transform->SetTimeStamp(seconds, fraction);
+        transform->Pack();
+        if (!SendAll(fd, transform->GetPackPointer(), std::size_t(transform->GetPackSize()))) {
+          ended = std::string("sending: ") + std::strerror(errno);
+          break;
+        }
+        ++poses;
+      }
+      next_ns += period_ns;
+      // Absolute deadlines; after a stall of more than 100 ms start afresh instead of bursting.
+      if (now_ns - next_ns > 100'000'000) next_ns = now_ns + period_ns;
+    }
+    // Wait for a wrench until the next deadline.
+    pollfd p{fd, POLLIN, 0};
+    const std::int64_t wait_ns = std::max<std::int64_t>(0, next_ns - NowNs(CLOCK_MONOTONIC));
+    timespec timeout{time_t(wait_ns / 1'000'000'000), long(wait_ns % 1'000'000'000)};
+    if (ppoll(&p, 1, &timeout, nullptr) <= 0) continue;
+    unsigned char chunk[4096];
+    const ssize_t got = recv(fd, chunk, sizeof chunk, 0);
+    if (got == 0) break;
+    if (got < 0) {
+      if (errno == EINTR || errno == EAGAIN) continue;
+      ended = std::string("receiving: ") + std::strerror(errno);
+      break;
+    }
+    const std::int64_t arrived_ns = NowNs(CLOCK_REALTIME);
+    in.insert(in.end(), chunk, chunk + got);
+    std::size_t used = 0;
+    while (in.size() - used >= IGTL_HEADER_SIZE) {
+      igtl_header raw;
+      std::memcpy(&raw, in.data() + used, IGTL_HEADER_SIZE);
+      igtl_header_convert_byte_order(&raw);
+      if (in.size() - used < IGTL_HEADER_SIZE + raw.body_size) break;
+      header->InitPack();
+      std::memcpy(header->GetPackPointer(), in.data() + used, IGTL_HEADER_SIZE);
+      header->Unpack();
+      if (std::strcmp(header->GetDeviceType(), "SENSOR") == 0) {
+        sensor->SetMessageHeader(header);
+        sensor->AllocatePack();
+        std::memcpy(sensor->GetPackBodyPointer(), in.data() + used + IGTL_HEADER_SIZE,
+                    std::size_t(raw.body_size));
+        if (!(sensor->Unpack(1) & igtl::MessageHeader::UNPACK_BODY) || sensor->GetLength() != 3) {
+          ++bad_crc;
+        } else {
+          const std::string name = sensor->GetDeviceName();
+          unsigned seconds = 0, fraction = 0;
+          sensor->GetTimeStamp(&seconds, &fraction);
+          const std::int64_t echoed_ns =
+              std::int64_t(seconds) * 1'000'000'000 + igtl_frac_to_nanosec(fraction);
+          wrenches.push_back({double(NowNs(CLOCK_MONOTONIC) - start_ns) * 1e-9,
+                              name == "tubeplan_force", sensor->GetValue(0), sensor->GetValue(1),
+                              sensor->GetValue(2),
+                              seconds != 0 ? double(arrived_ns - echoed_ns) * 1e-3 : -1.0});
+        }
+      } else {
+        ++other;
+      }
+      used += IGTL_HEADER_SIZE + std::size_t(raw.body_size);
+    }
+    in.erase(in.begin(), in.begin() + std::ptrdiff_t(used));
+  }
+  close(fd);
+
+  std::vector<double> round_trips;
+  double max_force_N = 0.0;
+  const Wrench* last_force = nullptr;
+  long forces = 0;
+  for (const Wrench& w : wrenches) {
+    if (!w.force) continue;
+    ++forces;
+    last_force = &w;
+    max_force_N = std::max(max_force_N, std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z));
+    if (w.round_trip_us >= 0.0) round_trips.push_back(w.round_trip_us);
+  }
+  if (!o.wrenches.empty()) {
+    std::ofstream out(o.wrenches);
+    out << "t_s,kind,x,y,z,round_trip_us\n";
+    char row[256];
+    for (const Wrench& w : wrenches) {
+      std::snprintf(row, sizeof row, "%.6f,%s,%.17g,%.17g,%.17g,%.1f\n", w.t_s,
+                    w.force ? "force" : "torque", w.x, w.y, w.z, w.round_trip_us);
+      out << row;
+    }
+    if (!out) std::cerr << "igtl-bridge: error: cannot write " << o.wrenches << "\n";
+  }
+  std::printf(
+      "igtl-bridge: ended (%s): sent %ld poses, received %ld wrenches (%ld bad, %ld other "
+      "messages); max |force| %.3f N, last force (%g, %g, %g) N; round trip pose to wrench: "
+      "median %.0f us, p99 %.0f us, max %.0f us\n",
+      ended.c_str(), poses, forces, bad_crc, other, max_force_N, last_force ? last_force->x : 0.0,
+      last_force ? last_force->y : 0.0, last_force ? last_force->z : 0.0,
+      Percentile(round_trips, 0.5), Percentile(round_trips, 0.99), Percentile(round_trips, 1.0));
+  return bad_crc == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  CLI::App app(
+      "An emulated OpenIGTLink haptic bridge: streams a trajectory's poses as TRANSFORM "
+      "messages to one client and records the wrenches it sends back (docs/live.md).",
+      "igtl-bridge");
+  app.add_option("trajectory", o.trajectory, "trajectory CSV (the repository's format)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  app.add_option("--port", o.port, "TCP port; 0: any free one (printed on the first line)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--bind", o.bind, "IPv4 address to listen on")->capture_default_str();
+  app.add_option("--rate", o.rate_hz, "poses per second")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 10000.0));
+  app.add_option("--stop-after", o.stop_after_s,
+                 "stop sending poses after S seconds, the connection kept (stale data)")
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--close-after", o.close_after_s, "close the connection after S seconds")
+      ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--accept-timeout", o.accept_timeout_s, "give up when no client comes in S s")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 86400.0));
+  app.add_option("--max-time", o.max_time_s, "end the session after S seconds in any case")
+      ->capture_default_str()
+      ->check(CLI::Range(0.001, 86400.0));
+  app.add_option("--wrenches", o.wrenches, "write the wrenches received to FILE (CSV)");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  struct sigaction action {};
+  action.sa_handler = OnSignal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+  return Run(o);
+}
