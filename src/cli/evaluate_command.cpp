@@ -160,7 +160,9 @@ bool GraphSections(const std::vector<Evaluated>& results,
     char what[160];
     std::snprintf(what, sizeof what, " (%zu CFs, %zu transitions, explored in %.1f s)",
                   g.nodes.size(), g.arcs.size(), g.seconds);
-    html.graphs.push_back({scene_path + what, svg.svg});
+    std::error_code ec;
+    const std::filesystem::path shown = std::filesystem::relative(scene_path, ec);
+    html.graphs.push_back({(ec || shown.empty() ? scene_path : shown.string()) + what, svg.svg});
   }
   return true;
 }
