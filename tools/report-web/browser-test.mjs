@@ -1,6 +1,7 @@
 // Opens an HTML report of `tubeplan evaluate --html` in headless Chromium (Debian's `chromium`,
 // driven by playwright-core) with the network off, and checks what a user would see:
-//   node browser-test.mjs REPORT.html [SCREENSHOT.png]
+//   node browser-test.mjs REPORT.html [SCREENSHOT.png [PLAN_SCREENSHOT.png]]
+// (the screenshots: the top of the page, and the first plan's section with its plots)
 // - the page refers to nothing outside itself (no http(s) or protocol-relative src/href/url());
 // - it loads with no console error or warning, no uncaught exception, no request but the file;
 // - the screenshot is not blank (many colours, most of it not the background);
@@ -11,7 +12,7 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { chromium } from 'playwright-core';
 
-const [reportPath, screenshotPath] = process.argv.slice(2);
+const [reportPath, screenshotPath, planShotPath] = process.argv.slice(2);
 if (!reportPath) {
   console.error('usage: node browser-test.mjs REPORT.html [SCREENSHOT.png]');
   process.exit(2);
@@ -130,6 +131,8 @@ const picture = await page.evaluate(async (b64) => {
 }, png.toString('base64'));
 check(picture.colours >= 200 && picture.nonWhite / picture.total >= 0.05,
       `screenshot not blank: ${picture.colours} colours, ${(100 * picture.nonWhite / picture.total).toFixed(1)} % not white`);
+
+if (planShotPath) await page.locator('#plan-0').screenshot({ path: planShotPath });
 
 const charts = await page.evaluate(() => document.querySelectorAll('section.plan svg').length);
 check(charts >= 5, `charts in the page: ${charts}`);
