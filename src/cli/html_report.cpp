@@ -197,6 +197,19 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
 
   spans = force.spans;
   spans.insert(spans.end(), strain.spans.begin(), strain.spans.end());
+  // The moment a transition was judged infeasible for another reason than a limit (those are
+  // shaded above): another state reached, never reached, stalled. A thin line on every chart.
+  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = e.judgement.transitions[k];
+    if (v.verdict != plan::Verdict::kInfeasible || v.reason.rfind("limit exceeded", 0) == 0 ||
+        v.reason.rfind("not reached", 0) == 0)
+      continue;
+    const report::Span moment{v.t_end_s, v.t_end_s,
+                              "transition " + std::to_string(k + 1) +
+                                  " infeasible at t = " + Fixed(v.t_end_s, 3) + " s: " + v.reason};
+    spans.push_back(moment);
+    for (report::LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
+  }
   std::string svg;
   for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
     svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";

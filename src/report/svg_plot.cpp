@@ -140,7 +140,8 @@ Axis FixedAxis(double lo, double hi, double px_lo, double px_hi) {
   return a;
 }
 
-// Shaded spans, clipped to the axis, with their tooltip.
+// Shaded spans, clipped to the axis, with their tooltip; a span of no width (a moment) is a solid
+// line.
 void DrawSpans(std::ostream& o, const std::vector<Span>& spans, const Axis& ax, double y_top,
                double y_bottom) {
   for (const Span& s : spans) {
@@ -149,8 +150,8 @@ void DrawSpans(std::ostream& o, const std::vector<Span>& spans, const Axis& ax, 
     const double x1 = ax.Map(std::clamp(std::max(s.x0, s.x1), ax.lo, ax.hi));
     o << "<rect class=\"span\" x=\"" << Num(x0) << "\" y=\"" << Num(y_top) << "\" width=\""
       << Num(std::max(x1 - x0, 2.0)) << "\" height=\"" << Num(y_bottom - y_top)
-      << "\" fill=\"#D55E00\" fill-opacity=\"0.15\"><title>" << EscapeXml(s.label)
-      << "</title></rect>\n";
+      << "\" fill=\"#D55E00\" fill-opacity=\"" << (s.x1 > s.x0 ? "0.15" : "0.8") << "\"><title>"
+      << EscapeXml(s.label) << "</title></rect>\n";
   }
 }
 

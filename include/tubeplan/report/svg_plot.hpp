@@ -42,7 +42,8 @@ struct LimitLine {
   std::string label;  ///< e.g. "limit 8.5 N"
 };
 
-/// An interval of x shaded across the chart: a time something was wrong.
+/// An interval of x shaded across the chart: a time something was wrong (x0 == x1: a moment, drawn
+/// as a solid line).
 struct Span {
   double x0 = 0.0, x1 = 0.0;
   std::string label;  ///< tooltip
