@@ -6,8 +6,11 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -17,12 +20,17 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/graph/dot.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/perturb.hpp>
 
 #include "commands.hpp"
+#include "graphviz.hpp"
+#include "html_report.hpp"
 #include "report.hpp"
 
 namespace tubeplan::cli {
@@ -33,7 +41,9 @@ struct EvaluateOptions {
   int jobs = 0;
   bool json = false;
   std::string report_path;
-  std::string shard;  // "I/N", empty: all
+  std::string shard;        // "I/N", empty: all
+  std::string html_path;    // the HTML report (docs/report.md)
+  bool html_graph = false;  // with the contact-state graph (an exploration per scene, ~5 s)
   int monte_carlo = 0;
   std::uint64_t seed = 1;
 };
@@ -108,6 +118,55 @@ class InterruptGuard {
   sigset_t old_mask_{};
 };
 
+// The graph section of the HTML report: each scene's pruned contact-state graph, explored with the
+// core as `tubeplan graph SCENE` does (same defaults), coloured by this run's verdicts, drawn by
+// Graphviz's dot. On failure returns false after saying why on `err`.
+bool GraphSections(const std::vector<Evaluated>& results,
+                   const std::vector<io::PlanLoadResult>& loaded, int jobs, HtmlOptions& html,
+                   std::ostream& err) {
+  std::map<std::string, std::vector<std::size_t>> by_scene;  // scene path -> plans
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    std::error_code ec;
+    const std::filesystem::path scene =
+        std::filesystem::path(results[i].file).parent_path() / loaded[i].plan->scene;
+    by_scene[std::filesystem::weakly_canonical(scene, ec).string()].push_back(i);
+  }
+  for (const auto& [scene_path, members] : by_scene) {
+    const scene::Scene& s = *loaded[members.front()].scene;
+    graph::ExploreOptions explore;
+    explore.jobs = jobs;
+    graph::ContactGraph g = graph::Explore(s, explore);
+    graph::Prune(g, {s.heuristics.friction, s.heuristics.energy, s.heuristics.distance,
+                     s.heuristics.tolerance});
+    std::vector<graph::ReplayedPlan> replayed;
+    for (const std::size_t i : members) {
+      graph::ReplayedPlan r;
+      for (const plan::TransitionVerdict& v : results[i].judgement.transitions)
+        r.transitions.push_back(
+            {v.from, v.to, v.verdict != plan::Verdict::kInfeasible, v.t_start_s, v.t_end_s});
+      for (const plan::Observation& ob : results[i].judgement.observed)
+        r.observed.push_back({ob.t_s, ob.cf});
+      replayed.push_back(std::move(r));
+    }
+    graph::ApplyVerdicts(g, replayed);
+    graph::DotOptions dot;
+    dot.dropped_arcs = false;
+    dot.title = "tubeplan: contact-state graph of " + s.name + " with this run's verdicts";
+    const SvgFromDot svg = RenderDot(graph::FormatDot(g, dot));
+    if (!svg.error.empty()) {
+      err << "tubeplan evaluate: error: --html-graph: " << svg.error << "\n";
+      return false;
+    }
+    char what[160];
+    std::snprintf(what, sizeof what, " (%zu CFs, %zu transitions, explored in %.1f s)",
+                  g.nodes.size(), g.arcs.size(), g.seconds);
+    std::error_code ec;
+    const std::filesystem::path shown = std::filesystem::relative(scene_path, ec);
+    html.graphs.push_back({(ec || shown.empty() ? scene_path : shown.string()) + what, svg.svg});
+  }
+  return true;
+}
+
 int RunEvaluate(const EvaluateOptions& o, Streams io) {
   bool ok = true;
   std::vector<std::string> files = PlanFiles(o.inputs, io.err, ok);
@@ -139,7 +198,19 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   }
   if (!ok) return kExitBadInput;
 
+  // Graphviz is checked before the replays: a missing `dot` should not cost a batch.
+  if (o.html_graph) {
+    if (o.html_path.empty()) {
+      io.err << "tubeplan evaluate: error: --html-graph needs --html FILE\n";
+      return kExitBadInput;
+    }
+    if (const SvgFromDot probe = RenderDot("digraph{}"); !probe.error.empty()) {
+      io.err << "tubeplan evaluate: error: --html-graph: " << probe.error << "\n";
+      return kExitBadInput;
+    }
+  }
   std::vector<Evaluated> results(files.size());
+  std::vector<ReplayRecording> recordings(o.html_path.empty() ? 0 : files.size());
   const int jobs = std::clamp(o.jobs > 0 ? o.jobs : int(std::thread::hardware_concurrency()), 1,
                               std::max<int>(1, int(files.size())));
   std::atomic<std::size_t> next{0};
@@ -150,11 +221,16 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   auto work = [&] {
     for (std::size_t i = next++; i < files.size() && !g_interrupted.load(); i = next++) {
       const io::PlanLoadResult& l = loaded[i];
+      // With --html the judged replay is recorded as it runs (no second replay).
+      ReplayRecorder recorder;
+      plan::TickWatcher watch;
+      if (!recordings.empty()) watch = std::ref(recorder);
       Evaluated e{files[i],
                   *l.plan,
-                  plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits),
+                  plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits, watch),
                   0,
                   {}};
+      if (!recordings.empty()) recordings[i] = recorder.Finish();
       e.runs = o.monte_carlo;
       e.robust.assign(e.judgement.transitions.size(), 0);
       e.replayed_s = e.judgement.replayed_s;
@@ -204,6 +280,29 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       return kExitBadInput;
     }
   }
+  if (!o.html_path.empty()) {
+    HtmlOptions html;
+    html.command = "tubeplan evaluate";
+    for (const std::string& f : o.inputs) html.command += " " + f;
+    html.command += " --html " + o.html_path + (o.html_graph ? " --html-graph" : "");
+    if (o.html_graph) {
+      if (!GraphSections(results, loaded, jobs, html, io.err)) return kExitBadInput;
+    } else {
+      html.graph_note =
+          "Not included: add --html-graph to explore each scene's contact-state graph with the "
+          "core (about 5 s a scene on two cores) and draw it here with this run's verdicts.";
+    }
+    std::vector<HtmlPlan> pages;
+    for (std::size_t i = 0; i < results.size(); ++i)
+      pages.push_back(
+          {&results[i], &*loaded[i].scene, loaded[i].plan->scene, std::move(recordings[i])});
+    if (const std::string e =
+            io::WriteTextFileAtomically(o.html_path, FormatHtmlReport(pages, html));
+        !e.empty()) {
+      io.err << o.html_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
   const bool all_feasible = std::all_of(results.begin(), results.end(),
                                         [](const Evaluated& e) { return e.judgement.feasible; });
   if (o.json) {
@@ -227,6 +326,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     << (jobs == 1 ? "" : "s") << " (" << (run_s > 0 ? replayed_s / run_s : 0.0)
     << "x real time per core)\n";
   if (!o.report_path.empty()) t << "report written to " << o.report_path << "\n";
+  if (!o.html_path.empty()) t << "HTML report written to " << o.html_path << "\n";
   io.out << t.str();
   return all_feasible ? kExitOk : kExitNegative;
 }
@@ -245,6 +345,12 @@ Command AddEvaluateCommand(CLI::App& app, Streams streams) {
       ->check(CLI::Range(1, 256));
   sub->add_flag("--json", options->json, "print the report as one JSON document");
   sub->add_option("--report", options->report_path, "also write the JSON report to FILE");
+  sub->add_option("--html", options->html_path,
+                  "also write an HTML report to FILE: verdicts, CF timeline, force/friction/"
+                  "energy/strain plots and a 3D replay, self-contained (docs/report.md)");
+  sub->add_flag("--html-graph", options->html_graph,
+                "with --html: also explore each scene's contact-state graph with the core (about "
+                "5 s a scene) and draw it with this run's verdicts (Graphviz dot)");
   sub->add_option("--monte-carlo", options->monte_carlo,
                   "also replay each plan N times with perturbed trajectories (offset within 1 mm, "
                   "0.1 mm 8-12 Hz tremor, 0.8-1.25x speed) and report each transition's feasible "

@@ -27,6 +27,7 @@
 
 #include "commands.hpp"
 #include "graph_json.hpp"
+#include "graphviz.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -34,6 +35,7 @@ namespace {
 struct GraphOptions {
   std::string scene_path;
   std::string dot_path;
+  std::string svg_path;  // graph only: the DOT rendered by Graphviz's dot
   std::string json_path;
   bool unpruned = false;
   std::uint64_t seed = 1;
@@ -180,6 +182,13 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
 }
 
 int RunGraph(const GraphOptions& o, Streams io) {
+  // Graphviz is checked before the exploration: a missing `dot` should not cost one.
+  if (!o.svg_path.empty()) {
+    if (const SvgFromDot probe = RenderDot("digraph{}"); !probe.error.empty()) {
+      io.err << "tubeplan graph: error: --svg: " << probe.error << "\n";
+      return kExitBadInput;
+    }
+  }
   std::variant<Built, int> built = BuildGraph(o, io);
   if (const int* code = std::get_if<int>(&built)) return *code;
   const Built& b = std::get<Built>(built);
@@ -188,13 +197,26 @@ int RunGraph(const GraphOptions& o, Streams io) {
   const graph::ExploreOptions& explore = b.explore;
   const graph::PruneWeights& weights = b.weights;
 
+  graph::DotOptions dot;
+  dot.dropped_arcs = o.unpruned;
+  dot.title = "tubeplan: contact-state graph of " + s.name + (o.unpruned ? " (unpruned)" : "");
+  const std::string dot_text =
+      o.dot_path.empty() && o.svg_path.empty() ? std::string() : graph::FormatDot(g, dot);
   if (!o.dot_path.empty()) {
-    graph::DotOptions dot;
-    dot.dropped_arcs = o.unpruned;
-    dot.title = "tubeplan: contact-state graph of " + s.name + (o.unpruned ? " (unpruned)" : "");
-    if (const std::string e = io::WriteTextFileAtomically(o.dot_path, graph::FormatDot(g, dot));
-        !e.empty()) {
+    if (const std::string e = io::WriteTextFileAtomically(o.dot_path, dot_text); !e.empty()) {
       io.err << o.dot_path << ": error: " << e << "\n";
+      return kExitBadInput;
+    }
+  }
+  if (!o.svg_path.empty()) {
+    const SvgFromDot svg = RenderDot(dot_text);
+    if (!svg.error.empty()) {
+      io.err << "tubeplan graph: error: " << svg.error << "\n";
+      return kExitBadInput;
+    }
+    io.err << svg.warnings;
+    if (const std::string e = io::WriteTextFileAtomically(o.svg_path, svg.svg); !e.empty()) {
+      io.err << o.svg_path << ": error: " << e << "\n";
       return kExitBadInput;
     }
   }
@@ -267,6 +289,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
       << " transitions seen only in the replays added\n";
   }
   if (!o.dot_path.empty()) t << "DOT written to " << o.dot_path << "\n";
+  if (!o.svg_path.empty()) t << "SVG (Graphviz dot) written to " << o.svg_path << "\n";
   if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";
   io.out << t.str();
   return g.goal >= 0 ? kExitOk : kExitNegative;
@@ -389,6 +412,8 @@ Command AddGraphCommand(CLI::App& app, Streams streams) {
       "friction, bending-energy and distance heuristics, and write DOT and JSON.");
   sub->add_option("scene", options->scene_path, "scene file (.yaml)")->required();
   sub->add_option("--dot", options->dot_path, "write the graph in Graphviz DOT to FILE");
+  sub->add_option("--svg", options->svg_path,
+                  "write the graph's picture (SVG) to FILE, drawn by Graphviz's `dot` program");
   sub->add_option("--json", options->json_path, "write the graph as JSON to FILE (docs/graph.md)");
   sub->add_option("--verdicts", options->verdicts_path,
                   "colour arcs by an evaluate report (feasible green, infeasible red) and add the "

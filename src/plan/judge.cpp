@@ -178,7 +178,8 @@ Judgement Judging::Finish() {
 }
 
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
-                const std::vector<std::string>& states, const Limits& limits) {
+                const std::vector<std::string>& states, const Limits& limits,
+                const TickWatcher& watch) {
   const auto clock_start = std::chrono::steady_clock::now();
   const double T = scene.model.time_step_s;
   // One tick at a time (TickStream), not Resample: a long recording is not held twice.
@@ -190,6 +191,7 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
   for (std::size_t k = 0; k < ticks.count(); ++k) {
     const HandSample sample = ticks.Tick(k);
     judging.Tick(sample.t_s, core.Step(sample.t_s, Pose(sample)), text);
+    if (watch) watch(sample.t_s, core);
   }
   Judgement j = judging.Finish();
   j.run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();

@@ -86,9 +86,15 @@ class Judging {
   long stuck_ticks_ = 0;
 };
 
+/// Sees every tick of a replay after the core's step: the tick's time and the core (its last()
+/// output, its Centreline on demand). Read only; reports record from it (evaluate --html), so
+/// that what they draw is the judged replay itself, not a second one.
+using TickWatcher = std::function<void(double t_s, const core::Core& core)>;
+
 /// Replays `trajectory` (resampled onto the scene's step) from its first pose and judges
-/// `states` (planned CFs, canonical) under `limits`.
+/// `states` (planned CFs, canonical) under `limits`; `watch` (may be empty) sees every tick.
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
-                const std::vector<std::string>& states, const Limits& limits);
+                const std::vector<std::string>& states, const Limits& limits,
+                const TickWatcher& watch = {});
 
 }  // namespace tubeplan::plan

@@ -1,0 +1,431 @@
+#include "html_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/report/svg_plot.hpp>
+
+#include "report_assets.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+using report::EscapeXml;
+
+void Take(ReplayRecording::Extremes& e, double t_s, double v, bool first) {
+  if (first || v < e.min) e.min = v, e.t_min_s = t_s;
+  if (first || v > e.max) e.max = v, e.t_max_s = t_s;
+}
+
+// Rounded for the page: 0.01 mm and 1 mN are far below what a picture shows, and the JSON stays
+// small (nlohmann prints the shortest text that reads back the same double).
+double Round(double v, double quantum) { return std::round(v / quantum) * quantum; }
+nlohmann::json Mm(const Eigen::Vector3d& p_m) {
+  return {Round(p_m.x() * 1e3, 0.01), Round(p_m.y() * 1e3, 0.01), Round(p_m.z() * 1e3, 0.01)};
+}
+nlohmann::json Newton(const Eigen::Vector3d& f_N) {
+  return {Round(f_N.x(), 1e-3), Round(f_N.y(), 1e-3), Round(f_N.z(), 1e-3)};
+}
+
+std::string Fixed(double v, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+// Three significant digits: energies and work span many decades.
+std::string Sig(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+const char* VerdictColour(plan::Verdict v) {
+  return v == plan::Verdict::kFeasible             ? "#009E73"
+         : v == plan::Verdict::kFeasibleWithDetour ? "#E69F00"
+                                                   : "#D55E00";
+}
+
+// Plot points of a bin series: each bin's minimum and maximum in the order they happened, so the
+// polyline passes through every peak.
+template <typename Member>
+std::vector<report::PlotPoint> Envelope(const ReplayRecording& r, Member member) {
+  std::vector<report::PlotPoint> points;
+  points.reserve(r.bins.size() * 2);
+  for (const ReplayRecording::Bin& b : r.bins) {
+    const ReplayRecording::Extremes& e = b.*member;
+    if (e.t_min_s <= e.t_max_s) {
+      points.push_back({e.t_min_s, e.min, ""});
+      if (e.t_max_s > e.t_min_s) points.push_back({e.t_max_s, e.max, ""});
+    } else {
+      points.push_back({e.t_max_s, e.max, ""});
+      points.push_back({e.t_min_s, e.min, ""});
+    }
+  }
+  return points;
+}
+
+// Where a series is above its limit: one shaded span per run of bins over it and a marker at the
+// run's highest value.
+template <typename Member>
+void MarkExceeded(const ReplayRecording& r, Member member, double limit, const std::string& unit,
+                  const std::string& what, report::LinePlot& plot) {
+  for (std::size_t i = 0; i < r.bins.size();) {
+    if (!((r.bins[i].*member).max > limit)) {
+      ++i;
+      continue;
+    }
+    report::Span span{(r.bins[i].*member).t_max_s, 0.0, ""};
+    report::PlotPoint peak{0.0, -1e300, ""};
+    for (; i < r.bins.size() && (r.bins[i].*member).max > limit; ++i) {
+      const ReplayRecording::Extremes& e = r.bins[i].*member;
+      span.x0 = std::min(span.x0, std::min(e.t_min_s, e.t_max_s));
+      span.x1 = std::max(span.x1, e.t_max_s);
+      if (e.max > peak.y) peak = {e.t_max_s, e.max, ""};
+    }
+    span.x1 = std::max(span.x1, span.x0);
+    span.label =
+        what + " over its limit from t = " + Fixed(span.x0, 3) + " to " + Fixed(span.x1, 3) + " s";
+    peak.label = what + " " + Fixed(peak.y, 4) + " " + unit + " > limit " + Fixed(limit, 4) + " " +
+                 unit + " at t = " + Fixed(peak.x, 3) + " s";
+    plot.spans.push_back(span);
+    plot.markers.push_back(peak);
+  }
+}
+
+std::string VerdictTable(const Evaluated& e) {
+  std::ostringstream o;
+  o << "<table class=\"verdicts\"><thead><tr><th>#</th><th>planned transition</th>"
+       "<th>verdict</th><th>why / detour</th><th>t [s]</th><th>peak force [N]</th>"
+       "<th>friction work [&micro;J]</th><th>bending energy [&micro;J]</th></tr></thead><tbody>\n";
+  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = e.judgement.transitions[k];
+    std::string why = v.reason;
+    if (!v.detour.empty()) {
+      why += why.empty() ? "via" : "; via";
+      for (const std::string& d : v.detour) why += " " + d;
+    }
+    o << "<tr><td>" << k + 1 << "</td><td class=\"cf\">" << EscapeXml(v.from) << " &rarr; "
+      << EscapeXml(v.to)
+      << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
+      << plan::ToString(v.verdict) << "</span></td><td>" << EscapeXml(why)
+      << "</td><td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
+      << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
+      << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
+      << " &rarr; " << Sig(v.energy_exit_J * 1e6) << "</td></tr>\n";
+  }
+  o << "</tbody></table>\n";
+  return o.str();
+}
+
+// The observed CFs (counted after the dwell) in lanes against the planned transitions' windows.
+std::string Timeline(const Evaluated& e, const ReplayRecording& r,
+                     const std::vector<report::Span>& spans) {
+  const plan::Judgement& j = e.judgement;
+  report::TimelinePlot plot;
+  plot.title = "Contact formations: planned windows and observed states";
+  plot.x_label = "time [s]";
+  plot.x_min = r.t_first_s;
+  plot.x_max = r.t_last_s;
+  plot.label_width_px = 250;
+  plot.spans = spans;
+  plot.lanes.push_back("planned transitions");
+  std::map<std::string, int> lane;
+  for (const std::string& s : e.plan.states)
+    if (lane.emplace(s, int(plot.lanes.size())).second) plot.lanes.push_back(s);
+  for (const plan::Observation& ob : j.observed)
+    if (lane.emplace(ob.cf, int(plot.lanes.size())).second) plot.lanes.push_back(ob.cf);
+  for (std::size_t k = 0; k < j.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = j.transitions[k];
+    if (v.t_end_s <= v.t_start_s && v.verdict == plan::Verdict::kInfeasible &&
+        v.reason.rfind("not reached", 0) == 0)
+      continue;  // never started
+    plot.bars.push_back({0, v.t_start_s, std::max(v.t_end_s, v.t_start_s), VerdictColour(v.verdict),
+                         std::to_string(k + 1) + " " + ToString(v.verdict),
+                         std::to_string(k + 1) + ": " + v.from + " -> " + v.to + ": " +
+                             ToString(v.verdict) +
+                             (v.reason.empty() ? "" : " (" + v.reason + ")")});
+  }
+  const std::vector<std::string>& planned = e.plan.states;
+  for (std::size_t k = 0; k < j.observed.size(); ++k) {
+    const plan::Observation& ob = j.observed[k];
+    const double t1 = k + 1 < j.observed.size() ? j.observed[k + 1].t_s : r.t_last_s;
+    const bool is_planned = std::find(planned.begin(), planned.end(), ob.cf) != planned.end();
+    plot.bars.push_back({lane[ob.cf], ob.t_s, t1, is_planned ? "#0072B2" : "#CC79A7", "",
+                         ob.cf + (is_planned ? " (planned)" : " (not planned)") +
+                             ", t = " + Fixed(ob.t_s, 3) + " .. " + Fixed(t1, 3) + " s"});
+  }
+  return report::RenderSvg(plot);
+}
+
+std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<report::Span>& spans) {
+  const plan::Limits& limits = e.plan.limits;
+  const auto base = [&](const std::string& title, const std::string& y_label) {
+    report::LinePlot p;
+    p.title = title;
+    p.x_label = "time [s]";
+    p.y_label = y_label;
+    p.x_min = r.t_first_s;
+    p.x_max = r.t_last_s;
+    return p;
+  };
+  using Bin = ReplayRecording::Bin;
+  report::LinePlot force = base("Operator force |F|", "N");
+  force.series = {{"|F| (min/max per 20 ms)", "#0072B2", Envelope(r, &Bin::force_N)}};
+  force.limits = {{limits.max_force_N, "limit " + Fixed(limits.max_force_N, 3) + " N"}};
+  MarkExceeded(r, &Bin::force_N, limits.max_force_N, "N", "operator force", force);
+
+  report::LinePlot friction = base("Friction force (sum over the contacts)", "N");
+  friction.series = {
+      {"|friction|", "#CC79A7", Envelope(r, &Bin::friction_N)},
+      {"capacity f_max (slip above)", "#999999", Envelope(r, &Bin::friction_limit_N)}};
+
+  report::LinePlot energy = base("Bending energy", "\u00b5J");
+  std::vector<report::PlotPoint> energy_uJ = Envelope(r, &Bin::energy_J);
+  for (report::PlotPoint& p : energy_uJ) p.y *= 1e6;
+  energy.series = {{"bending energy", "#009E73", energy_uJ}};
+
+  report::LinePlot strain = base("Largest bending strain", "-");
+  strain.series = {{"strain", "#E69F00", Envelope(r, &Bin::strain)}};
+  strain.limits = {{limits.max_strain, "limit " + Fixed(limits.max_strain, 3)}};
+  MarkExceeded(r, &Bin::strain, limits.max_strain, "", "strain", strain);
+
+  spans = force.spans;
+  spans.insert(spans.end(), strain.spans.begin(), strain.spans.end());
+  // The moment a transition was judged infeasible for another reason than a limit (those are
+  // shaded above): another state reached, never reached, stalled. A thin line on every chart.
+  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = e.judgement.transitions[k];
+    if (v.verdict != plan::Verdict::kInfeasible || v.reason.rfind("limit exceeded", 0) == 0 ||
+        v.reason.rfind("not reached", 0) == 0)
+      continue;
+    const report::Span moment{v.t_end_s, v.t_end_s,
+                              "transition " + std::to_string(k + 1) +
+                                  " infeasible at t = " + Fixed(v.t_end_s, 3) + " s: " + v.reason};
+    spans.push_back(moment);
+    for (report::LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
+  }
+  std::string svg;
+  for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
+    svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";
+  return svg;
+}
+
+nlohmann::json PlanJson(const HtmlPlan& p) {
+  const ReplayRecording& r = p.recording;
+  const scene::Scene& s = *p.scene;
+  nlohmann::json parts = nlohmann::json::array();
+  for (const scene::BoxPart& b : s.parts) {
+    const Eigen::Quaterniond q(b.X_WP.linear());
+    parts.push_back(
+        {{"name", b.name},
+         {"size_mm", Mm(b.size_m)},
+         {"p_mm", Mm(b.X_WP.translation())},
+         {"q_wxyz",
+          {Round(q.w(), 1e-6), Round(q.x(), 1e-6), Round(q.y(), 1e-6), Round(q.z(), 1e-6)}}});
+  }
+  nlohmann::json t = nlohmann::json::array(), cf = nlohmann::json::array(),
+                 line = nlohmann::json::array(), held = nlohmann::json::array(),
+                 hand = nlohmann::json::array(), force = nlohmann::json::array(),
+                 contacts = nlohmann::json::array();
+  for (const ReplayRecording::Frame& f : r.frames) {
+    t.push_back(Round(f.t_s, 1e-4));
+    cf.push_back(f.cf);
+    nlohmann::json c = nlohmann::json::array();
+    for (const Eigen::Vector3d& q : f.centreline_W_m)
+      for (const double v : Mm(q)) c.push_back(v);
+    line.push_back(std::move(c));
+    held.push_back(Mm(f.p_WH_m));
+    hand.push_back(Mm(f.p_W_hand_m));
+    force.push_back(Newton(f.force_W_N));
+    nlohmann::json fc = nlohmann::json::array();
+    for (const ReplayRecording::Contact& k : f.contacts)
+      fc.push_back({{"p_mm", Mm(k.p_W_m)},
+                    {"normal_N", Newton(k.normal_force_W_N)},
+                    {"friction_N", Newton(k.friction_W_N)},
+                    {"sliding", k.sliding}});
+    contacts.push_back(std::move(fc));
+  }
+  const Evaluated& e = *p.evaluated;
+  return {{"name", e.plan.name},
+          {"file", e.file},
+          {"scene", p.scene_path},
+          {"feasible", e.judgement.feasible},
+          {"max_force_N", e.plan.limits.max_force_N},
+          {"tube",
+           {{"outer_radius_mm", s.tube.outer_radius_m * 1e3},
+            {"inner_radius_mm", s.tube.inner_radius_m * 1e3},
+            {"length_mm", s.tube.length_m * 1e3}}},
+          {"parts", parts},
+          {"cfs", r.cfs},
+          {"frames",
+           {{"t_s", t},
+            {"cf", cf},
+            {"centreline_mm", line},
+            {"held_mm", held},
+            {"hand_mm", hand},
+            {"force_N", force},
+            {"contacts", contacts}}}};
+}
+
+// JSON inside <script type="application/json">: a '<' would let "</script>" or "<!--" end or
+// confuse the element, so every one is written as \u003c (only strings can hold one).
+std::string ScriptSafe(const std::string& json) {
+  std::string out;
+  out.reserve(json.size());
+  for (const char c : json) {
+    if (c == '<')
+      out += "\\u003c";
+    else
+      out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+void ReplayRecorder::operator()(double t_s, const core::Core& core) {
+  const core::StepOutput& out = core.last();
+  if (ticks_++ == 0) rec_.t_first_s = t_s;
+  rec_.t_last_s = t_s;
+  const auto bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
+  const bool new_bin = rec_.bins.size() <= bin;
+  if (new_bin) rec_.bins.resize(bin + 1);
+  ReplayRecording::Bin& b = rec_.bins[bin];
+  double friction_N = 0.0, friction_limit_N = 0.0;
+  for (const core::ContactState& c : out.Contacts()) {
+    friction_N += c.friction_W_N.norm();
+    friction_limit_N += c.friction_limit_N;
+  }
+  Take(b.force_N, t_s, out.force_W_N.norm(), new_bin);
+  Take(b.friction_N, t_s, friction_N, new_bin);
+  Take(b.friction_limit_N, t_s, friction_limit_N, new_bin);
+  Take(b.energy_J, t_s, out.energy_J, new_bin);
+  Take(b.strain, t_s, out.max_strain, new_bin);
+
+  // The CF's text only when it changes (it allocates); its index for every frame.
+  const core::FormationKey key = core::KeyOf(out);
+  if (rec_.cfs.empty() || key != key_) {
+    key_ = key;
+    const std::string text = core.FormationText();
+    cf_ = int(std::find(rec_.cfs.begin(), rec_.cfs.end(), text) - rec_.cfs.begin());
+    if (cf_ == int(rec_.cfs.size())) rec_.cfs.push_back(text);
+  }
+  if (!new_bin) return;
+  ReplayRecording::Frame f;
+  f.t_s = t_s;
+  f.cf = cf_;
+  core.Centreline(f.centreline_W_m);
+  f.p_WH_m = out.X_WH.translation();
+  f.p_W_hand_m = out.X_W_hand.translation();
+  f.force_W_N = out.force_W_N;
+  for (const core::ContactState& c : out.Contacts())
+    f.contacts.push_back({c.p_WC_m, c.normal_W * c.normal_force_N, c.friction_W_N, c.sliding});
+  rec_.frames.push_back(std::move(f));
+}
+
+std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options) {
+  std::ostringstream o;
+  long feasible = 0;
+  for (const HtmlPlan& p : plans) feasible += p.evaluated->judgement.feasible;
+  o << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+       // Nothing may be fetched: the page is complete, and a browser enforces that here.
+       "<meta http-equiv=\"Content-Security-Policy\" content=\"default-src 'none'; "
+       "script-src 'unsafe-inline'; style-src 'unsafe-inline'; img-src data:\">\n"
+       "<title>tubeplan report: "
+    << plans.size() << " plan" << (plans.size() == 1 ? "" : "s") << "</title>\n<style>\n"
+    << assets::ReportCss() << "</style>\n</head>\n<body>\n";
+  o << "<header><h1>tubeplan: feasibility of assembly plans</h1><p class=\"summary\">"
+    << plans.size() << " plan" << (plans.size() == 1 ? "" : "s") << ": <b class=\"ok\">" << feasible
+    << " feasible</b>, <b class=\"bad\">" << long(plans.size()) - feasible
+    << " infeasible</b></p><p class=\"command\"><code>" << EscapeXml(options.command)
+    << "</code></p></header>\n";
+
+  o << "<section id=\"summary\"><table class=\"plans\"><thead><tr><th>plan</th><th>file</th>"
+       "<th>verdict</th><th>transitions</th><th>replayed [s]</th><th>peak force [N]</th>"
+       "</tr></thead><tbody>\n";
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const Evaluated& e = *plans[i].evaluated;
+    double peak = 0.0;
+    for (const auto& v : e.judgement.transitions) peak = std::max(peak, v.peak_force_N);
+    const plan::Verdict verdict =
+        e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible;
+    o << "<tr><td><a href=\"#plan-" << i << "\">" << EscapeXml(e.plan.name) << "</a></td><td>"
+      << EscapeXml(e.file)
+      << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(verdict) << "\">"
+      << (e.judgement.feasible ? "FEASIBLE" : "INFEASIBLE") << "</span></td><td class=\"num\">"
+      << e.judgement.transitions.size() << "</td><td class=\"num\">"
+      << Fixed(e.judgement.replayed_s, 3) << "</td><td class=\"num\">" << Fixed(peak, 3)
+      << "</td></tr>\n";
+  }
+  o << "</tbody></table></section>\n";
+
+  o << "<section id=\"replay\"><h2>3D replay</h2>\n"
+       "<div class=\"controls\"><label>plan <select id=\"plan-select\"></select></label>"
+       "<button id=\"play\" type=\"button\">&#9654; play</button>"
+       "<input id=\"scrub\" type=\"range\" min=\"0\" max=\"0\" value=\"0\" step=\"1\">"
+       "<span id=\"clock\" class=\"num\"></span>"
+       "<label>speed <select id=\"speed\"><option value=\"0.25\">0.25&times;</option>"
+       "<option value=\"0.5\">0.5&times;</option><option value=\"1\" selected>1&times;</option>"
+       "<option value=\"2\">2&times;</option></select></label></div>\n"
+       "<div class=\"viewer\"><canvas id=\"view\"></canvas><div id=\"hud\"></div>"
+       "<div class=\"legend\"><span style=\"color:"
+    << kTubeColour
+    << "\">&#9632; tube</span> <span class=\"c-contact\">&#9679; contact (sliding: "
+       "faded)</span> <span class=\"c-normal\">&#8594; normal force</span> "
+       "<span class=\"c-friction\">&#8594; friction</span> <span class=\"c-operator\">&#8594; "
+       "force on the operator</span> <span class=\"c-hand\">&#9679; hand</span></div></div>\n"
+       "<p class=\"note\">Drag to orbit, wheel to zoom, right-drag to pan. Frames every 20 ms "
+       "of the judged replay (the core's own tube shape, Core::Centreline); the arrows' scale is "
+       "in "
+       "the corner box. "
+       "Click a plot below to jump there.</p></section>\n";
+
+  for (std::size_t i = 0; i < plans.size(); ++i) {
+    const HtmlPlan& p = plans[i];
+    const Evaluated& e = *p.evaluated;
+    o << "<section class=\"plan\" id=\"plan-" << i << "\" data-plan=\"" << i << "\"><h2>"
+      << EscapeXml(e.plan.name) << " <span class=\"badge\" style=\"background:"
+      << VerdictColour(e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible)
+      << "\">" << (e.judgement.feasible ? "FEASIBLE" : "INFEASIBLE") << "</span></h2>\n"
+      << "<p class=\"meta\">" << EscapeXml(e.file) << " on " << EscapeXml(p.scene_path) << "; "
+      << Fixed(e.judgement.replayed_s, 3) << " s replayed, " << e.judgement.ticks
+      << " core ticks; limits: force " << Fixed(e.plan.limits.max_force_N, 3) << " N, strain "
+      << Fixed(e.plan.limits.max_strain, 3) << ", penetration "
+      << Fixed(e.plan.limits.max_penetration_m * 1e3, 3) << " mm, dwell "
+      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n"
+      << VerdictTable(e);
+    std::vector<report::Span> spans;
+    const std::string plots = Plots(e, p.recording, spans);
+    o << "<div class=\"plot timeline\">" << Timeline(e, p.recording, spans) << "</div>\n"
+      << plots << "</section>\n";
+  }
+
+  o << "<section id=\"graph\"><h2>Contact-state graph with this run's verdicts</h2>\n";
+  if (!options.graph_note.empty()) o << "<p class=\"note\">" << options.graph_note << "</p>\n";
+  for (const auto& [title, svg] : options.graphs) {
+    const std::size_t start = svg.find("<svg");
+    o << "<h3>" << EscapeXml(title) << "</h3><div class=\"graph\">"
+      << (start == std::string::npos ? std::string() : svg.substr(start)) << "</div>\n";
+  }
+  o << "</section>\n";
+  o << "<footer>Made by tubeplan evaluate --html. 3D view: three.js " << assets::ThreeVersion()
+    << " (MIT licence), embedded. Plots: tubeplan's SVG charts. No network access needed."
+       "</footer>\n";
+
+  nlohmann::json data = {{"tube_colour", kTubeColour}, {"plans", nlohmann::json::array()}};
+  for (const HtmlPlan& p : plans) data["plans"].push_back(PlanJson(p));
+  o << "<script type=\"application/json\" id=\"tubeplan-data\">" << ScriptSafe(data.dump())
+    << "</script>\n<script>\n"
+    << assets::ThreeJs() << "\n</script>\n<script>\n"
+    << assets::ReportJs() << "\n</script>\n</body>\n</html>\n";
+  return o.str();
+}
+
+}  // namespace tubeplan::cli

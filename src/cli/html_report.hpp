@@ -1,0 +1,89 @@
+#pragma once
+// Private to the cli library: the HTML report of `evaluate --html` (docs/report.md). One
+// self-contained page: per plan the verdict table, a timeline of the observed CFs against the
+// planned ones, plots over time (SVG by report/svg_plot) and a 3D replay (three.js, embedded).
+// Everything it draws is recorded from the judged replay itself (plan::Judge's TickWatcher):
+// no second run of the core, no second physics.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/plan/plan.hpp>
+#include <tubeplan/scene/scene.hpp>
+
+#include "report.hpp"
+
+namespace tubeplan::cli {
+
+/// The tube's colour in the 3D replay (the browser test counts pixels of it).
+inline constexpr const char* kTubeColour = "#f07814";
+
+/// One replay decimated for a page: plots keep each bin's minimum and maximum (with when they
+/// happened), so a one-tick spike stays visible; the 3D replay keeps one frame per bin.
+struct ReplayRecording {
+  static constexpr int kCentrelinePoints = 24;
+  struct Extremes {
+    double t_min_s = 0.0, min = 0.0, t_max_s = 0.0, max = 0.0;
+  };
+  struct Bin {
+    Extremes force_N;           ///< |force on the operator|
+    Extremes friction_N;        ///< sum over PCs of |friction force|
+    Extremes friction_limit_N;  ///< sum over PCs of the friction capacity f_max
+    Extremes energy_J;          ///< bending energy
+    Extremes strain;            ///< largest bending strain
+  };
+  struct Contact {
+    Eigen::Vector3d p_W_m, normal_force_W_N, friction_W_N;
+    bool sliding = false;
+  };
+  struct Frame {
+    double t_s = 0.0;
+    int cf = 0;  ///< index into cfs
+    std::array<Eigen::Vector3d, kCentrelinePoints> centreline_W_m;
+    Eigen::Vector3d p_WH_m, p_W_hand_m, force_W_N;
+    std::vector<Contact> contacts;
+  };
+  double bin_s = 0.02;
+  double t_first_s = 0.0, t_last_s = 0.0;
+  std::vector<Bin> bins;
+  std::vector<Frame> frames;
+  std::vector<std::string> cfs;  ///< the CFs the frames name, in order of first appearance
+};
+
+/// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default).
+class ReplayRecorder {
+ public:
+  explicit ReplayRecorder(double bin_s = 0.02) { rec_.bin_s = bin_s; }
+  void operator()(double t_s, const core::Core& core);
+  ReplayRecording Finish() { return std::move(rec_); }
+
+ private:
+  ReplayRecording rec_;
+  long ticks_ = 0;
+  core::FormationKey key_{};
+  int cf_ = 0;
+};
+
+struct HtmlPlan {
+  const Evaluated* evaluated = nullptr;
+  const scene::Scene* scene = nullptr;
+  std::string scene_path;
+  ReplayRecording recording;
+};
+
+struct HtmlOptions {
+  std::string command;  ///< how the report was made, shown in its header
+  /// The contact-state graph section: Graphviz SVG of each scene's graph with this run's
+  /// verdicts, or a sentence saying why there is none.
+  std::vector<std::pair<std::string, std::string>> graphs;  ///< (title, SVG)
+  std::string graph_note;
+};
+
+/// The page, complete (three.js, the page's script and style, the data inline).
+std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options);
+
+}  // namespace tubeplan::cli

@@ -1,0 +1,14 @@
+#pragma once
+// Private to the cli library: the HTML report's web assets, embedded at build time
+// (tools/report-web/embed.mjs writes their definitions; CMakeLists.txt has the rule).
+
+#include <string_view>
+
+namespace tubeplan::cli::assets {
+
+std::string_view ThreeJs();       ///< three.js and OrbitControls, minified (sets window.THREE)
+std::string_view ThreeVersion();  ///< e.g. "0.187.0"
+std::string_view ReportJs();      ///< src/report/web/report.js: the 3D replay and its controls
+std::string_view ReportCss();     ///< src/report/web/report.css
+
+}  // namespace tubeplan::cli::assets

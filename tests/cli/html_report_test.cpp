@@ -1,0 +1,152 @@
+// The HTML report (evaluate --html): the page's series are the judged replay's own ticks,
+// decimated without losing a peak; the page is self-contained. (The page in a browser:
+// tools/report-web/browser-test.mjs, registered with ctest as html_report_browser.)
+#include "cli/html_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/plan/judge.hpp>
+
+#include "run_tool.hpp"
+
+namespace {
+
+using namespace tubeplan;
+using testing::RunTool;
+using testing::SourcePath;
+
+std::string Slurp(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::filesystem::path TempDir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+}  // namespace
+
+TEST_CASE("The report's series are the judged replay's ticks, each bin's extremes kept",
+          "[cli][html]") {
+  // The gentle plan: the operator force crosses its 0.2 N limit, so peaks matter.
+  const io::PlanLoadResult l = io::LoadPlanFile(SourcePath("plans/groove-gentle.yaml"));
+  REQUIRE(l.plan);
+  std::vector<double> t_s, force_N, energy_J;
+  const plan::Judgement plain =
+      plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits);
+  cli::ReplayRecorder recorder;
+  const plan::Judgement watched =
+      plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits,
+                  [&](double t, const core::Core& core) {
+                    recorder(t, core);
+                    t_s.push_back(t);
+                    force_N.push_back(core.last().force_W_N.norm());
+                    energy_J.push_back(core.last().energy_J);
+                  });
+  const cli::ReplayRecording r = recorder.Finish();
+
+  // Watching changes nothing the judge decides.
+  REQUIRE(plain.transitions.size() == watched.transitions.size());
+  for (std::size_t k = 0; k < plain.transitions.size(); ++k) {
+    CHECK(plain.transitions[k].verdict == watched.transitions[k].verdict);
+    CHECK(plain.transitions[k].reason == watched.transitions[k].reason);
+    CHECK(plain.transitions[k].peak_force_N == watched.transitions[k].peak_force_N);
+  }
+  CHECK(plain.observed.size() == watched.observed.size());
+  // Every tick seen once.
+  CHECK(long(t_s.size()) == watched.ticks);
+
+  // Bins of 20 ms: each bin's minimum and maximum are exactly the extremes of its ticks (a
+  // one-tick spike survives), and one 3D frame per bin.
+  REQUIRE(!r.bins.empty());
+  CHECK(r.frames.size() == r.bins.size());
+  std::vector<double> lo(r.bins.size(), 1e300), hi(r.bins.size(), -1e300), e_hi = hi;
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    const auto b = std::size_t(std::floor((t_s[k] - t_s.front()) / r.bin_s));
+    REQUIRE(b < r.bins.size());
+    lo[b] = std::min(lo[b], force_N[k]);
+    hi[b] = std::max(hi[b], force_N[k]);
+    e_hi[b] = std::max(e_hi[b], energy_J[k]);
+  }
+  for (std::size_t b = 0; b < r.bins.size(); ++b) {
+    CHECK(r.bins[b].force_N.min == lo[b]);
+    CHECK(r.bins[b].force_N.max == hi[b]);
+    CHECK(r.bins[b].energy_J.max == e_hi[b]);
+  }
+  // The overall peak is at least the judge's peak of every transition (the judge stops counting
+  // after the plan fails; the recording does not).
+  double peak = 0.0;
+  for (const auto& b : r.bins) peak = std::max(peak, b.force_N.max);
+  for (const auto& v : watched.transitions) CHECK(peak >= v.peak_force_N);
+  CHECK(peak == *std::max_element(force_N.begin(), force_N.end()));
+  // The frames' shapes are the core's centreline: the held end first, the tube's length along it.
+  for (const auto& f : r.frames) {
+    double length = 0.0;
+    for (std::size_t i = 1; i < f.centreline_W_m.size(); ++i)
+      length += (f.centreline_W_m[i] - f.centreline_W_m[i - 1]).norm();
+    // A chord polygon of 24 points is shorter than the arc, by far less than 1 % here.
+    CHECK(length == Approx(l.scene->tube.length_m).epsilon(0.01));
+    CHECK((f.centreline_W_m.front() - f.p_WH_m).norm() < 1e-6);
+  }
+}
+
+TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cli][html]") {
+  const std::filesystem::path dir = TempDir("tubeplan-html-test");
+  const std::string html = (dir / "report.html").string();
+  const testing::Outcome r = RunTool({"evaluate", SourcePath("plans/groove-insert.yaml"),
+                                      SourcePath("plans/groove-gentle.yaml"), "--html", html});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 1);  // the gentle plan is infeasible by design
+  CHECK(r.out.find("HTML report written to " + html) != std::string::npos);
+  const std::string page = Slurp(html);
+  CHECK(page.rfind("<!DOCTYPE html>", 0) == 0);
+  CHECK(page.find("</html>") != std::string::npos);
+  // Nothing fetched from outside: no http(s) or protocol-relative src/href.
+  const std::regex external(R"re((src|href)\s*=\s*["']?\s*(https?:)?//)re", std::regex::icase);
+  CHECK(!std::regex_search(page, external));
+  // three.js is in it (its licence header), with the page's script and the data.
+  CHECK(page.find("Three.js Authors") != std::string::npos);
+  CHECK(page.find("OrbitControls") != std::string::npos);
+  const std::size_t start = page.find("<script type=\"application/json\" id=\"tubeplan-data\">");
+  REQUIRE(start != std::string::npos);
+  const std::size_t body = page.find('>', start) + 1;
+  const nlohmann::json data =
+      nlohmann::json::parse(page.substr(body, page.find("</script>", body) - body));
+  REQUIRE(data["plans"].size() == 2);
+  CHECK(data["tube_colour"] == cli::kTubeColour);
+  for (const nlohmann::json& p : data["plans"]) {
+    const std::size_t frames = p["frames"]["t_s"].size();
+    CHECK(frames > 200);  // 5.5 s at 50 Hz
+    CHECK(p["frames"]["centreline_mm"].size() == frames);
+    CHECK(p["frames"]["centreline_mm"][0].size() == 3 * cli::ReplayRecording::kCentrelinePoints);
+    CHECK(p["parts"].size() == 3);
+  }
+  // The verdicts, the timeline, four plots a plan; the gentle plan's force over its 0.2 N limit
+  // is marked (a span and a peak marker) on its force plot.
+  CHECK(page.find("limit 0.200 N") != std::string::npos);
+  CHECK(page.find("class=\"marker\"") != std::string::npos);
+  CHECK(page.find("planned transitions") != std::string::npos);
+  CHECK(page.find("--html-graph") != std::string::npos);  // the note on how to add the graph
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("evaluate: --html-graph needs --html", "[cli][html]") {
+  const testing::Outcome r =
+      RunTool({"evaluate", SourcePath("plans/groove-insert.yaml"), "--html-graph"});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("--html-graph needs --html FILE") != std::string::npos);
+}
