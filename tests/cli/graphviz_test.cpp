@@ -14,14 +14,8 @@ namespace {
 
 using namespace tubeplan;
 using testing::RunTool;
+using testing::Slurp;
 using testing::SourcePath;
-
-std::string Slurp(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 }  // namespace
 

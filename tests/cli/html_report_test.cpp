@@ -22,14 +22,8 @@ namespace {
 
 using namespace tubeplan;
 using testing::RunTool;
+using testing::Slurp;
 using testing::SourcePath;
-
-std::string Slurp(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::filesystem::path TempDir(const std::string& name) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;

@@ -19,15 +19,21 @@ Eigen::Isometry3d SegmentPose(const Eigen::Vector3d& a, const Eigen::Vector3d& b
   return X;
 }
 
+// FCL's GJK as the core configures it: 1e-12 (its default 1e-6 leaves micrometres in d).
+fcl::detail::GJKSolver_indep<double> TightGjk() {
+  fcl::detail::GJKSolver_indep<double> gjk;
+  gjk.gjk_tolerance = 1e-12;
+  gjk.gjk_max_iterations = 128;
+  return gjk;
+}
+
 }  // namespace
 
 TEST_CASE("End cylinder near a box face: the closed form agrees with GJK", "[core][collision]") {
   // The groove scene's end piece (r1 = 8 mm, 12.5 mm long) around a 60 x 200 x 10 mm floor.
   const double r = 0.008, length = 0.0125;
   const Eigen::Vector3d half(0.03, 0.1, 0.005);
-  fcl::detail::GJKSolver_indep<double> gjk;
-  gjk.gjk_tolerance = 1e-12;
-  gjk.gjk_max_iterations = 128;
+  fcl::detail::GJKSolver_indep<double> gjk = TightGjk();
   const fcl::Boxd box(2.0 * half);
   const fcl::Cylinderd cylinder(r, length);
   std::mt19937_64 rng(20261123);
@@ -140,9 +146,7 @@ TEST_CASE("End cylinder pressed into a box: the depth through a face", "[core][c
   SECTION("random overlaps: moving out by the depth along the normal separates them (GJK)") {
     // The depth is a way out, so it bounds the true penetration from above; GJK, an independent
     // method, confirms the moved cylinder no longer overlaps the box.
-    fcl::detail::GJKSolver_indep<double> gjk;
-    gjk.gjk_tolerance = 1e-12;
-    gjk.gjk_max_iterations = 128;
+    fcl::detail::GJKSolver_indep<double> gjk = TightGjk();
     const fcl::Boxd box(2.0 * half);
     const fcl::Cylinderd cylinder(r, length);
     std::mt19937_64 rng(20261123);

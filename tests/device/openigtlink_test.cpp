@@ -32,6 +32,7 @@
 #include <tubeplan/io/text_file.hpp>
 
 #include "../alloc_count.hpp"
+#include "live_replay.hpp"
 
 extern char** environ;
 
@@ -41,14 +42,8 @@ using namespace tubeplan;
 using device::StopReason;
 namespace fs = std::filesystem;
 
-std::string SourcePath(const std::string& relative) {
-  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
-}
-
-const io::PlanLoadResult& InsertPlan() {
-  static const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-insert.yaml"));
-  return loaded;
-}
+using testing::InsertPlan;
+using testing::SourcePath;
 
 fs::path TempDir(const std::string& name) {
   const fs::path dir =
@@ -431,23 +426,9 @@ TEST_CASE("live over OpenIGTLink gets the verdicts of evaluate of its recording"
   WARN(summary);  // the round-trip figures, for the record
 
   REQUIRE(fs::exists(recording));
-  plan::Plan p = *InsertPlan().plan;
-  p.scene = SourcePath("scenes/groove.yaml");
-  p.trajectory = recording.string();
-  const fs::path plan_file = dir / "live.yaml";
-  REQUIRE(io::WriteTextFileAtomically(plan_file, io::FormatPlanYaml(p)).empty());
-  std::ostringstream out2, err2;
-  const int code2 =
-      cli::Run(std::vector<std::string>{"evaluate", plan_file.string(), "--json"}, out2, err2);
-  INFO(err2.str());
-  CHECK(code2 == (live_report["plans"][0]["feasible"] == true ? 0 : 1));
-  const nlohmann::json batch = nlohmann::json::parse(out2.str());
-  const nlohmann::json& a = live_report["plans"][0];
-  const nlohmann::json& b = batch["plans"][0];
-  CHECK(a["transitions"] == b["transitions"]);
-  CHECK(a["observed"] == b["observed"]);
-  CHECK(a["ticks"] == b["ticks"]);
-  CHECK(a["feasible"] == b["feasible"]);
+  const testing::Evaluated batch = testing::EvaluateRecording(recording, dir / "live.yaml");
+  CHECK(batch.exit_code == (live_report["plans"][0]["feasible"] == true ? 0 : 1));
+  testing::CheckSameVerdicts(live_report, batch.report);
   fs::remove_all(dir);
 }
 

@@ -21,19 +21,15 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
+#include "live_replay.hpp"
+
 namespace {
 
 using namespace tubeplan;
 using device::StopReason;
 
-std::string SourcePath(const std::string& relative) {
-  return std::string(TUBEPLAN_SOURCE_DIR) + "/" + relative;
-}
-
-const io::PlanLoadResult& InsertPlan() {
-  static const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-insert.yaml"));
-  return loaded;
-}
+using testing::InsertPlan;
+using testing::SourcePath;
 
 plan::Trajectory StillTarget(const Eigen::Vector3d& p_W_m, double duration_s) {
   plan::Trajectory t;
@@ -255,28 +251,13 @@ TEST_CASE("A live run of a shipped plan gets the verdicts of the batch replay of
   CHECK(live_report["servo"]["ticks"] == 6001);  // 5.5 s of trajectory and 0.5 s, both ends
 
   // The plan with the recording for its trajectory, judged by `evaluate`.
-  plan::Plan p = *InsertPlan().plan;
-  p.scene = SourcePath("scenes/groove.yaml");
-  p.trajectory = recording.string();
-  const fs::path plan_file = dir / "insert.yaml";
-  REQUIRE(io::WriteTextFileAtomically(plan_file, io::FormatPlanYaml(p)).empty());
-  std::ostringstream out2, err2;
-  const int code2 =
-      cli::Run(std::vector<std::string>{"evaluate", plan_file.string(), "--json"}, out2, err2);
-  INFO(err2.str());
-  REQUIRE(code2 == 0);
-  const nlohmann::json batch = nlohmann::json::parse(out2.str());
-  const nlohmann::json& a = live_report["plans"][0];
-  const nlohmann::json& b = batch["plans"][0];
-  // Equal to the bit: the replay steps the core with the poses the live run gave it.
-  CHECK(a["transitions"] == b["transitions"]);
-  CHECK(a["observed"] == b["observed"]);
-  CHECK(a["ticks"] == b["ticks"]);
-  CHECK(a["feasible"] == b["feasible"]);
+  const testing::Evaluated batch = testing::EvaluateRecording(recording, dir / "insert.yaml");
+  REQUIRE(batch.exit_code == 0);
+  testing::CheckSameVerdicts(live_report, batch.report);
   // The same schema as evaluate's, plus the servo's figures.
   for (const char* key : {"ticks", "overruns", "median_us", "p999_us", "max_us", "rate_hz"})
     CHECK(live_report["servo"].contains(key));
-  CHECK(live_report["tubeplan_evaluate"] == batch["tubeplan_evaluate"]);
+  CHECK(live_report["tubeplan_evaluate"] == batch.report["tubeplan_evaluate"]);
   fs::remove_all(dir);
 }
 
