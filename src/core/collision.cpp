@@ -67,6 +67,7 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     part.R_PW = part.R_WP.transpose();
     part.p_PW = -(part.R_PW * part.p_WP);
     part.half_m = 0.5 * box.size_m;
+    part.aligned = part.R_WP == Eigen::Matrix3d::Identity();
     parts_.push_back(part);
   }
 }
@@ -199,12 +200,12 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
 
 bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P,
                                    const Eigen::Vector3d& b_P, double& distance_m,
-                                   Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W,
-                                   Eigen::Vector3d& normal_W) const {
+                                   Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
+                                   Eigen::Vector3d& normal_P) const {
   double t = 0.0;
   const double axis_m = std::sqrt(SegmentBoxDistanceSquared(a_P, b_P, part.half_m, t));
   const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
-  const Eigen::Vector3d q_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
+  q_part_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
   // Below a micrometre the direction from the box to the axis is not defined well enough: that
   // is the axis inside the box, for which no signed distance is given.
   if (!(axis_m > 1e-6 * radius_m_)) return false;
@@ -212,14 +213,12 @@ bool Collision::CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P,
   // depth r1 - |c - q| is then exact (the nearest box point q is the foot of the deepest point's
   // normal), so the penalty keeps growing past K eps instead of saturating at the surface.
   distance_m = axis_m - radius_m_;
-  q_part_W = part.ToWorld(q_P);
-  normal_W = part.R_WP * ((c_P - q_P) / axis_m);
-  p_tube_W = part.ToWorld(c_P + (q_P - c_P) * (radius_m_ / axis_m));
+  normal_P = (c_P - q_part_P) / axis_m;
+  p_tube_P = c_P + (q_part_P - c_P) * (radius_m_ / axis_m);
   return true;
 }
 
-std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_W) const {
-  const Eigen::Vector3d q_P = part.ToPart(q_W);
+std::uint8_t Collision::FaceMask(const Part& part, const Eigen::Vector3d& q_P) const {
   std::uint8_t mask = 0;
   for (int a = 0; a < 3; ++a) {
     if (q_P[a] >= part.half_m[a] - part_tolerance_m_) mask |= std::uint8_t(1u << kPositiveFace[a]);
@@ -246,8 +245,8 @@ bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_P,
   return true;
 }
 
-void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
-                            const Eigen::Vector3d& b_W, RawContact& c) const {
+Eigen::Vector3d Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
+                                       const Eigen::Vector3d& b_W, RawContact& c) const {
   // GJK reports overlap without a depth. The contact is taken at the piece's midpoint, pushed out
   // through the face of the part nearest to it, at distance 0: the largest penalty force, K eps,
   // and a defined normal. The tick is flagged kPenetration by the caller.
@@ -259,9 +258,10 @@ void Collision::Overlapping(const Part& part, const Eigen::Vector3d& a_W,
   Eigen::Vector3d q_P = m_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
   q_P[axis] = side * part.half_m[axis];
   c.q_W_m = part.ToWorld(q_P);
-  c.normal_W = part.R_WP * (side * Eigen::Vector3d::Unit(axis));
+  c.normal_W = part.DirectionToWorld(side * Eigen::Vector3d::Unit(axis));
   c.distance_m = 0.0;
   c.overlap = true;
+  return q_P;
 }
 
 int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
@@ -306,54 +306,61 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       }
 
       double d = 0.0;
-      Eigen::Vector3d p_tube_W, q_part_W, capsule_normal_W;
+      // The tube's and the part's points and the normal, in the part's frame until the pair is
+      // known to be in the band (GJK's answer comes in the world frame).
+      Eigen::Vector3d p_P, q_P, n_P, p_gjk_W, q_gjk_W;
       ++narrow_calls_;
       bool separated = false;
       bool signed_depth = false;  // overlapping with a trusted depth: d < 0, normal given
+      bool from_gjk = false;
       if (!is_end) {
-        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_tube_W, q_part_W, capsule_normal_W);
+        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_P, q_P, n_P);
         signed_depth = separated && d <= 0.0;
-      } else if (Eigen::Vector3d p_P, q_P;
-                 CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
+      } else if (CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
         // The end piece nearest to a face (the usual case: the tip on the floor, the end against
         // a wall) in closed form; FCL's GJK only for an edge or a vertex nearest, or overlap.
         separated = true;
-        p_tube_W = part.ToWorld(p_P);
-        q_part_W = part.ToWorld(q_P);
       } else {
         separated = solver_.shapeDistance(end_, SegmentPose(a_W, b_W), part.box, part.X_WP, &d,
-                                          &p_tube_W, &q_part_W);
+                                          &p_gjk_W, &q_gjk_W);
+        from_gjk = true;
         // Overlapping: the shallowest way out through a face of the part (exact for an end
         // pressed into a face, an upper bound of the depth elsewhere), while less than r1.
-        Eigen::Vector3d p_in_P, q_in_P, n_P;
         if ((!separated || !(d > 0.0)) &&
-            CylinderBoxPenetration(a_P, b_P, radius_m_, part.half_m, d, p_in_P, q_in_P, n_P)) {
+            CylinderBoxPenetration(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P, n_P)) {
           signed_depth = true;
+          from_gjk = false;
           d = -d;
-          p_tube_W = part.ToWorld(p_in_P);
-          q_part_W = part.ToWorld(q_in_P);
-          capsule_normal_W = part.R_WP * n_P;
         }
+      }
+      if (separated && d >= band_m) continue;
+      Eigen::Vector3d p_tube_W, q_part_W;
+      if (from_gjk) {
+        p_tube_W = p_gjk_W;
+        q_part_W = q_gjk_W;
+        q_P = part.ToPart(q_gjk_W);
+      } else {
+        p_tube_W = part.ToWorld(p_P);
+        q_part_W = part.ToWorld(q_P);
       }
       RawContact c;
       c.part = part.index;
-      if (separated && d >= band_m) continue;
       const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
       if (signed_depth) {
         c.distance_m = d;
         c.q_W_m = q_part_W;
-        c.normal_W = capsule_normal_W;
+        c.normal_W = part.DirectionToWorld(n_P);
         c.overlap = true;
       } else if (separated && d > 0.0) {
         c.distance_m = d;
         c.q_W_m = q_part_W;
         c.normal_W = (p_tube_W - q_part_W) / d;
       } else {
-        Overlapping(part, a_W, b_W, c);
+        q_P = Overlapping(part, a_W, b_W, c);
         p_tube_W = c.q_W_m;
       }
       c.p_W_m = p_tube_W;
-      c.face_mask = FaceMask(part, c.q_W_m);
+      c.face_mask = FaceMask(part, q_P);
       c.part_element = element_of_[part.index][c.face_mask];
 
       // The centreline point under the contact, and which element of the tube touches.

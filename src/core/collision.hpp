@@ -100,23 +100,36 @@ class Collision {
     Eigen::Matrix3d R_PW = Eigen::Matrix3d::Identity(), R_WP = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_PW = Eigen::Vector3d::Zero(), p_WP = Eigen::Vector3d::Zero();
     Eigen::Vector3d half_m = Eigen::Vector3d::Zero();
-    Eigen::Vector3d ToPart(const Eigen::Vector3d& p_W) const { return R_PW * p_W + p_PW; }
-    Eigen::Vector3d ToWorld(const Eigen::Vector3d& p_P) const { return R_WP * p_P + p_WP; }
+    // Parts set square to the world (most scenes' floors and walls) skip the rotation: a
+    // product with the identity gives the same numbers, so nothing else changes.
+    bool aligned = false;
+    Eigen::Vector3d ToPart(const Eigen::Vector3d& p_W) const {
+      return aligned ? Eigen::Vector3d(p_W + p_PW) : Eigen::Vector3d(R_PW * p_W + p_PW);
+    }
+    Eigen::Vector3d ToWorld(const Eigen::Vector3d& p_P) const {
+      return aligned ? Eigen::Vector3d(p_P + p_WP) : Eigen::Vector3d(R_WP * p_P + p_WP);
+    }
+    Eigen::Vector3d DirectionToWorld(const Eigen::Vector3d& v_P) const {
+      return aligned ? v_P : Eigen::Vector3d(R_WP * v_P);
+    }
   };
-  // Classifies the part point q (world) into a face mask of the box.
-  std::uint8_t FaceMask(const Part& part, const Eigen::Vector3d& q_W) const;
+  // Classifies the part point q (part frame) into a face mask of the box.
+  std::uint8_t FaceMask(const Part& part, const Eigen::Vector3d& q_P) const;
   // Points in the part's frame from here on.
   bool PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
                         double band_m) const;
   // Capsule (segment a-b swept by r1) against the box, in closed form: the signed distance
   // (negative when the capsule dips into the box with its axis outside; then exact too), the
   // deepest or nearest tube point, the nearest box point and the normal from the part into the
-  // tube. False only when the axis reaches into the box (no defined direction).
+  // tube, all in the part's frame (most pieces that pass the broad phase turn out farther than the
+  // band and need nothing in the world frame). False only when the axis reaches into the box (no
+  // defined direction).
   bool CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
-                          double& distance_m, Eigen::Vector3d& p_tube_W, Eigen::Vector3d& q_part_W,
-                          Eigen::Vector3d& normal_W) const;
-  void Overlapping(const Part& part, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
-                   RawContact& c) const;
+                          double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
+                          Eigen::Vector3d& normal_P) const;
+  // Returns the contact's part point in the part's frame.
+  Eigen::Vector3d Overlapping(const Part& part, const Eigen::Vector3d& a_W,
+                              const Eigen::Vector3d& b_W, RawContact& c) const;
 
   std::vector<Part> parts_;
   std::vector<std::array<int, 64>> element_of_;
