@@ -244,21 +244,20 @@ void BeamChain::ElasticaNodes(const std::array<ElasticaSegment, kMaxLoads>& segm
     model::ElasticaCentreline(seg.solution, s_unit, xz, theta);
     const Eigen::Vector3d x_H = seg.R_HS * seg.bend_x_S;
     const Eigen::Vector3d z_H = seg.R_HS.col(2);
-    const auto point = [&](int j) {
-      return Eigen::Vector3d(seg.origin_H +
-                             L * (xz[std::size_t(j)].x() * x_H + xz[std::size_t(j)].y() * z_H));
-    };
-    const auto tangent = [&](int j) {  // d/ds of the position, unit length
-      return Eigen::Vector3d(std::sin(theta[std::size_t(j)]) * x_H +
-                             std::cos(theta[std::size_t(j)]) * z_H);
-    };
+    // The samples' points and unit tangents (d/ds of the position), each computed once: every
+    // node between two samples needs both samples' (a sine and a cosine each).
+    std::array<Eigen::Vector3d, n> point, tangent;
+    for (std::size_t j = 0; j < std::size_t(n); ++j) {
+      point[j] = seg.origin_H + L * (xz[j].x() * x_H + xz[j].y() * z_H);
+      tangent[j] = std::sin(theta[j]) * x_H + std::cos(theta[j]) * z_H;
+    }
     const double h = L / (n - 1);
     for (; k < count && step_m * double(k) <= seg.clamp_m + L; ++k) {
       const double u = std::clamp((step_m * double(k) - seg.clamp_m) / h, 0.0, double(n - 1));
-      const int j = std::min(static_cast<int>(u), n - 2);
-      const double t = u - j, t2 = t * t, t3 = t2 * t;
-      nodes[k] = (2 * t3 - 3 * t2 + 1) * point(j) + (t3 - 2 * t2 + t) * h * tangent(j) +
-                 (-2 * t3 + 3 * t2) * point(j + 1) + (t3 - t2) * h * tangent(j + 1);
+      const std::size_t j = std::size_t(std::min(static_cast<int>(u), n - 2));
+      const double t = u - double(j), t2 = t * t, t3 = t2 * t;
+      nodes[k] = (2 * t3 - 3 * t2 + 1) * point[j] + (t3 - 2 * t2 + t) * h * tangent[j] +
+                 (-2 * t3 + 3 * t2) * point[j + 1] + (t3 - t2) * h * tangent[j + 1];
     }
   }
   // Beyond the last load (or with none): straight along the last tangent.

@@ -275,29 +275,52 @@ struct Jacobi {
   double dn = 1.0;
 };
 
-Jacobi JacobiFunctions(double z, double k, double kc) {
-  constexpr int kMaxLevels = 24;
+// The descending Landen moduli of k (with their complements): they depend on k only, so a
+// caller that evaluates many arguments at one modulus (the quadrature nodes, the shape's samples)
+// computes them once.
+struct LandenChain {
+  static constexpr int kMaxLevels = 24;
   std::array<double, kMaxLevels> ks{};
   std::array<double, kMaxLevels> kcs{};
+  int levels = 0;
+  double k = 0.0, kc = 1.0;
+};
+
+LandenChain MakeLandenChain(double k, double kc) {
+  LandenChain chain;
+  chain.k = k;
+  chain.kc = kc;
+  auto& ks = chain.ks;
+  auto& kcs = chain.kcs;
   int n = 0;
   ks[0] = k;
   kcs[0] = kc;
-  while (ks[n] > 1e-9 && n + 1 < kMaxLevels) {
-    const double one_plus = 1.0 + kcs[n];
-    ks[n + 1] = ks[n] * ks[n] / (one_plus * one_plus);
-    kcs[n + 1] = 2.0 * std::sqrt(kcs[n]) / one_plus;
+  while (ks[std::size_t(n)] > 1e-9 && n + 1 < LandenChain::kMaxLevels) {
+    const std::size_t i = std::size_t(n);
+    const double one_plus = 1.0 + kcs[i];
+    ks[i + 1] = ks[i] * ks[i] / (one_plus * one_plus);
+    kcs[i + 1] = 2.0 * std::sqrt(kcs[i]) / one_plus;
     ++n;
-    z /= 1.0 + ks[n];
   }
+  chain.levels = n;
+  return chain;
+}
+
+Jacobi JacobiFunctions(double z, const LandenChain& chain) {
+  const auto& ks = chain.ks;
+  const auto& kcs = chain.kcs;
+  const int n = chain.levels;
+  for (int level = 1; level <= n; ++level) z /= 1.0 + ks[std::size_t(level)];
   double sn = std::sin(z);
   double cn = std::cos(z);
   for (int level = n; level >= 1; --level) {
-    const double dn = std::sqrt(kcs[level] * kcs[level] + ks[level] * ks[level] * cn * cn);
-    const double den = 1.0 + ks[level] * sn * sn;
-    sn = (1.0 + ks[level]) * sn / den;
+    const std::size_t i = std::size_t(level);
+    const double dn = std::sqrt(kcs[i] * kcs[i] + ks[i] * ks[i] * cn * cn);
+    const double den = 1.0 + ks[i] * sn * sn;
+    sn = (1.0 + ks[i]) * sn / den;
     cn = cn * dn / den;
   }
-  return {sn, cn, std::sqrt(kc * kc + k * k * cn * cn)};
+  return {sn, cn, std::sqrt(chain.kc * chain.kc + chain.k * chain.k * cn * cn)};
 }
 
 // ---- Tip displacement by quadrature (moderate alpha) ---------------------------------------
@@ -338,8 +361,9 @@ void TipDisplacementByQuadrature(const Loading& load, const Trial& trial, double
   const double c0 = load.c0;
   double sum_x = 0.0;
   double sum_h = 0.0;
+  const LandenChain chain = MakeLandenChain(trial.k, trial.kc);
   for (int i = 0; i < kGaussPoints; ++i) {
-    const Jacobi j = JacobiFunctions(sqrt_alpha * rule.node[i], trial.k, trial.kc);
+    const Jacobi j = JacobiFunctions(sqrt_alpha * rule.node[i], chain);
     const double sn_sq = j.sn * j.sn;
     const double den = 1.0 - s0 * s0 * sn_sq;
     const double mix = c0 * c0 + s0 * s0 * j.cn;
@@ -496,17 +520,18 @@ struct FromTip {
   double theta = 0.0;
 };
 
-FromTip ShapeFromTip(const ElasticaSolution& solution, double sqrt_alpha, double tau0, double s) {
+FromTip ShapeFromTip(const ElasticaSolution& solution, const LandenChain& chain, double sqrt_alpha,
+                     double tau0, double s) {
   const double k = solution.modulus_k;
   const double kc = solution.modulus_kc;
   const double w = sqrt_alpha * (1.0 - s);
   const double tau = tau0 + sqrt_alpha * s;  // = K - w
   Jacobi tipside;                            // sn, cn, dn at w
   if (w <= tau) {
-    tipside = JacobiFunctions(w, k, kc);
+    tipside = JacobiFunctions(w, chain);
   } else {
     // Reflection about K/2: sn(K - tau) = cd(tau), cn(K - tau) = k' sd(tau), dn = k' nd(tau).
-    const Jacobi rootside = JacobiFunctions(tau, k, kc);
+    const Jacobi rootside = JacobiFunctions(tau, chain);
     tipside.sn = rootside.cn / rootside.dn;
     tipside.cn = kc * rootside.sn / rootside.dn;
     tipside.dn = kc / rootside.dn;
@@ -590,13 +615,14 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
   const double tau0 = sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
   // The closed forms give the whole tip position relative to the root too; its tiny difference
   // from the tip figures (rounding) is spread linearly so that s = 0 and s = 1 are both exact.
-  const FromTip root = ShapeFromTip(solution, sqrt_alpha, tau0, 0.0);
+  const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
+  const FromTip root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
   const double root_x = root.along * load.cos_psi - root.across * load.sin_psi;
   const double root_z = root.along * load.sin_psi + root.across * load.cos_psi;
   const double error_x = tip.deflection - root_x;
   const double error_z = (1.0 - tip.shortening) - root_z;
   for (std::size_t i = 0; i < s.size(); ++i) {
-    const FromTip here = ShapeFromTip(solution, sqrt_alpha, tau0, s[i]);
+    const FromTip here = ShapeFromTip(solution, chain, sqrt_alpha, tau0, s[i]);
     const double along = root.along - here.along;
     const double across = root.across - here.across;
     xz_out[i] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s[i] * error_x,
