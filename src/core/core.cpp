@@ -42,13 +42,16 @@ bool IsBoundaryOf(states::TubeElement a, states::TubeElement b) {
 }  // namespace
 
 int ChainCapsuleCount(const scene::Scene& scene) {
+  if (scene.model.capsules > 0)
+    return std::clamp(scene.model.capsules, kMinCapsules, kMaxCapsules);  // the loader checks it
   const model::TubeSection section = model::ComputeSection(scene.tube);
   const double l = scene.tube.length_m;
   const double kappa = scene.device.max_force_N * l / section.bending_stiffness_Nm2;
   const double tolerance_m = 0.1 * scene.contact.threshold_m;
   // kappa (l/N)^2 / 8 <= tolerance  <=>  N >= l sqrt(kappa / (8 tolerance)).
   const double n = std::ceil(l * std::sqrt(kappa / (8.0 * tolerance_m)));
-  return static_cast<int>(std::clamp(n, 8.0, static_cast<double>(kMaxCapsules)));
+  return static_cast<int>(
+      std::clamp(n, static_cast<double>(kMinCapsules), static_cast<double>(kMaxCapsules)));
 }
 
 struct Core::Impl {

@@ -15,6 +15,7 @@
 #include <yaml-cpp/depthguard.h>
 #include <yaml-cpp/yaml.h>
 
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/core/coupling.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
@@ -261,7 +262,7 @@ void ReadDevice(Reader& r, const YAML::Node& node, scene::Device& d) {
 
 void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
   const std::string w = "model";
-  if (!r.ExpectMap(node, w, {"beam", "multi_contact", "slip", "time_step"})) return;
+  if (!r.ExpectMap(node, w, {"beam", "multi_contact", "slip", "time_step", "capsules"})) return;
   if (const YAML::Node n = r.Get(node, "beam", w, false); n.IsDefined())
     if (const auto v = r.Choice<model::BeamModel>(
             n, "model.beam",
@@ -284,6 +285,26 @@ void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
       (m.time_step_s <= 0.0 || m.time_step_s > 0.010))
     r.Error(r.Get(node, "time_step", w, false),
             "model.time_step must be in (0, 10 ms], expected e.g. \"1 ms\" (1 kHz)");
+  // The chain's capsule count: "auto" (the core's choice) or a whole number the core supports.
+  if (const YAML::Node n = r.Get(node, "capsules", w, false); n.IsDefined()) {
+    const std::string expected = "expected \"auto\" or a whole number from " +
+                                 std::to_string(core::kMinCapsules) + " to " +
+                                 std::to_string(core::kMaxCapsules);
+    if (n.IsScalar() && n.Scalar() == "auto") {
+      m.capsules = 0;
+    } else if (!n.IsScalar()) {
+      r.Error(
+          n, "model.capsules must be a count, found " + std::string(KindName(n)) + ", " + expected);
+    } else if (const auto v = r.Quantity(n, "model.capsules", dim::kNone)) {
+      if (*v != std::floor(*v) || *v < core::kMinCapsules || *v > core::kMaxCapsules)
+        r.Error(n, "model.capsules " + Abbreviate(n.Scalar()) +
+                       " is not a count the core "
+                       "supports, " +
+                       expected);
+      else
+        m.capsules = static_cast<int>(*v);
+    }
+  }
 }
 
 void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {

@@ -18,6 +18,7 @@
 #include <tubeplan/core/friction.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/model/tube.hpp>
 
 #include "../alloc_count.hpp"
 
@@ -298,5 +299,40 @@ TEST_CASE("Free motion: the held end follows the hand and nothing is felt", "[co
     CHECK(out.force_W_N.isZero(0.0));
     CHECK(out.energy_J == 0.0);
     CHECK(c.narrow_phase_calls() == 0);  // far from every part: the broad phase stops it all
+  }
+}
+
+TEST_CASE("The chain's capsule count keeps its chord error, or is the scene's", "[core]") {
+  // ChainCapsuleCount's rule, checked as the property it promises: a capsule of length l/N on an
+  // arc of the largest curvature the device can bend the tube to (kappa = F_max l / (E I), the
+  // linear root curvature under a tip force) lies within epsilon / 10 of the arc, unless the count
+  // is at the cap. A count the scene sets replaces the rule and shapes the chain.
+  for (const char* file : {"scenes/groove.yaml", "scenes/groove-steel.yaml"}) {
+    scene::Scene s = LoadScene(file);
+    const double l = s.tube.length_m;
+    const double kappa =
+        s.device.max_force_N * l / model::ComputeSection(s.tube).bending_stiffness_Nm2;
+    const int n = core::ChainCapsuleCount(s);
+    CAPTURE(file, n, kappa);
+    CHECK(n >= core::kMinCapsules);
+    CHECK(n <= core::kMaxCapsules);
+    const double chord_error_m = kappa * (l / n) * (l / n) / 8.0;
+    if (n < core::kMaxCapsules) CHECK(chord_error_m <= 0.1 * s.contact.threshold_m);
+    // One capsule fewer would not do, unless the count is at the floor.
+    if (n > core::kMinCapsules)
+      CHECK(kappa * (l / (n - 1)) * (l / (n - 1)) / 8.0 > 0.1 * s.contact.threshold_m);
+
+    s.model.capsules = 16;
+    core::Core c(s);
+    CHECK(c.capsule_count() == 16);
+    // The coarser chain still carries the tube: pressed onto the floor it reports the floor.
+    Eigen::Isometry3d X = s.X_WH_start;
+    c.Reset(X);
+    for (int k = 0; k < 200; ++k) {
+      X.translation().z() -= 2e-4;
+      const core::StepOutput& out = c.Step(1e-3 * k, X);
+      REQUIRE(out.force_W_N.allFinite());
+    }
+    CHECK(c.last().contact_count >= 1);
   }
 }

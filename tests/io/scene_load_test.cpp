@@ -196,6 +196,15 @@ TEST_CASE("Broken scenes get exactly the right diagnostics", "[scene]") {
       {"unknown model", kMinimal + "model: {beam: timoshenko}\n",
        "t.yaml:12:15: error: model.beam 'timoshenko' is not known (expected one of: linear, "
        "elastica)\n"},
+      {"capsule count beyond the core's", kMinimal + "model: {capsules: 60}\n",
+       "t.yaml:12:19: error: model.capsules 60 is not a count the core supports, expected "
+       "\"auto\" or a whole number from 8 to 48\n"},
+      {"capsule count not whole", kMinimal + "model: {capsules: 12.5}\n",
+       "t.yaml:12:19: error: model.capsules 12.5 is not a count the core supports, expected "
+       "\"auto\" or a whole number from 8 to 48\n"},
+      {"capsule count not a scalar", kMinimal + "model: {capsules: [16]}\n",
+       "t.yaml:12:19: error: model.capsules must be a count, found a sequence, expected \"auto\" "
+       "or a whole number from 8 to 48\n"},
       {"top level not a map", "- 1\n- 2\n",
        "t.yaml:1:1: error: a scene file must be a map, found a sequence, expected keys such as "
        "tubeplan, name, tube, parts\n"},

@@ -47,7 +47,9 @@ inline constexpr int kMaxContacts = 6;
 /// along a face) is carried by two, at the ends of the region, so that its resultant can move
 /// and its moment is carried; others by one.
 inline constexpr int kMaxLoads = 8;
-/// Most capsules in the tube's chain (the count is chosen per scene, see ChainCapsuleCount).
+/// Fewest and most capsules in the tube's chain (the count is chosen per scene, see
+/// ChainCapsuleCount, or set by the scene's model.capsules).
+inline constexpr int kMinCapsules = 8;
 inline constexpr int kMaxCapsules = 48;
 
 /// Bits of StepOutput::flags.
@@ -118,7 +120,8 @@ inline FormationKey KeyOf(const StepOutput& out) {
 /// Capsule count of the chain: the chord of a segment of length l/N on an arc of curvature
 /// kappa lies inside the arc by kappa (l/N)^2 / 8; the largest curvature the core can produce is
 /// at the root under the device's largest force, kappa = F_max l / (E I). N is the smallest count
-/// that keeps that error below epsilon / 10, clamped to [8, kMaxCapsules].
+/// that keeps that error below epsilon / 10, clamped to [kMinCapsules, kMaxCapsules]. A scene
+/// that sets model.capsules gets that count instead.
 int ChainCapsuleCount(const scene::Scene& scene);
 
 class Core {

@@ -56,6 +56,9 @@ struct ModelOptions {
   MultiContactRule multi_contact = MultiContactRule::kSegmented;
   SlipRule slip = SlipRule::kReturnMapping;
   double time_step_s = 1.0e-3;  ///< the core's fixed step [s]
+  /// Capsules in the tube's chain; 0: chosen by the core from the tube and the device
+  /// (core::ChainCapsuleCount). Set to trade the chain's chord error for speed, or to study it.
+  int capsules = 0;
 };
 
 /// The haptic device and the virtual coupling of the hand to the held end (physics.md).
