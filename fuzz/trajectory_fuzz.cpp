@@ -1,11 +1,13 @@
-// libFuzzer target: the bytes as a trajectory CSV, through the loader `check`, `simulate` and
-// the plan loader use (LoadTrajectoryFile reads the file and hands its text to
-// LoadTrajectoryText).
+// libFuzzer target: the bytes as a trajectory CSV, through the in-memory loader (the plan loader
+// for `evaluate --monte-carlo` and `live`, LoadTrajectoryText), and through the input checks as
+// the streamed passes of `check`, `simulate` and `evaluate` run them (in pieces, cut where a
+// 64 KiB chunk would end): the same text must get the same messages.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
 
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -25,5 +27,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
   (void)result.diagnostics.FormatAll();
+
+  // The checks fed in three pieces, cut at places the input chooses (its first two bytes).
+  const std::size_t cut1 = size > 0 ? data[0] % (size + 1) : 0;
+  const std::size_t cut2 = size > 1 ? cut1 + data[1] % (size - cut1 + 1) : cut1;
+  tubeplan::io::InputTextCheck check;
+  check.Feed(text.substr(0, cut1));
+  check.Feed(text.substr(cut1, cut2 - cut1));
+  check.Feed(text.substr(cut2));
+  tubeplan::io::Diagnostics pieces, whole;
+  const bool pieces_ok = check.Finish("fuzz.csv", "a trajectory", pieces);
+  const bool whole_ok = tubeplan::io::CheckInputText(text, "fuzz.csv", "a trajectory", whole);
+  if (pieces_ok != whole_ok || pieces.FormatAll() != whole.FormatAll()) __builtin_trap();
   return 0;
 }

@@ -1,6 +1,7 @@
 #include <exception>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
 
 #include "commands.hpp"
 
@@ -68,6 +69,10 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
   try {
     for (const Command& command : commands)
       if (command.app->parsed()) return command.run();
+  } catch (const io::InputChanged& e) {
+    // A trajectory rewritten between its check and its replay: bad input, not a bug.
+    err << e.what() << "\n";
+    return kExitBadInput;
   } catch (const std::exception& e) {
     err << "tubeplan: internal error: " << e.what() << "\n";
     return kExitInternal;

@@ -50,11 +50,11 @@ std::string Summary(const scene::Scene& s) {
   return out.str();
 }
 
-std::string Summary(const plan::Trajectory& t) {
-  const double duration_s = t.samples.back().t_s - t.samples.front().t_s;
+std::string Summary(const io::TrajectoryInfo& t) {
+  const double duration_s = t.t_last_s - t.t_first_s;
   std::ostringstream out;
-  out << "trajectory: " << t.samples.size() << " samples over " << duration_s << " s (mean rate "
-      << static_cast<double>(t.samples.size() - 1) / duration_s << " Hz";
+  out << "trajectory: " << t.sample_count << " samples over " << duration_s << " s (mean rate "
+      << static_cast<double>(t.sample_count - 1) / duration_s << " Hz";
   if (t.nominal_rate_Hz > 0.0) out << ", nominal " << t.nominal_rate_Hz << " Hz";
   out << ")";
   if (!t.device.empty()) out << "; device " << t.device;
@@ -74,21 +74,22 @@ struct Checked {
 
 Checked CheckFile(const std::string& file) {
   if (std::filesystem::path(file).extension() == ".csv") {
-    io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(file);
-    Checked c{"trajectory", std::move(loaded.diagnostics), std::nullopt};
-    if (loaded.trajectory) c.summary = Summary(*loaded.trajectory);
+    // Streamed: a recording of hours is checked in the memory of a few lines.
+    io::TrajectoryScanResult scanned = io::ScanTrajectoryFile(file);
+    Checked c{"trajectory", std::move(scanned.diagnostics), std::nullopt};
+    if (scanned.info) c.summary = Summary(*scanned.info);
     return c;
   }
   // A plan file names its plan at the top level ("plan: ..."); any other YAML is a scene.
   if (const std::optional<std::string> text = io::ReadTextFile(file);
       text && (text->rfind("plan:", 0) == 0 || text->find("\nplan:") != std::string::npos)) {
-    io::PlanLoadResult plan = io::LoadPlanFile(file);
+    io::PlanLoadResult plan = io::LoadPlanFile(file, {.trajectory_in_memory = false});
     Checked c{"plan", std::move(plan.diagnostics), std::nullopt};
     if (plan.plan) {
       std::ostringstream out;
       out << "plan \"" << plan.plan->name << "\": " << plan.plan->states.size() << " states, "
           << plan.plan->states.front() << " to " << plan.plan->states.back() << "; scene \""
-          << plan.scene->name << "\"; " << Summary(*plan.trajectory);
+          << plan.scene->name << "\"; " << Summary(*plan.trajectory_file);
       c.summary = out.str();
     }
     return c;

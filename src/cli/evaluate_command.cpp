@@ -12,6 +12,8 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -25,6 +27,7 @@
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/perturb.hpp>
 
@@ -192,7 +195,9 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   }
   std::vector<io::PlanLoadResult> loaded;
   for (const std::string& f : files) {
-    loaded.push_back(io::LoadPlanFile(f));
+    // Monte Carlo perturbs the trajectory and needs its samples; otherwise the trajectory is
+    // checked streamed and replayed from its file row by row (docs/hardening.md).
+    loaded.push_back(io::LoadPlanFile(f, {.trajectory_in_memory = o.monte_carlo > 0}));
     io.err << loaded.back().diagnostics.FormatAll();
     ok = ok && loaded.back().plan.has_value();
   }
@@ -218,6 +223,8 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   std::atomic<std::size_t> done{0};
   std::atomic<std::size_t> judged{0};
   const InterruptGuard interrupt_guard;
+  std::mutex changed_mutex;
+  std::vector<std::string> changed_errors;  // trajectory files rewritten during their replay
   auto work = [&] {
     for (std::size_t i = next++; i < files.size() && !g_interrupted.load(); i = next++) {
       const io::PlanLoadResult& l = loaded[i];
@@ -225,11 +232,23 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       ReplayRecorder recorder;
       plan::TickWatcher watch;
       if (!recordings.empty()) watch = std::ref(recorder);
-      Evaluated e{files[i],
-                  *l.plan,
-                  plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits, watch),
-                  0,
-                  {}};
+      std::optional<plan::Judgement> judgement;
+      if (l.trajectory) {
+        judgement = plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits, watch);
+      } else {
+        try {
+          io::TrajectoryFileSamples samples(*l.trajectory_file);
+          plan::SampleTicks ticks(samples, l.trajectory_file->t_first_s,
+                                  l.trajectory_file->t_last_s, l.scene->model.time_step_s);
+          judgement = plan::Judge(*l.scene, ticks, l.plan->states, l.plan->limits, watch);
+        } catch (const io::InputChanged& changed) {
+          // Said after the batch, which then has no report: a result needs every plan.
+          const std::lock_guard lock(changed_mutex);
+          changed_errors.emplace_back(changed.what());
+          continue;
+        }
+      }
+      Evaluated e{files[i], *l.plan, std::move(*judgement), 0, {}};
       if (!recordings.empty()) recordings[i] = recorder.Finish();
       e.runs = o.monte_carlo;
       e.robust.assign(e.judgement.transitions.size(), 0);
@@ -265,6 +284,13 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
 
+  if (!changed_errors.empty()) {
+    for (const std::string& e : changed_errors) io.err << e << "\n";
+    io.err << "tubeplan evaluate: no report written"
+           << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
+           << "\n";
+    return kExitBadInput;
+  }
   if (judged.load() < files.size()) {
     io.err << "tubeplan evaluate: interrupted after " << judged.load() << " of " << files.size()
            << " plans; no report written"

@@ -41,7 +41,9 @@ struct Visit {
 
 int RunSimulate(const SimulateOptions& o, Streams io) {
   io::SceneLoadResult scene = io::LoadSceneFile(o.scene_path);
-  io::TrajectoryLoadResult trajectory = io::LoadTrajectoryFile(o.trajectory_path);
+  // The trajectory is checked in a streamed pass and replayed in a second one, row by row: an
+  // hour's recording is never held (docs/hardening.md).
+  io::TrajectoryScanResult trajectory = io::ScanTrajectoryFile(o.trajectory_path);
   io.err << scene.diagnostics.FormatAll() << trajectory.diagnostics.FormatAll();
   SeriesFormat format = SeriesFormat::kNone;
   if (!o.out_path.empty()) {
@@ -56,7 +58,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
       return kExitBadInput;
     }
   }
-  if (!scene.scene || !trajectory.trajectory) return kExitBadInput;
+  if (!scene.scene || !trajectory.info) return kExitBadInput;
 
   const scene::Scene& s = *scene.scene;
   // The series goes to its file as it is made (an hour at 1 kHz is about 2 GB of CSV), into a
@@ -70,8 +72,10 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
       return kExitBadInput;
     }
   }
-  // Ticks one at a time: the resampled trajectory is never held as a second copy.
-  plan::TickStream ticks(*trajectory.trajectory, s.model.time_step_s);
+  // Ticks one at a time from the file's rows: only the two samples around a tick are held.
+  io::TrajectoryFileSamples samples(*trajectory.info);
+  plan::SampleTicks ticks(samples, trajectory.info->t_first_s, trajectory.info->t_last_s,
+                          s.model.time_step_s);
   core::Core core(s);
   const plan::HandSample first = ticks.Tick(0);
   Eigen::Isometry3d X_W_hand0 = Eigen::Isometry3d::Identity();

@@ -32,7 +32,8 @@ void ReadLimits(Reader& r, const YAML::Node& node, plan::Limits& l) {
 }  // namespace
 
 PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& display_name,
-                            const std::filesystem::path& directory) {
+                            const std::filesystem::path& directory,
+                            const PlanLoadOptions& options) {
   PlanLoadResult result;
   Reader r(display_name, result.diagnostics);
   plan::Plan p;
@@ -82,21 +83,33 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     std::string full;
     std::string text;
   };
-  auto read_named = [&](const char* key, const char* expected, std::uintmax_t max_bytes,
-                        std::string& target) {
-    std::optional<Named> named;
+  // A path the plan names, relative to the plan's directory, or nothing (reported).
+  auto named_path = [&](const char* key, std::string& target) {
+    std::optional<std::pair<YAML::Node, std::filesystem::path>> named;
     const YAML::Node n = r.Get(root, key, "plan file", true);
     if (!n.IsDefined()) return named;
     const auto path = r.String(n, key);
     if (!path) return named;
     target = *path;
-    const std::filesystem::path full = directory / *path;
+    named.emplace(n, directory / *path);
+    return named;
+  };
+  auto cannot_read = [&](const YAML::Node& n, const char* key, const std::filesystem::path& full,
+                         const std::string& why, const char* expected) {
+    r.Error(n, std::string(key) + ": cannot read '" + full.string() + "' (" + why + "), expected " +
+                   expected);
+  };
+  auto read_named = [&](const char* key, const char* expected, std::uintmax_t max_bytes,
+                        std::string& target) {
+    std::optional<Named> named;
+    const auto path = named_path(key, target);
+    if (!path) return named;
+    const auto& [n, full] = *path;
     ReadResult read = ReadInputFile(full, max_bytes);
     if (read.text) {
       named = Named{n, full.string(), std::move(*read.text)};
     } else {
-      r.Error(n, std::string(key) + ": cannot read '" + full.string() + "' (" + read.error +
-                     "), expected " + expected);
+      cannot_read(n, key, full, read.error, expected);
     }
     return named;
   };
@@ -109,13 +122,26 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     if (!loaded.scene) r.Error(named->node, "scene: '" + named->full + "' has errors (listed)");
     scene = std::move(loaded.scene);
   }
-  if (const auto named = read_named("trajectory", "a trajectory CSV path relative to the plan file",
-                                    kMaxInputBytes, p.trajectory)) {
-    TrajectoryLoadResult loaded = LoadTrajectoryText(named->text, named->full);
-    result.diagnostics.Append(loaded.diagnostics);
-    if (!loaded.trajectory)
-      r.Error(named->node, "trajectory: '" + named->full + "' has errors (listed)");
-    result.trajectory = std::move(loaded.trajectory);
+  constexpr const char* kTrajectoryPath = "a trajectory CSV path relative to the plan file";
+  if (options.trajectory_in_memory) {
+    if (const auto named =
+            read_named("trajectory", kTrajectoryPath, kMaxInputBytes, p.trajectory)) {
+      TrajectoryLoadResult loaded = LoadTrajectoryText(named->text, named->full);
+      result.diagnostics.Append(loaded.diagnostics);
+      if (!loaded.trajectory)
+        r.Error(named->node, "trajectory: '" + named->full + "' has errors (listed)");
+      result.trajectory = std::move(loaded.trajectory);
+    }
+  } else if (const auto named = named_path("trajectory", p.trajectory)) {
+    const auto& [n, full] = *named;
+    TrajectoryScanResult scanned = ScanTrajectoryFile(full);
+    if (!scanned.read_error.empty()) {
+      cannot_read(n, "trajectory", full, scanned.read_error, kTrajectoryPath);
+    } else {
+      result.diagnostics.Append(scanned.diagnostics);
+      if (!scanned.info) r.Error(n, "trajectory: '" + full.string() + "' has errors (listed)");
+      result.trajectory_file = std::move(scanned.info);
+    }
   }
   if (const YAML::Node n = r.Get(root, "states", "plan file", true); n.IsDefined()) {
     if (!n.IsSequence() || n.size() < 2) {
@@ -154,15 +180,17 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     result.scene = std::move(scene);
   } else {
     result.trajectory.reset();
+    result.trajectory_file.reset();
     result.states.clear();
   }
   return result;
 }
 
 PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
-                            const std::filesystem::path& directory) {
+                            const std::filesystem::path& directory,
+                            const PlanLoadOptions& options) {
   try {
-    return ReadPlanText(yaml_text, display_name, directory);
+    return ReadPlanText(yaml_text, display_name, directory, options);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
     PlanLoadResult result;
@@ -185,7 +213,7 @@ PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& displ
   }
 }
 
-PlanLoadResult LoadPlanFile(const std::filesystem::path& path) {
+PlanLoadResult LoadPlanFile(const std::filesystem::path& path, const PlanLoadOptions& options) {
   const ReadResult read = ReadInputFile(path, kMaxYamlBytes);
   if (!read.text) {
     PlanLoadResult result;
@@ -194,7 +222,7 @@ PlanLoadResult LoadPlanFile(const std::filesystem::path& path) {
         "cannot read file (" + read.error + "), expected a readable YAML plan file");
     return result;
   }
-  return LoadPlanText(*read.text, path.string(), path.parent_path());
+  return LoadPlanText(*read.text, path.string(), path.parent_path(), options);
 }
 
 }  // namespace tubeplan::io

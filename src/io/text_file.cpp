@@ -23,39 +23,43 @@ struct Fd {
   }
 };
 
+// Opens `path` for reading if it is a regular file of at most `max_bytes`; else closes it and
+// says why, in the words every "cannot read file (...)" message quotes.
+std::string OpenRegularFile(const std::filesystem::path& path, std::uintmax_t max_bytes, Fd& in,
+                            struct stat& info) {
+  // O_NONBLOCK: opening a FIFO nobody writes to must not block; a regular file ignores it.
+  in.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (in.fd < 0) return errno == ENOENT ? "no such file" : std::strerror(errno);
+  if (::fstat(in.fd, &info) != 0) return std::strerror(errno);
+  if (S_ISDIR(info.st_mode)) return "it is a directory";
+  if (!S_ISREG(info.st_mode)) return "it is not a regular file (a device, FIFO or socket)";
+  const auto size = static_cast<std::uintmax_t>(info.st_size);
+  if (size > max_bytes)
+    return "it is " + MiB(size) + ", more than the " + MiB(max_bytes) + " allowed";
+  return {};
+}
+
+// Reads up to `count` bytes, retrying on EINTR; -1 on an error (errno set).
+ssize_t ReadSome(int fd, char* to, std::size_t count) {
+  while (true) {
+    const ssize_t n = ::read(fd, to, count);
+    if (n < 0 && errno == EINTR) continue;
+    return n;
+  }
+}
+
 }  // namespace
 
 ReadResult ReadInputFile(const std::filesystem::path& path, std::uintmax_t max_bytes) {
   ReadResult result;
-  // O_NONBLOCK: opening a FIFO nobody writes to must not block; a regular file ignores it.
-  Fd in{::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
-  if (in.fd < 0) {
-    result.error = errno == ENOENT ? "no such file" : std::strerror(errno);
-    return result;
-  }
+  Fd in;
   struct stat info {};
-  if (::fstat(in.fd, &info) != 0) {
-    result.error = std::strerror(errno);
-    return result;
-  }
-  if (S_ISDIR(info.st_mode)) {
-    result.error = "it is a directory";
-    return result;
-  }
-  if (!S_ISREG(info.st_mode)) {
-    result.error = "it is not a regular file (a device, FIFO or socket)";
-    return result;
-  }
-  const auto size = static_cast<std::uintmax_t>(info.st_size);
-  if (size > max_bytes) {
-    result.error = "it is " + MiB(size) + ", more than the " + MiB(max_bytes) + " allowed";
-    return result;
-  }
-  std::string text(static_cast<std::size_t>(size), '\0');
+  result.error = OpenRegularFile(path, max_bytes, in, info);
+  if (!result.error.empty()) return result;
+  std::string text(static_cast<std::size_t>(info.st_size), '\0');
   std::size_t done = 0;
   while (done < text.size()) {
-    const ssize_t n = ::read(in.fd, text.data() + done, text.size() - done);
-    if (n < 0 && errno == EINTR) continue;
+    const ssize_t n = ReadSome(in.fd, text.data() + done, text.size() - done);
     if (n < 0) {
       result.error = std::strerror(errno);
       return result;
@@ -66,6 +70,79 @@ ReadResult ReadInputFile(const std::filesystem::path& path, std::uintmax_t max_b
   text.resize(done);
   result.text = std::move(text);
   return result;
+}
+
+InputFileReader::~InputFileReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::string InputFileReader::Open(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  Fd in;
+  struct stat info {};
+  std::string error = OpenRegularFile(path, max_bytes, in, info);
+  if (!error.empty()) return error;
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = in.fd;
+  in.fd = -1;
+  size_ = left_ = static_cast<std::uintmax_t>(info.st_size);
+  modified_ns_ = std::int64_t{info.st_mtim.tv_sec} * 1'000'000'000 + info.st_mtim.tv_nsec;
+  buffer_.resize(kChunkBytes);
+  error_.clear();
+  return {};
+}
+
+std::string_view InputFileReader::Next() {
+  if (fd_ < 0 || left_ == 0 || !error_.empty()) return {};
+  const ssize_t n = ReadSome(
+      fd_, buffer_.data(), static_cast<std::size_t>(std::min<std::uintmax_t>(left_, kChunkBytes)));
+  if (n < 0) {
+    error_ = std::strerror(errno);
+    return {};
+  }
+  // n == 0: the file shrank while we read it; what was there is what we have (as ReadInputFile).
+  left_ = n == 0 ? 0 : left_ - static_cast<std::uintmax_t>(n);
+  return {buffer_.data(), static_cast<std::size_t>(n)};
+}
+
+bool InputLineReader::Next(std::string_view& line) {
+  line_.clear();
+  bool partial = false;
+  // A line cut by a chunk's end is copied into line_, up to just over the limit: the check
+  // fails such a file, and its parser needs only to see that the line is long.
+  const auto keep = [this](std::string_view piece) {
+    if (line_.size() <= kMaxLineBytes)
+      line_.append(piece.substr(0, kMaxLineBytes + 1 - line_.size()));
+  };
+  while (true) {
+    if (chunk_.empty()) {
+      if (!end_) {
+        chunk_ = file_.Next();
+        if (!chunk_.empty()) {
+          check_.Feed(chunk_);
+          continue;
+        }
+        end_ = true;
+      }
+      if (!partial) return false;
+      line = line_;
+      return true;
+    }
+    const std::size_t newline = chunk_.find('\n');
+    if (newline == std::string_view::npos) {
+      keep(chunk_);
+      partial = true;
+      chunk_ = {};
+      continue;
+    }
+    if (partial) {
+      keep(chunk_.substr(0, newline));
+      line = line_;
+    } else {
+      line = chunk_.substr(0, newline);
+    }
+    chunk_.remove_prefix(newline + 1);
+    return true;
+  }
 }
 
 std::optional<std::string> ReadTextFile(const std::filesystem::path& path) {
@@ -80,59 +157,65 @@ std::string Abbreviate(std::string_view text, std::size_t max_bytes) {
   return std::string(text.substr(0, cut)) + "...";
 }
 
-bool CheckInputText(std::string_view text, const std::string& display_name,
-                    std::string_view expected, Diagnostics& diagnostics) {
-  const std::string expect(expected);
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
-    diagnostics.Error(display_name, 0, 0,
-                      std::string(text.empty() ? "the file is empty" : "the file is blank") +
-                          ", expected " + expect);
-    return false;
+void InputTextCheck::Feed(std::string_view piece) {
+  size_ += piece.size();
+  if (blank_ && piece.find_first_not_of(" \t\r\n") != std::string_view::npos) blank_ = false;
+  if (wide_ != nullptr) return;
+  if (carry_.empty()) {
+    Scan(piece, false);
+  } else {
+    joined_ = carry_;
+    joined_.append(piece);
+    carry_.clear();
+    Scan(joined_, false);
   }
-  // Byte-order marks of the encodings a Windows editor may save in.
-  auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
-  const char* wide = nullptr;
-  if (starts(std::string_view("\xFF\xFE\x00\x00", 4)) ||
-      starts(std::string_view("\x00\x00\xFE\xFF", 4))) {
-    wide = "UTF-32";
-  } else if (starts("\xFF\xFE") || starts("\xFE\xFF")) {
-    wide = "UTF-16";
+}
+
+void InputTextCheck::EndLongLine(std::uint64_t end) {
+  findings_[open_long_].length = end - line_start_;
+  open_long_ = SIZE_MAX;
+}
+
+// `data` starts at offset base_ of the whole text; `last`: nothing follows it. A UTF-8 sequence
+// (or, at the start, a byte-order mark) cut by data's end is kept in carry_ for the next piece,
+// so every decision sees the same bytes as a scan of the whole text would.
+void InputTextCheck::Scan(std::string_view data, bool last) {
+  const std::size_t n = data.size();
+  if (!bom_checked_) {
+    if (n < 4 && !last) {
+      carry_.assign(data);
+      return;
+    }
+    // Byte-order marks of the encodings a Windows editor may save in.
+    auto starts = [&](std::string_view bom) { return data.substr(0, bom.size()) == bom; };
+    bom_checked_ = true;
+    if (starts(std::string_view("\xFF\xFE\x00\x00", 4)) ||
+        starts(std::string_view("\x00\x00\xFE\xFF", 4))) {
+      wide_ = "UTF-32";
+    } else if (starts("\xFF\xFE") || starts("\xFE\xFF")) {
+      wide_ = "UTF-16";
+    }
+    if (wide_ != nullptr) return;
   }
-  if (wide != nullptr) {
-    diagnostics.Error(display_name, 1, 1,
-                      std::string("the file is ") + wide +
-                          " (it starts with a byte-order mark), expected UTF-8 text: " + expect);
-    return false;
-  }
-  bool ok = true;
-  bool reported_nul = false, reported_utf8 = false, reported_long = false;
-  int line = 1;
-  std::size_t line_start = 0;
-  const auto column = [&](std::size_t at) { return static_cast<int>(at - line_start) + 1; };
-  const std::size_t n = text.size();
+  const auto column = [&](std::size_t at) {
+    return static_cast<int>(base_ + at - line_start_) + 1;
+  };
   for (std::size_t i = 0; i < n;) {
-    const auto c = static_cast<unsigned char>(text[i]);
+    const auto c = static_cast<unsigned char>(data[i]);
     if (c == '\n') {
-      ++line;
-      line_start = ++i;
+      if (open_long_ != SIZE_MAX) EndLongLine(base_ + i);
+      ++line_;
+      line_start_ = base_ + ++i;
       continue;
     }
-    if (!reported_long && i - line_start >= kMaxLineBytes) {
-      const std::size_t end = std::min(n, text.find('\n', i));
-      diagnostics.Error(display_name, line, 1,
-                        "line " + std::to_string(line) + " is " + std::to_string(end - line_start) +
-                            " bytes long, expected at most " + std::to_string(kMaxLineBytes) +
-                            " bytes per line in " + expect);
-      reported_long = true;
-      ok = false;
+    if (!long_ && base_ + i - line_start_ >= kMaxLineBytes) {
+      open_long_ = findings_.size();
+      findings_.push_back({Kind::kLong, line_, 1});
+      long_ = true;
     }
     if (c == 0) {
-      if (!reported_nul) {
-        diagnostics.Error(display_name, line, column(i),
-                          "a NUL byte: this is a binary file, expected UTF-8 text: " + expect);
-        reported_nul = true;
-      }
-      ok = false;
+      if (!nul_) findings_.push_back({Kind::kNul, line_, column(i)});
+      nul_ = true;
       ++i;
       continue;
     }
@@ -155,27 +238,79 @@ bool CheckInputText(std::string_view text, const std::string& display_name,
       if (c == 0xF0) lo = 0x90;
       if (c == 0xF4) hi = 0x8F;
     }
+    if (length > 0 && i + length > n && !last) {
+      carry_.assign(data.substr(i));
+      base_ += i;
+      return;
+    }
     bool valid = length > 0 && i + length <= n;
     for (std::size_t k = 1; valid && k < length; ++k) {
-      const auto b = static_cast<unsigned char>(text[i + k]);
+      const auto b = static_cast<unsigned char>(data[i + k]);
       valid = k == 1 ? (b >= lo && b <= hi) : (b >= 0x80 && b <= 0xBF);
     }
     if (!valid) {
-      if (!reported_utf8) {
-        char hex[8];
-        std::snprintf(hex, sizeof hex, "0x%02X", c);
-        diagnostics.Error(
-            display_name, line, column(i),
-            std::string("invalid UTF-8 (byte ") + hex + "), expected UTF-8 text: " + expect);
-        reported_utf8 = true;
-      }
-      ok = false;
+      if (!utf8_) findings_.push_back({Kind::kUtf8, line_, column(i), c});
+      utf8_ = true;
       ++i;
       continue;
     }
     i += length;
   }
-  return ok;
+  base_ += n;
+}
+
+bool InputTextCheck::Finish(const std::string& display_name, std::string_view expected,
+                            Diagnostics& diagnostics) {
+  if (!carry_.empty() || !bom_checked_) {
+    const std::string rest = std::move(carry_);
+    carry_.clear();
+    if (wide_ == nullptr) Scan(rest, true);
+  }
+  if (open_long_ != SIZE_MAX) EndLongLine(size_);
+  const std::string expect(expected);
+  if (blank_) {
+    diagnostics.Error(display_name, 0, 0,
+                      std::string(size_ == 0 ? "the file is empty" : "the file is blank") +
+                          ", expected " + expect);
+    return false;
+  }
+  if (wide_ != nullptr) {
+    diagnostics.Error(display_name, 1, 1,
+                      std::string("the file is ") + wide_ +
+                          " (it starts with a byte-order mark), expected UTF-8 text: " + expect);
+    return false;
+  }
+  for (const Finding& f : findings_) {
+    switch (f.kind) {
+      case Kind::kNul:
+        diagnostics.Error(display_name, f.line, f.column,
+                          "a NUL byte: this is a binary file, expected UTF-8 text: " + expect);
+        break;
+      case Kind::kUtf8: {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", f.byte);
+        diagnostics.Error(
+            display_name, f.line, f.column,
+            std::string("invalid UTF-8 (byte ") + hex + "), expected UTF-8 text: " + expect);
+        break;
+      }
+      case Kind::kLong:
+        diagnostics.Error(display_name, f.line, 1,
+                          "line " + std::to_string(f.line) + " is " + std::to_string(f.length) +
+                              " bytes long, expected at most " + std::to_string(kMaxLineBytes) +
+                              " bytes per line in " + expect);
+        break;
+    }
+  }
+  return findings_.empty();
+}
+
+bool CheckInputText(std::string_view text, const std::string& display_name,
+                    std::string_view expected, Diagnostics& diagnostics) {
+  // One implementation for whole texts and streamed files: the same text, the same messages.
+  InputTextCheck check;
+  check.Feed(text);
+  return check.Finish(display_name, expected, diagnostics);
 }
 
 AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {

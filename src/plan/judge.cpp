@@ -180,10 +180,16 @@ Judgement Judging::Finish() {
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch) {
+  // One tick at a time (TickStream), not Resample: a long recording is not held twice.
+  TickStream ticks(trajectory, scene.model.time_step_s);
+  return Judge(scene, ticks, states, limits, watch);
+}
+
+Judgement Judge(const scene::Scene& scene, TickSource& ticks,
+                const std::vector<std::string>& states, const Limits& limits,
+                const TickWatcher& watch) {
   const auto clock_start = std::chrono::steady_clock::now();
   const double T = scene.model.time_step_s;
-  // One tick at a time (TickStream), not Resample: a long recording is not held twice.
-  TickStream ticks(trajectory, T);
   core::Core core(scene);
   core.Reset(Pose(ticks.Tick(0)));
   Judging judging(states, limits, T);

@@ -44,23 +44,76 @@ HandSample PoseAt(const Trajectory& trajectory, double t_s, std::size_t& cursor)
   return Interpolate(v[cursor], v[cursor + 1], t_s);
 }
 
-TickStream::TickStream(const Trajectory& trajectory, double step_s)
-    : trajectory_(trajectory), step_s_(step_s) {
+namespace {
+
+// The first sample's time, after Resample's checks of the trajectory and the step, in its order.
+double FirstTime(const Trajectory& trajectory, double step_s) {
   if (!(step_s > 0.0) || !std::isfinite(step_s))
     throw std::invalid_argument("Resample: the step must be a finite time greater than zero");
   if (trajectory.samples.size() < 2)
     throw std::invalid_argument("Resample: a trajectory needs at least two samples");
-  t0_ = trajectory.samples.front().t_s;
-  const double duration = trajectory.samples.back().t_s - t0_;
+  return trajectory.samples.front().t_s;
+}
+
+}  // namespace
+
+TickSource::TickSource(double t_first_s, double t_last_s, double step_s)
+    : step_s_(step_s), t0_(t_first_s), t_last_s_(t_last_s) {
+  if (!(step_s > 0.0) || !std::isfinite(step_s))
+    throw std::invalid_argument("Resample: the step must be a finite time greater than zero");
+  const double duration = t_last_s - t0_;
   // 1e-9 of a step: a recorder's time stamps are rounded; a last sample meant to be on the grid
   // must not be lost to that rounding.
   count_ = static_cast<std::size_t>(std::floor(duration / step_s + 1e-9)) + 1;
 }
 
+TickStream::TickStream(const Trajectory& trajectory, double step_s)
+    : TickSource(FirstTime(trajectory, step_s), trajectory.samples.back().t_s, step_s),
+      trajectory_(trajectory) {}
+
 HandSample TickStream::Tick(std::size_t k) {
   // t0 + k T rather than an accumulated sum: no drift over long recordings.
-  const double t = std::min(TimeOf(k), trajectory_.samples.back().t_s);
-  HandSample sample = PoseAt(trajectory_, t, cursor_);
+  HandSample sample = PoseAt(trajectory_, SampleTimeOf(k), cursor_);
+  sample.t_s = TimeOf(k);
+  return sample;
+}
+
+SampleTicks::SampleTicks(SampleSource& samples, double t_first_s, double t_last_s, double step_s)
+    : TickSource(t_first_s, t_last_s, step_s), samples_(samples) {
+  if (!(t_last_s > t_first_s))
+    throw std::invalid_argument("Resample: a trajectory needs at least two samples");
+}
+
+void SampleTicks::Advance() {
+  a_ = b_;
+  if (!samples_.Next(b_)) throw std::runtime_error("SampleTicks: the samples ended early");
+}
+
+HandSample SampleTicks::Tick(std::size_t k) {
+  // PoseAt's cases on the two samples around t instead of the whole vector: the same samples
+  // reach the same arithmetic, so the ticks are the same bits.
+  if (!started_) {
+    if (!samples_.Next(a_) || !samples_.Next(b_))
+      throw std::runtime_error("SampleTicks: fewer than two samples");
+    if (a_.t_s != TimeOf(0)) throw std::runtime_error("SampleTicks: the first sample moved");
+    started_ = true;
+  }
+  const double t = SampleTimeOf(k);
+  HandSample sample;
+  if (ended_) {
+    sample = b_;
+  } else if (t >= t_last_s()) {
+    // The end, held at the last sample (PoseAt's second case): read to it.
+    HandSample next;
+    while (samples_.Next(next)) a_ = b_, b_ = next;
+    if (b_.t_s != t_last_s()) throw std::runtime_error("SampleTicks: the last sample moved");
+    ended_ = true;
+    sample = b_;
+  } else {
+    // PoseAt's first case (t at the first sample) is Interpolate's exact return of a_.
+    while (b_.t_s <= t) Advance();
+    sample = Interpolate(a_, b_, t);
+  }
   sample.t_s = TimeOf(k);
   return sample;
 }

@@ -13,6 +13,7 @@
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/perturb.hpp>
 
 namespace {
@@ -162,6 +163,74 @@ TEST_CASE("Bad plan files get every problem at once, and nothing is evaluated", 
             file +
             ":6:27: error: unknown key 'dwel' in 'limits', did you mean 'dwell'? "
             "(expected one of: max_force, max_strain, max_penetration, dwell, stall)\n");
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("A plan replayed from its trajectory file row by row gets the same judgement",
+          "[plan][stream]") {
+  // evaluate without --monte-carlo streams the trajectory; with it, it loads it whole. Both must
+  // give the same bits: the same ticks into the same core.
+  for (const char* name : {"groove-insert", "groove-insert-coarse", "groove-gentle",
+                           "groove-lay-flat", "groove-wrong-side"}) {
+    CAPTURE(name);
+    const std::string path = SourcePath(std::string("plans/") + name + ".yaml");
+    const io::PlanLoadResult memory = io::LoadPlanFile(path);
+    const io::PlanLoadResult streamed = io::LoadPlanFile(path, {.trajectory_in_memory = false});
+    REQUIRE(memory.trajectory);
+    REQUIRE(streamed.trajectory_file);
+    CHECK_FALSE(streamed.trajectory);
+    const plan::Judgement a =
+        plan::Judge(*memory.scene, *memory.trajectory, memory.plan->states, memory.plan->limits);
+    io::TrajectoryFileSamples samples(*streamed.trajectory_file);
+    plan::SampleTicks ticks(samples, streamed.trajectory_file->t_first_s,
+                            streamed.trajectory_file->t_last_s, streamed.scene->model.time_step_s);
+    const plan::Judgement b =
+        plan::Judge(*streamed.scene, ticks, streamed.plan->states, streamed.plan->limits);
+    CHECK(b.feasible == a.feasible);
+    CHECK(b.ticks == a.ticks);
+    CHECK(b.replayed_s == a.replayed_s);
+    REQUIRE(b.observed.size() == a.observed.size());
+    for (std::size_t i = 0; i < a.observed.size(); ++i) {
+      CHECK(b.observed[i].cf == a.observed[i].cf);
+      CHECK(b.observed[i].t_s == a.observed[i].t_s);
+    }
+    REQUIRE(b.transitions.size() == a.transitions.size());
+    for (std::size_t i = 0; i < a.transitions.size(); ++i) {
+      const plan::TransitionVerdict &x = a.transitions[i], &y = b.transitions[i];
+      CHECK(y.verdict == x.verdict);
+      CHECK(y.reason == x.reason);
+      CHECK(y.detour == x.detour);
+      CHECK(y.t_start_s == x.t_start_s);
+      CHECK(y.t_end_s == x.t_end_s);
+      CHECK(y.peak_force_N == x.peak_force_N);
+      CHECK(y.friction_work_J == x.friction_work_J);
+      CHECK(y.energy_entry_J == x.energy_entry_J);
+      CHECK(y.energy_exit_J == x.energy_exit_J);
+    }
+  }
+}
+
+TEST_CASE("A plan's bad trajectory gets the same messages streamed and in memory",
+          "[plan][stream]") {
+  const std::filesystem::path dir = "judge_test_stream_plans";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "bad.csv")
+      << "t,px,py,pz,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.001,0,x,0,1,0,0,0\n";
+  for (const std::string trajectory :
+       {"bad.csv", "missing.csv", ".", "/dev/zero", "../judge_test_stream_plans/bad.csv"}) {
+    CAPTURE(trajectory);
+    std::ofstream(dir / "p.yaml")
+        << "tubeplan: 1\nplan: p\nscene: "
+        << std::filesystem::absolute(SourcePath("scenes/groove.yaml")).string()
+        << "\ntrajectory: " << trajectory << "\nstates: [\"{}\", goal]\n";
+    const io::PlanLoadResult memory = io::LoadPlanFile(dir / "p.yaml");
+    const io::PlanLoadResult streamed =
+        io::LoadPlanFile(dir / "p.yaml", {.trajectory_in_memory = false});
+    CHECK_FALSE(streamed.plan);
+    CHECK_FALSE(streamed.trajectory_file);
+    CHECK(memory.diagnostics.HasErrors());
+    CHECK(streamed.diagnostics.FormatAll() == memory.diagnostics.FormatAll());
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,7 @@
 // Hand trajectories: resampling onto the core's step, and the CSV loader's values and messages.
 #include <cmath>
 #include <numbers>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -99,6 +100,80 @@ TEST_CASE("TickStream gives Resample's ticks exactly, one at a time", "[trajecto
     REQUIRE(s.p_WH_m == all[k].p_WH_m);
     REQUIRE(s.q_WH.coeffs() == all[k].q_WH.coeffs());
   }
+}
+
+namespace {
+
+// The samples of a trajectory in memory, handed out one at a time as a file's rows are.
+class VectorSamples final : public tubeplan::plan::SampleSource {
+ public:
+  explicit VectorSamples(const std::vector<HandSample>& samples) : samples_(samples) {}
+  bool Next(HandSample& sample) override {
+    if (next_ == samples_.size()) return false;
+    sample = samples_[next_++];
+    return true;
+  }
+
+ private:
+  const std::vector<HandSample>& samples_;
+  std::size_t next_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("SampleTicks gives TickStream's ticks bit for bit from samples read in order",
+          "[trajectory]") {
+  // Jittered samples (some on the grid, some between its points), a flip of the quaternion's
+  // sign, and steps finer, equal to and coarser than the samples' spacing, with the last sample
+  // on the grid and off it: every case of PoseAt.
+  Trajectory trajectory;
+  for (int i = 0; i <= 300; ++i) {
+    HandSample s;
+    s.t_s = 0.5 + i * 2e-3 + (i % 4 == 1 ? 7e-4 : 0.0);
+    s.p_WH_m = Eigen::Vector3d(std::cos(i * 0.02), 0.05 * i, 0.001 * i * i);
+    s.q_WH = AboutZ(0.01 * i);
+    if (i % 5 == 0) s.q_WH.coeffs() = -s.q_WH.coeffs();
+    trajectory.samples.push_back(s);
+  }
+  for (const double step_s : {3e-4, 1e-3, 2e-3, 5e-3, 0.6}) {
+    CAPTURE(step_s);
+    tubeplan::plan::TickStream memory(trajectory, step_s);
+    VectorSamples samples(trajectory.samples);
+    tubeplan::plan::SampleTicks streamed(samples, trajectory.samples.front().t_s,
+                                         trajectory.samples.back().t_s, step_s);
+    REQUIRE(streamed.count() == memory.count());
+    for (std::size_t k = 0; k < memory.count(); ++k) {
+      const HandSample a = memory.Tick(k);
+      const HandSample b = streamed.Tick(k);
+      REQUIRE(b.t_s == a.t_s);
+      REQUIRE(b.p_WH_m == a.p_WH_m);
+      REQUIRE(b.q_WH.coeffs() == a.q_WH.coeffs());
+      // The replays ask for tick 0 twice (the core's reset, then its first step).
+      if (k == 0) REQUIRE(streamed.Tick(0).p_WH_m == a.p_WH_m);
+    }
+  }
+}
+
+TEST_CASE("SampleTicks refuses samples that do not reach the times it was promised",
+          "[trajectory]") {
+  std::vector<HandSample> samples;
+  for (int i = 0; i <= 10; ++i) samples.push_back({i * 1e-3, Eigen::Vector3d::Zero(), AboutZ(0)});
+  {
+    // Promised 20 ms, given 10 ms: the source ends before the last tick.
+    VectorSamples source(samples);
+    tubeplan::plan::SampleTicks ticks(source, 0.0, 0.020, 1e-3);
+    CHECK_NOTHROW(ticks.Tick(5));
+    CHECK_THROWS_AS(ticks.Tick(15), std::runtime_error);
+  }
+  {
+    // Promised 5 ms as the last: the source goes on past it.
+    VectorSamples source(samples);
+    tubeplan::plan::SampleTicks ticks(source, 0.0, 0.005, 1e-3);
+    CHECK_THROWS_AS(ticks.Tick(5), std::runtime_error);
+  }
+  VectorSamples source(samples);
+  CHECK_THROWS_AS(tubeplan::plan::SampleTicks(source, 0.0, 0.0, 1e-3), std::invalid_argument);
+  CHECK_THROWS_AS(tubeplan::plan::SampleTicks(source, 0.0, 0.01, 0.0), std::invalid_argument);
 }
 
 TEST_CASE("A good trajectory file loads with exact values and metadata", "[trajectory]") {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <tubeplan/io/diagnostics.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/plan.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
@@ -20,7 +21,10 @@ struct PlanLoadResult {
   /// All set only when there is no error anywhere (plan, its scene, its trajectory).
   std::optional<plan::Plan> plan;
   std::optional<scene::Scene> scene;
-  std::optional<plan::Trajectory> trajectory;
+  std::optional<plan::Trajectory> trajectory;  ///< unless the options asked for it streamed
+  /// With PlanLoadOptions::trajectory_in_memory false: the checked trajectory file, to replay
+  /// row by row (TrajectoryFileSamples) instead of `trajectory`.
+  std::optional<TrajectoryInfo> trajectory_file;
   std::vector<states::ContactFormation> states;  ///< the planned CFs, parsed
   Diagnostics diagnostics;
 };
@@ -28,9 +32,17 @@ struct PlanLoadResult {
 /// Reads a plan, then its scene and trajectory (paths relative to the plan's directory), and
 /// checks each planned CF against the scene: unknown elements are errors naming them; the word
 /// `goal` stands for the scene's goal.
-PlanLoadResult LoadPlanFile(const std::filesystem::path& path);
+struct PlanLoadOptions {
+  /// True: the trajectory's samples are loaded (what Monte Carlo perturbation and the live
+  /// verification need). False: the trajectory file is checked streamed (the same diagnostics)
+  /// and only its TrajectoryInfo kept, so that memory does not grow with the recording.
+  bool trajectory_in_memory = true;
+};
+
+PlanLoadResult LoadPlanFile(const std::filesystem::path& path, const PlanLoadOptions& options = {});
 PlanLoadResult LoadPlanText(std::string_view yaml_text, const std::string& display_name,
-                            const std::filesystem::path& directory);
+                            const std::filesystem::path& directory,
+                            const PlanLoadOptions& options = {});
 
 /// The plan as YAML text, format version 1, units written out.
 std::string FormatPlanYaml(const plan::Plan& plan);

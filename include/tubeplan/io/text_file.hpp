@@ -1,6 +1,7 @@
 #pragma once
-// Whole-file text input and output for the loaders and writers, and the checks every text input
-// passes before a parser sees it (docs/hardening.md lists the limits and why).
+// Text input (whole files, or chunks and lines for files too long to hold) and output for the
+// loaders and writers, and the checks every text input passes before a parser sees it
+// (docs/hardening.md lists the limits and why).
 
 #include <cstdint>
 #include <cstdio>
@@ -8,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <tubeplan/io/diagnostics.hpp>
 
@@ -43,6 +45,99 @@ std::optional<std::string> ReadTextFile(const std::filesystem::path& path);
 /// scene file"). Returns false when the text must not be parsed. A UTF-8 byte-order mark is fine.
 bool CheckInputText(std::string_view text, const std::string& display_name,
                     std::string_view expected, Diagnostics& diagnostics);
+
+/// CheckInputText's checks on a text that arrives in pieces (a file read in chunks): Feed the
+/// pieces in order, then Finish reports exactly what CheckInputText reports for the whole text.
+/// Holds at most a few bytes of it (a UTF-8 sequence cut by a piece's end) and the findings.
+class InputTextCheck {
+ public:
+  void Feed(std::string_view piece);
+  /// Reports and returns as CheckInputText does; call once, after the last piece.
+  bool Finish(const std::string& display_name, std::string_view expected, Diagnostics& diagnostics);
+  /// True once the text is known to fail (then a parser need not read on).
+  bool failing() const { return wide_ != nullptr || !findings_.empty(); }
+
+ private:
+  enum class Kind { kNul, kUtf8, kLong };
+  struct Finding {
+    Kind kind;
+    int line = 0;
+    int column = 0;
+    unsigned char byte = 0;    // kUtf8: the lead byte
+    std::uint64_t length = 0;  // kLong: the line's length, known at its end
+  };
+  void Scan(std::string_view data, bool last);
+  void EndLongLine(std::uint64_t end);
+
+  std::uint64_t size_ = 0;      // bytes fed
+  std::uint64_t base_ = 0;      // the offset of the next byte Scan sees
+  std::string carry_, joined_;  // a cut UTF-8 sequence (or the first bytes, for the BOM)
+  bool blank_ = true;           // only " \t\r\n" so far
+  bool bom_checked_ = false;
+  const char* wide_ = nullptr;  // "UTF-16" or "UTF-32" when a byte-order mark says so
+  bool nul_ = false, utf8_ = false, long_ = false;
+  std::size_t open_long_ = SIZE_MAX;  // index of the kLong finding whose line has not ended
+  int line_ = 1;
+  std::uint64_t line_start_ = 0;
+  std::vector<Finding> findings_;
+};
+
+/// A regular file read in fixed-size chunks: ReadInputFile's refusals (same words), without
+/// holding the file. Reads at most the size the file had when opened.
+class InputFileReader {
+ public:
+  static constexpr std::size_t kChunkBytes = std::size_t{64} << 10;
+  InputFileReader() = default;
+  ~InputFileReader();
+  InputFileReader(const InputFileReader&) = delete;
+  InputFileReader& operator=(const InputFileReader&) = delete;
+
+  /// Empty on success, else why not ("no such file", "it is a directory", ...).
+  std::string Open(const std::filesystem::path& path, std::uintmax_t max_bytes = kMaxInputBytes);
+  /// The next chunk (valid until the next call); empty at the end of the file or after a read
+  /// error (then error() says which).
+  std::string_view Next();
+  const std::string& error() const { return error_; }
+  /// What the file was when opened, to tell a second pass that it changed in between.
+  std::uintmax_t size() const { return size_; }
+  std::int64_t modified_ns() const { return modified_ns_; }
+
+ private:
+  int fd_ = -1;
+  std::uintmax_t size_ = 0, left_ = 0;
+  std::int64_t modified_ns_ = 0;
+  std::string buffer_;
+  std::string error_;
+};
+
+/// A text file line by line, read in chunks and checked as CheckInputText checks (FinishCheck).
+/// Memory stays at a chunk and one line, whatever the file's length; a line longer than
+/// kMaxLineBytes is handed out cut there (the check fails the file anyway).
+class InputLineReader {
+ public:
+  std::string Open(const std::filesystem::path& path, std::uintmax_t max_bytes = kMaxInputBytes) {
+    return file_.Open(path, max_bytes);
+  }
+  /// The next line without its '\n' (valid until the next call); false at the end of the file
+  /// or on a read error (error()). A last line without '\n' is a line; nothing after a last
+  /// '\n' is not.
+  bool Next(std::string_view& line);
+  const std::string& error() const { return file_.error(); }
+  bool check_failing() const { return check_.failing(); }
+  /// After the last line: CheckInputText's verdict on the whole file.
+  bool FinishCheck(const std::string& display_name, std::string_view expected,
+                   Diagnostics& diagnostics) {
+    return check_.Finish(display_name, expected, diagnostics);
+  }
+  const InputFileReader& file() const { return file_; }
+
+ private:
+  InputFileReader file_;
+  InputTextCheck check_;
+  std::string_view chunk_;
+  std::string line_;
+  bool end_ = false;
+};
 
 /// `text` for a message: as is when short, else its first `max_bytes` bytes (never cutting a
 /// UTF-8 sequence) and "...", so a 1 MB field does not become a 1 MB message.

@@ -96,5 +96,10 @@ using TickWatcher = std::function<void(double t_s, const core::Core& core)>;
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch = {});
+/// The same from ticks that come one at a time (a trajectory file replayed row by row,
+/// SampleTicks); `ticks` must be on the scene's step. The same ticks give the same judgement.
+Judgement Judge(const scene::Scene& scene, TickSource& ticks,
+                const std::vector<std::string>& states, const Limits& limits,
+                const TickWatcher& watch = {});
 
 }  // namespace tubeplan::plan

@@ -2,6 +2,8 @@
 // Hand trajectories: the pose of the operator's hand over time, as a PHANToM records it (loaded by
 // io/trajectory_csv.hpp), and their resampling onto the core's fixed step. Plain data, SI.
 
+#include <algorithm>
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -35,22 +37,66 @@ struct Trajectory {
 std::vector<HandSample> Resample(const Trajectory& trajectory, double step_s);
 
 /// Resample's grid one tick at a time, for replays that must not hold a second copy of a long
-/// trajectory (an hour at 1 kHz is 230 MB of samples): Tick(k) is Resample(...)[k] exactly, in
-/// O(1) for k = 0, 1, 2, ... in order. Same requirements as Resample (it throws the same way).
-class TickStream {
+/// trajectory: Tick(k) is Resample(...)[k] exactly, for k = 0, 1, 2, ... in order (a k may be
+/// asked again). The grid t0 + k T, k < count(), is fixed by the first and last samples' times.
+class TickSource {
  public:
-  TickStream(const Trajectory& trajectory, double step_s);
+  virtual ~TickSource() = default;
   std::size_t count() const { return count_; }
   /// The grid time of tick k: t0 + k T.
   double TimeOf(std::size_t k) const { return t0_ + static_cast<double>(k) * step_s_; }
-  HandSample Tick(std::size_t k);
+  /// The last sample's time (the first is TimeOf(0)).
+  double t_last_s() const { return t_last_s_; }
+  virtual HandSample Tick(std::size_t k) = 0;
+
+ protected:
+  /// Throws std::invalid_argument as Resample does for a step that is not finite and positive.
+  TickSource(double t_first_s, double t_last_s, double step_s);
+  /// The time Tick(k) interpolates at: the grid time, held at the last sample.
+  double SampleTimeOf(std::size_t k) const { return std::min(TimeOf(k), t_last_s_); }
+
+ private:
+  double step_s_ = 0.0;
+  double t0_ = 0.0;
+  double t_last_s_ = 0.0;
+  std::size_t count_ = 0;
+};
+
+/// The ticks of a trajectory in memory, in O(1) a tick. Same requirements as Resample (it throws
+/// the same way).
+class TickStream final : public TickSource {
+ public:
+  TickStream(const Trajectory& trajectory, double step_s);
+  HandSample Tick(std::size_t k) override;
 
  private:
   const Trajectory& trajectory_;
-  double step_s_ = 0.0;
-  double t0_ = 0.0;
-  std::size_t count_ = 0;
   std::size_t cursor_ = 0;
+};
+
+/// Samples in time order, one at a time: a trajectory file read row by row.
+class SampleSource {
+ public:
+  virtual ~SampleSource() = default;
+  /// The next sample; false after the last.
+  virtual bool Next(HandSample& sample) = 0;
+};
+
+/// The ticks of samples that arrive in order (an hour's recording read from its file a second
+/// time), holding only the two samples around the current grid time: TickStream's ticks, bit for
+/// bit, for the trajectory those samples make. The first and last samples' times come from a
+/// first pass (they fix the grid); a source that ends early or runs past t_last_s is a
+/// std::runtime_error.
+class SampleTicks final : public TickSource {
+ public:
+  SampleTicks(SampleSource& samples, double t_first_s, double t_last_s, double step_s);
+  HandSample Tick(std::size_t k) override;
+
+ private:
+  void Advance();
+  SampleSource& samples_;
+  HandSample a_, b_;  // a_.t_s <= the current time < b_.t_s, or both the last sample at the end
+  bool started_ = false, ended_ = false;
 };
 
 /// The pose at time t_s, interpolated as Resample does; times outside the trajectory are held at
