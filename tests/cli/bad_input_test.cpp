@@ -12,6 +12,7 @@
 
 #include <tubeplan/cli/app.hpp>
 
+#include "../scratch.hpp"
 #include "run_tool.hpp"
 
 namespace {
@@ -20,18 +21,10 @@ using tubeplan::testing::Outcome;
 using tubeplan::testing::RunTool;
 using tubeplan::testing::SourcePath;
 
-// A directory of its own for each test process (ctest runs cases in parallel).
-std::filesystem::path Scratch() {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("tubeplan-bad-input-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+std::filesystem::path Scratch() { return tubeplan::testing::ScratchDir("bad-input"); }
 
 std::string Write(const std::string& name, const std::string& bytes) {
-  const std::filesystem::path path = Scratch() / name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path.string();
+  return tubeplan::testing::WriteScratch("bad-input", name, bytes);
 }
 
 // The scene of these tests: line 3 is the tube, so a bad tube value is reported on line 3.

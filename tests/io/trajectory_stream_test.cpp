@@ -14,22 +14,17 @@
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 
+#include "../scratch.hpp"
+
 namespace {
 
 namespace io = tubeplan::io;
 namespace plan = tubeplan::plan;
 
-std::filesystem::path Scratch() {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("tubeplan-trajectory-stream-" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir;
-}
+std::filesystem::path Scratch() { return tubeplan::testing::ScratchDir("trajectory-stream"); }
 
 std::string Write(const std::string& name, const std::string& bytes) {
-  const std::filesystem::path path = Scratch() / name;
-  std::ofstream(path, std::ios::binary) << bytes;
-  return path.string();
+  return tubeplan::testing::WriteScratch("trajectory-stream", name, bytes);
 }
 
 std::string Source(const std::string& relative) {
