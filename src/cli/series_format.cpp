@@ -18,7 +18,7 @@ void AppendNumber(std::string& s, double v) {
 
 std::string FlagsText(std::uint32_t flags) {
   std::string text;
-  for (int b = 0; b < 6; ++b) {
+  for (int b = 0; b < core::kStepFlagCount; ++b) {
     if ((flags & (1u << b)) == 0) continue;
     if (!text.empty()) text += '|';
     text += FlagName(1u << b);
@@ -56,6 +56,8 @@ std::string_view FlagName(std::uint32_t bit) {
       return "linear_fallback";
     case core::kSolverFault:
       return "fault";
+    case core::kBeyondLinearRange:
+      return "beyond_linear";
     default:
       return "unknown";
   }
@@ -141,7 +143,7 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
   j["strain"] = out.max_strain;
   j["tip_deflection"] = out.tip_deflection_m;
   nlohmann::json flags = nlohmann::json::array();
-  for (int b = 0; b < 6; ++b)
+  for (int b = 0; b < core::kStepFlagCount; ++b)
     if (out.flags & (1u << b)) flags.push_back(FlagName(1u << b));
   j["flags"] = flags;
   nlohmann::json pcs = nlohmann::json::array();

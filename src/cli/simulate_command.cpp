@@ -98,7 +98,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   std::string cf_text;
   double peak_force_N = 0.0, peak_force_t = 0.0, peak_strain = 0.0, peak_strain_t = 0.0;
   double peak_energy_J = 0.0, peak_torque_Nm = 0.0;
-  std::array<long, 6> flag_ticks{};
+  std::array<long, core::kStepFlagCount> flag_ticks{};
   double core_s = 0.0, worst_tick_s = 0.0;
   constexpr std::size_t kSeriesChunkBytes = std::size_t{1} << 20;
   for (std::size_t k = 0; k < ticks.count(); ++k) {
@@ -119,7 +119,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     if (out.max_strain > peak_strain) peak_strain = out.max_strain, peak_strain_t = sample.t_s;
     peak_energy_J = std::max(peak_energy_J, out.energy_J);
     peak_torque_Nm = std::max(peak_torque_Nm, out.torque_W_Nm.norm());
-    for (int b = 0; b < 6; ++b)
+    for (int b = 0; b < core::kStepFlagCount; ++b)
       if (out.flags & (1u << b)) ++flag_ticks[std::size_t(b)];
     writer.Add(core, out, cf_text);
     if (series_file && writer.text().size() >= kSeriesChunkBytes) {
@@ -158,7 +158,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["peak_strain_t"] = peak_strain_t;
     j["peak_energy_J"] = peak_energy_J;
     nlohmann::json flags;
-    for (int b = 0; b < 6; ++b) flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
+    for (int b = 0; b < core::kStepFlagCount; ++b)
+      flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
     j["flag_ticks"] = flags;
     j["run_time_s"] = core_s;
     j["mean_tick_us"] = 1e6 * core_s / static_cast<double>(tick_count);
@@ -185,7 +186,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
        << " s; peak bending energy " << peak_energy_J << " J\n";
   text << "ticks flagged:";
   bool any = false;
-  for (int b = 0; b < 6; ++b)
+  for (int b = 0; b < core::kStepFlagCount; ++b)
     if (flag_ticks[std::size_t(b)] > 0) {
       text << " " << FlagName(1u << b) << " " << flag_ticks[std::size_t(b)];
       any = true;

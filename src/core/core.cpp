@@ -936,6 +936,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   out.energy_J = energy_J;
   out.max_strain = strain;
   out.tip_deflection_m = m.nodes_H[std::size_t(N)].head<2>().norm();
+  // The linear shape is a small-deflection model: at a tip deflection of l/3 (a tip load's
+  // alpha = F l^2 / (E I) = 1) it is 10 % off the exact elastica, and beyond it the deflection
+  // grows without bound, the tube drawn longer than it is (docs/core.md). Flagged, so that a
+  // replay that went there is not taken for the tube's motion.
+  if (!m.elastica_shape && out.tip_deflection_m > l / 3.0) out.flags |= kBeyondLinearRange;
 
   // Markers (contact-states.md): no bending below the threshold; the end face and rim never
   // deform; a side contact is concave or convex by the side of the bend it touches, judged by

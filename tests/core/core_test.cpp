@@ -335,3 +335,40 @@ TEST_CASE("Over an edge like a rope over a pulley: concave (coupled), convex (se
     }
   }
 }
+
+TEST_CASE("The linear shape beyond a tip deflection of l/3 is flagged beyond_linear", "[core]") {
+  // A thin tube (r1 = 1 mm) pushed sideways by an edge near its tip until the linear model's tip
+  // deflection passes l/3 (a tip load's alpha = 1, where the model is 10 % off the elastica).
+  // The flag must follow the deflection the loads make in the linear cantilever, from its closed
+  // form, not from the core's shape. Thin, so that the moment of the contact force's axial part
+  // (the normal tilts with the slope theta, offset r1 from the axis) moves the tip by at most
+  // 1.5 r1 / l = 1 % of the lateral load's deflection: ticks within 1.5 % of l/3 are not judged.
+  scene::Scene s = TubeScene(2e9, 1e-3, 0.5e-3, 0.15);
+  s.contact.threshold_m = 0.2e-3;
+  s.contact.bend_threshold_m = 2e-5;
+  const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, a = 0.14;
+  s.parts.push_back(EdgeBlock("edge", 1.0, a, r1, 0.1e-3));
+  core::Core c(s);
+  const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
+  double t = 0.0;
+  int flagged = 0, clear = 0;
+  for (int k = 1; k <= 1600; ++k) {
+    const core::StepOutput& out = c.Step(t += 1e-3, At({0.05e-3 * k, 0.0, 0.0}));
+    REQUIRE((out.flags & core::kSolverFault) == 0);
+    Eigen::Vector2d delta_m = Eigen::Vector2d::Zero();
+    for (const core::ContactState& pc : out.Contacts()) {
+      const Eigen::Vector3d F_H = out.X_WH.linear().transpose() * pc.force_W_N;
+      delta_m += F_H.head<2>() * pc.s_m * pc.s_m * (3.0 * l - pc.s_m) / (6.0 * EI);
+    }
+    const double ratio = delta_m.norm() / (l / 3.0);
+    if (std::abs(ratio - 1.0) < 0.015) continue;
+    const bool beyond = (out.flags & core::kBeyondLinearRange) != 0;
+    INFO("tick " << k << ": closed-form tip deflection " << delta_m.norm() << " m, core's "
+                 << out.tip_deflection_m << " m");
+    CHECK(beyond == (ratio > 1.0));
+    ++(beyond ? flagged : clear);
+  }
+  // Both sides of the threshold were reached.
+  CHECK(flagged > 100);
+  CHECK(clear > 100);
+}

@@ -60,7 +60,12 @@ enum StepFlag : std::uint32_t {
   kContactsTruncated = 1u << 3,  ///< more than kMaxContacts PCs; the shallowest were dropped
   kLinearFallback = 1u << 4,     ///< elastica asked for, but the loading is not one it covers
   kSolverFault = 1u << 5,        ///< the tick's system was singular or not finite: held still
+  /// The linear model drew the tube (a linear scene, or the fallback) with a tip deflection
+  /// beyond l/3, where it is ~10 % off the exact elastica and no longer keeps the tube's length.
+  kBeyondLinearRange = 1u << 6,
 };
+/// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
+inline constexpr int kStepFlagCount = 7;
 
 /// One principal contact in a tick, in the core's compact form.
 struct ContactState {
