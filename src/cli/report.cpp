@@ -39,7 +39,8 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"peak_force_N", v.peak_force_N},
                              {"friction_work_J", v.friction_work_J},
                              {"energy_entry_J", v.energy_entry_J},
-                             {"energy_exit_J", v.energy_exit_J}});
+                             {"energy_exit_J", v.energy_exit_J},
+                             {"beyond_linear_s", v.beyond_linear_s}});
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -93,6 +94,10 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
       << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
       << " -> " << v.energy_exit_J << " J\n";
+    if (v.beyond_linear_s > 0.0)
+      t << "      warning: for " << v.beyond_linear_s
+        << " s the linear model drew the tube beyond its range (tip deflection above l/3): "
+           "the verdict rests on a shape the tube cannot take\n";
   }
   t.precision(precision);
 }

@@ -27,6 +27,9 @@ struct TransitionVerdict {
   double peak_force_N = 0.0;
   double friction_work_J = 0.0;  ///< sum over sliding PCs of |F_f| times the slip
   double energy_entry_J = 0.0, energy_exit_J = 0.0;
+  /// Time the linear model drew the tube beyond its range (core flag beyond_linear: tip
+  /// deflection above l/3): the verdict then rests on a shape the tube cannot take.
+  double beyond_linear_s = 0.0;
 };
 
 struct Observation {
