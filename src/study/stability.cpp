@@ -143,6 +143,7 @@ struct Run {
   // First failing tick of each check (-1: never) and what it saw there.
   int fail_finite = -1, fail_force = -1, fail_law = -1, fail_friction = -1, fail_passive = -1,
       fail_tunnel = -1, fail_fault = -1;
+  int beyond_linear = -1;  // first tick the linear shape was beyond its range (not a check)
   std::string why_force, why_law, why_friction, why_passive, why_tunnel;
   double work_J = 0.0, stored_J = 0.0, initial_J = 0.0;
 };
@@ -180,6 +181,7 @@ Run Drive(const StabilityCase& c, bool check) {
       return;
     }
     if (o.flags & core::kSolverFault) Note(run.fail_fault, run.why_force, tick, run.why_force);
+    if ((o.flags & core::kBeyondLinearRange) && run.beyond_linear < 0) run.beyond_linear = tick;
     const Vector3d F = o.force_W_N, p = o.X_WH.translation();
     run.peak_force_N = std::max(run.peak_force_N, F.norm());
     run.max_strain = std::max(run.max_strain, o.max_strain);
@@ -425,6 +427,9 @@ StabilityResult RunStabilityCase(const StabilityCase& c) {
   r.detail = r.pass ? Fmt("%d ticks, peak force %.3g N, largest strain %.3g", r.ticks,
                           r.peak_force_N, first.max_strain)
                     : failed;
+  // Where the failures usually start (docs/core.md): the linear shape drawn beyond its range.
+  if (first.beyond_linear >= 0)
+    r.detail += Fmt("; the linear shape beyond l/3 from tick %d", first.beyond_linear);
   return r;
 }
 
