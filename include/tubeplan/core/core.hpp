@@ -66,6 +66,8 @@ enum StepFlag : std::uint32_t {
 };
 /// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
 inline constexpr int kStepFlagCount = 7;
+static_assert(kBeyondLinearRange == 1u << (kStepFlagCount - 1),
+              "kStepFlagCount must follow the last StepFlag bit");
 
 /// One principal contact in a tick, in the core's compact form.
 struct ContactState {
