@@ -1,0 +1,127 @@
+#pragma once
+// A discrete inextensible rod (Kirchhoff, isotropic, torsionally rigid) clamped at s = 0 along
+// +z and loaded by dead point forces on its surface: the large-deflection model for the loadings
+// the elastica (elastica.hpp: one tip load) does not cover — several loads on one cantilever, a
+// line contact carried by two load points, an axial push with a lateral one. It keeps its length
+// whatever the load, which the linear model does not (docs/core.md).
+//
+// Equilibrium. With n(s) = sum_{s_j > s} F_j the force the part beyond s exerts on the part
+// before it (known: the loads are dead) and m(s) the moment, m' = -t x n between loads, and m
+// drops by r_j x F_j (the load's moment about the centre, r_j its offset to the surface) at s_j.
+// The curvature is kappa = m_perp / (E I), the tangent turns as t' = kappa x t. Beyond the last
+// load the moment is exactly zero, so the integration runs from there back to the clamp, and
+// the unknown is the orientation of the section at the last load: Newton on it makes the section
+// at s = 0 the clamp's (a shooting method, its Jacobian by differences). Shooting from the free
+// end is the classical choice for the cantilever: the map from the end's angle to the root's is
+// monotone along the first mode (the pendulum analogy), where shooting from the clamp with the
+// root moment as unknown winds through several modes already at F l^2 / (E I) ~ 15.
+//
+// Discretisation. Steps of at most `max_step_m` between breakpoints (the loads and the arc
+// positions asked for). Each step is an arc: its rotation h kappa(s + h/2) from the moment
+// predicted at its middle, its chord exact for that arc, and the moment updated exactly by the
+// chord (m_new = m - dx x n), so the discrete chain is in exact equilibrium with the loads at
+// every node; the curvature's midpoint rule makes the shape second-order accurate in the step
+// (tests/model/rod_test.cpp measures the order against the exact elastica).
+//
+// Everything here is in the clamp's frame, SI. No heap allocation.
+
+#include <span>
+
+#include <Eigen/Core>
+
+namespace tubeplan::model {
+
+/// A dead force on the rod's surface: applied at the centreline point of arc position s_m plus
+/// the offset r_m (surface point minus centre, clamp frame), which carries the moment r x F. The
+/// offset turns with its cross-section when the shape is evaluated.
+struct RodLoad {
+  double s_m = 0.0;
+  Eigen::Vector3d f_N = Eigen::Vector3d::Zero();
+  Eigen::Vector3d r_m = Eigen::Vector3d::Zero();
+};
+
+/// A solved rod: its root moment, and what the shape gives.
+struct RodSolution {
+  Eigen::Vector3d root_moment_Nm = Eigen::Vector3d::Zero();  ///< m(0), clamp frame
+  /// The section frame at the last load (z: tangent), clamp frame: the unknown solved for, and
+  /// the next solve's starting guess.
+  Eigen::Matrix3d end_R = Eigen::Matrix3d::Identity();
+  /// The inverse Jacobian of the shooting map (clamp residual per turn of the end) where Newton
+  /// last computed it: the next solve's iterations use it while it still contracts (a chord
+  /// method: one integration an iteration instead of four). Zero when there is none.
+  Eigen::Matrix3d jacobian_inv = Eigen::Matrix3d::Zero();
+  bool converged = false;
+  int iterations = 0;          ///< Newton iterations used
+  double energy_J = 0.0;       ///< bending energy, 1/2 int |m_perp|^2 / (E I) ds
+  double max_moment_Nm = 0.0;  ///< largest |m_perp| along the rod
+  double end_m = 0.0;          ///< arc position of the last load
+  Eigen::Vector3d end_p_m = Eigen::Vector3d::Zero();  ///< centre at end_m
+};
+
+/// Where the shape is asked for: arc positions (ascending, within [0, end_m]) and the centre
+/// and section frame found there.
+struct RodSamples {
+  std::span<const double> s_m;
+  std::span<Eigen::Vector3d> p_m;
+  std::span<Eigen::Matrix3d> R;  ///< may be empty
+};
+
+class Rod {
+ public:
+  /// Bending stiffness E I [N m^2] (> 0) and the longest step [m] (> 0).
+  Rod(double bending_stiffness_Nm2, double max_step_m);
+
+  /// Solves for the loads (any order; s_m > 0). `end_R_guess` is the end section's frame to
+  /// start from: the last solution's, for a rod loaded a little differently, so that a sequence
+  /// of solves follows one branch of equilibria as the loads change (a rod pushed past a
+  /// buckling load has several). If Newton does not converge from it, the solve starts from the
+  /// unloaded rod and grows the load in steps (continuation): the branch that grows
+  /// continuously from the straight rod. Never NaN: without convergence `converged` is false
+  /// and the figures are those of the last iterate. At most kMaxLoads loads (asserted).
+  RodSolution Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const;
+  /// The same from a previous solution: its end frame and its Jacobian as the starting point.
+  RodSolution Solve(std::span<const RodLoad> loads, const RodSolution& previous) const;
+
+  /// The shape of a solved rod at the samples' arc positions (within [0, end_m]).
+  void Shape(std::span<const RodLoad> loads, const RodSolution& solution,
+             const RodSamples& samples) const;
+
+  /// Tangent compliance at a solution: w[i * count + j] = d p_i / d F_j [m/N] for the surface
+  /// points p_i = centre(s_i) + R(s_i) R*(s_i)^T r_i of the loads (R* the solved frame), the end
+  /// frame following the loads so that the rod stays clamped. By differences of the shooting
+  /// map, 3 + 3 count integrations: p_i and the clamp residual e move with the end frame's
+  /// rotation q and with F_j, and d p / d F = dp/dF - dp/dq (de/dq)^-1 de/dF.
+  /// False if the shooting Jacobian is singular (at a bifurcation).
+  bool Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
+                  std::span<Eigen::Matrix3d> w) const;
+
+  double bending_stiffness_Nm2() const { return EI_; }
+  double max_step_m() const { return max_step_m_; }
+
+  static constexpr int kMaxLoads = 16;
+  /// Newton iterations one Solve may spend, continuation included (each ~5 integrations).
+  static constexpr int kMaxIterations = 320;
+
+ private:
+  struct Result {
+    Eigen::Vector3d residual = Eigen::Vector3d::Zero();  ///< rotation vector of the root frame
+    Eigen::Vector3d root_moment = Eigen::Vector3d::Zero();
+    double energy_J = 0.0, max_moment_Nm = 0.0;
+    Eigen::Vector3d end_p = Eigen::Vector3d::Zero();
+  };
+  // Integrates from the last load (frame Q) back to the clamp with the loads scaled by `scale`;
+  // writes the centre (relative to the root's) and frame at the sample positions (ascending).
+  // Loads must be sorted by s (order).
+  Result Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                   const Eigen::Matrix3d& Q, const RodSamples& samples) const;
+  bool Newton(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+              int max_iterations, Eigen::Matrix3d& Q, Eigen::Matrix3d& jacobian_inv,
+              int& iterations, Result& result) const;
+  RodSolution SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess,
+                        const Eigen::Matrix3d& jacobian_inv) const;
+
+  double EI_ = 0.0;
+  double max_step_m_ = 0.0;
+};
+
+}  // namespace tubeplan::model

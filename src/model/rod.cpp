@@ -1,0 +1,350 @@
+#include <algorithm>
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <tubeplan/model/rod.hpp>
+
+namespace tubeplan::model {
+
+namespace {
+
+using Order = std::array<int, Rod::kMaxLoads>;
+
+// The loads' indices sorted by arc position (insertion sort: at most 16, and stable, so that the
+// integration visits loads in a fixed order whatever the caller's).
+int SortedOrder(std::span<const RodLoad> loads, Order& order) {
+  const int count = static_cast<int>(loads.size());
+  assert(count <= Rod::kMaxLoads);
+  for (int i = 0; i < count; ++i) {
+    int at = i;
+    while (at > 0 &&
+           loads[std::size_t(order[std::size_t(at - 1)])].s_m > loads[std::size_t(i)].s_m) {
+      order[std::size_t(at)] = order[std::size_t(at - 1)];
+      --at;
+    }
+    order[std::size_t(at)] = i;
+  }
+  return count;
+}
+
+// The rotation matrix of rotation vector w (Rodrigues), with its series near zero so that a
+// straight step is exactly the identity.
+Eigen::Matrix3d Rotation(const Eigen::Vector3d& w) {
+  const double theta2 = w.squaredNorm();
+  double a, b;  // sin(theta) / theta, (1 - cos(theta)) / theta^2
+  if (theta2 < 1e-8) {
+    a = 1.0 - theta2 / 6.0;
+    b = 0.5 - theta2 / 24.0;
+  } else {
+    const double theta = std::sqrt(theta2);
+    a = std::sin(theta) / theta;
+    b = (1.0 - std::cos(theta)) / theta2;
+  }
+  Eigen::Matrix3d W;
+  W << 0.0, -w.z(), w.y(), w.z(), 0.0, -w.x(), -w.y(), w.x(), 0.0;
+  return Eigen::Matrix3d::Identity() + a * W + b * (W * W);
+}
+
+// The largest moment the loads can make about the clamp (each force by its lever along the
+// straight rod and its offset): the scale of the shooting residual.
+double MomentScale(std::span<const RodLoad> loads) {
+  double scale = 0.0;
+  for (const RodLoad& load : loads) scale += load.f_N.norm() * (load.s_m + load.r_m.norm());
+  return scale;
+}
+
+}  // namespace
+
+Rod::Rod(double bending_stiffness_Nm2, double max_step_m)
+    : EI_(bending_stiffness_Nm2), max_step_m_(max_step_m) {
+  if (!(EI_ > 0.0) || !std::isfinite(EI_) || !(max_step_m_ > 0.0) || !std::isfinite(max_step_m_))
+    throw std::invalid_argument("Rod: bending stiffness and step must be positive and finite");
+}
+
+Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                           const Eigen::Matrix3d& Q, const RodSamples& samples) const {
+  const int count = static_cast<int>(order.size());
+  const double end = count > 0 ? loads[std::size_t(order[std::size_t(count - 1)])].s_m : 0.0;
+  // From the last load back to the clamp: beyond it the moment and force are zero; passing a
+  // load adds its force and its moment about the centre.
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();  // relative to the end; shifted at the root
+  Eigen::Matrix3d R = Q;
+  Result result;
+  const auto perp_norm = [&](const Eigen::Vector3d& v) {
+    const Eigen::Vector3d t = R.col(2);
+    return (v - v.dot(t) * t).norm();
+  };
+  const std::size_t sample_count = samples.s_m.size();
+  std::size_t beyond = sample_count;  // samples at s > end: straight, set at the end
+  while (beyond > 0 && samples.s_m[beyond - 1] > end) --beyond;
+  std::size_t next_sample = beyond;  // samples [0, next_sample) are still to be recorded
+  const auto record = [&](double s) {
+    while (next_sample > 0 && samples.s_m[next_sample - 1] >= s) {
+      --next_sample;
+      samples.p_m[next_sample] = x;
+      if (!samples.R.empty()) samples.R[next_sample] = R;
+    }
+  };
+  double s = end;
+  int next_load = count - 1;
+  for (;;) {
+    while (next_load >= 0 && loads[std::size_t(order[std::size_t(next_load)])].s_m >= s) {
+      const RodLoad& load = loads[std::size_t(order[std::size_t(next_load--)])];
+      const Eigen::Vector3d f = scale * load.f_N;
+      m += load.r_m.cross(f);
+      n += f;
+      result.max_moment_Nm = std::max(result.max_moment_Nm, perp_norm(m));
+    }
+    record(s);
+    if (s <= 0.0) break;
+    double stop = 0.0;
+    if (next_load >= 0)
+      stop = std::max(stop, loads[std::size_t(order[std::size_t(next_load)])].s_m);
+    if (next_sample > 0) stop = std::max(stop, samples.s_m[next_sample - 1]);
+    const int steps = std::max(1, static_cast<int>(std::ceil((s - stop) / max_step_m_ - 1e-9)));
+    const double h = (s - stop) / steps;
+    for (int k = 0; k < steps; ++k) {
+      const Eigen::Vector3d t = R.col(2);
+      // The moment and the tangent at the step's middle, predicted (m' = -t x n, t' = m x t / EI,
+      // here backwards); the step turns the section by h times the curvature there (across the
+      // tangent: the rod does not twist).
+      const Eigen::Vector3d m_mid = m + 0.5 * h * t.cross(n);
+      const Eigen::Vector3d t_mid = (t - (0.5 * h / EI_) * m_mid.cross(t)).normalized();
+      const Eigen::Vector3d kappa = (m_mid - m_mid.dot(t_mid) * t_mid) / EI_;
+      const Eigen::Matrix3d R_before = Rotation(-h * kappa) * R;
+      const Eigen::Vector3d t_before = R_before.col(2);
+      // The chord of an arc of length h whose tangent turns from t_before to t.
+      const double sin_half = 0.5 * (t - t_before).norm();
+      const double cos_half = 0.5 * (t + t_before).norm();
+      const double half = std::atan2(sin_half, cos_half);
+      const double chord = half > 1e-8 ? h * sin_half / half : h * (1.0 - half * half / 6.0);
+      const Eigen::Vector3d dx =
+          cos_half > 1e-12 ? Eigen::Vector3d(chord * (t + t_before) / (2.0 * cos_half)) : t * h;
+      m += dx.cross(n);  // exact for the chord: equilibrium of the discrete chain
+      x -= dx;
+      R = R_before;
+      result.energy_J += 0.5 * h * EI_ * kappa.squaredNorm();
+      result.max_moment_Nm = std::max(result.max_moment_Nm, perp_norm(m));
+      s = k + 1 == steps ? stop : s - h;
+    }
+  }
+  // Positions from the root; beyond the last load the rod is straight along its end tangent.
+  const Eigen::Vector3d root = x;
+  for (std::size_t k = 0; k < beyond; ++k) samples.p_m[k] -= root;
+  result.end_p = -root;
+  for (std::size_t k = beyond; k < sample_count; ++k) {
+    samples.p_m[k] = result.end_p + (samples.s_m[k] - end) * Q.col(2);
+    if (!samples.R.empty()) samples.R[k] = Q;
+  }
+  // The root section must be the clamp's: the residual is its rotation from it (twice the
+  // quaternion's vector part, taken with w >= 0 so that only the identity is a zero).
+  Eigen::Quaterniond q(R);
+  if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+  result.residual = 2.0 * q.vec();
+  result.root_moment = m;
+  return result;
+}
+
+bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                 int max_iterations, Eigen::Matrix3d& Q, Eigen::Matrix3d& jacobian_inv,
+                 int& iterations, Result& result) const {
+  // Each step's rotation rounds by ~1e-16: the tolerance grows with the number of steps.
+  const double end = order.empty() ? 0.0 : loads[std::size_t(order.back())].s_m;
+  const double kTolerance_rad = 1e-14 * std::max(1.0, end / max_step_m_);
+  result = Integrate(loads, order, scale, Q, {});
+  // Chord iterations with the Jacobian of an earlier solve, while each at least halves the
+  // residual (a rod loaded a little differently from last tick: two or three suffice).
+  for (int it = 0; it < 6 && !jacobian_inv.isZero(0.0); ++it) {
+    if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
+    Eigen::Vector3d step = -jacobian_inv * result.residual;
+    if (!step.allFinite() || step.norm() > 0.5) break;
+    const Eigen::Matrix3d trial = Rotation(step) * Q;
+    const Result r = Integrate(loads, order, scale, trial, {});
+    ++iterations;
+    if (!(r.residual.norm() < 0.5 * result.residual.norm())) break;
+    Q = trial;
+    result = r;
+  }
+  for (int it = 0; it < max_iterations; ++it) {
+    if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
+    ++iterations;
+    constexpr double kDelta_rad = 1e-7;
+    Eigen::Matrix3d J;
+    for (int c = 0; c < 3; ++c)
+      J.col(c) =
+          (Integrate(loads, order, scale, Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, {})
+               .residual -
+           result.residual) /
+          kDelta_rad;
+    const double det = J.determinant();
+    if (!(std::abs(det) > 1e-12) || !J.allFinite()) return false;
+    jacobian_inv = J.inverse();
+    Eigen::Vector3d step = -jacobian_inv * result.residual;
+    // At most half a radian a step: the map is far from linear over larger turns.
+    if (step.norm() > 0.5) step *= 0.5 / step.norm();
+    // Damped: halve the step until the residual falls.
+    bool improved = false;
+    for (double lambda = 1.0; lambda > 1.0 / 128.0; lambda *= 0.5) {
+      const Eigen::Matrix3d trial = Rotation(lambda * step) * Q;
+      const Result r = Integrate(loads, order, scale, trial, {});
+      if (r.residual.allFinite() && r.residual.norm() < result.residual.norm()) {
+        Q = trial;
+        result = r;
+        improved = true;
+        break;
+      }
+    }
+    if (!improved) return false;
+  }
+  return !(result.residual.norm() > kTolerance_rad) && result.residual.allFinite();
+}
+
+RodSolution Rod::Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const {
+  return SolveFrom(loads, end_R_guess, Eigen::Matrix3d::Zero());
+}
+
+RodSolution Rod::Solve(std::span<const RodLoad> loads, const RodSolution& previous) const {
+  return SolveFrom(loads, previous.end_R, previous.jacobian_inv);
+}
+
+RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess,
+                           const Eigen::Matrix3d& jacobian_inv) const {
+  Order order{};
+  const int count = SortedOrder(loads, order);
+  const std::span<const int> sorted(order.data(), std::size_t(count));
+  RodSolution solution;
+  Result result;
+  Eigen::Matrix3d Q = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d J_inv = jacobian_inv.allFinite() ? jacobian_inv : Eigen::Matrix3d::Zero();
+  bool converged = false;
+  // The load parameter F l^2 / (E I) of the whole load.
+  const double end = count > 0 ? loads[std::size_t(order[std::size_t(count - 1)])].s_m : 0.0;
+  const double alpha = MomentScale(loads) * end / EI_;
+  // A cold start (the straight rod as the guess) goes straight to the continuation once the
+  // load is large: from the straight rod Newton finds looped branches beyond alpha ~ 40, whose
+  // end is no further turned than the first mode's; up to 10 it finds the first mode
+  // (tests/model/rod_test.cpp).
+  const bool cold = end_R_guess.isIdentity(0.0);
+  if (end_R_guess.allFinite() && !(cold && alpha > 10.0)) {
+    // From the guess: a few iterations, since a guess from the same branch converges in two or
+    // three. Newton from far can land on another branch (from the straight rod at
+    // F l^2 / (E I) = 60 it finds a looped one in four iterations), so a solution whose end
+    // turned more than half a radian from the guess is not taken: a tick's loads change far
+    // less than that, and the continuation below decides instead.
+    const Eigen::Matrix3d guess = Eigen::Quaterniond(end_R_guess).normalized().toRotationMatrix();
+    Q = guess;
+    converged = Newton(loads, sorted, 1.0, 8, Q, J_inv, solution.iterations, result) &&
+                Eigen::AngleAxisd(Q * guess.transpose()).angle() <= 0.5;
+  }
+  // Continuation from the unloaded rod: the load grown in steps, each solved from the last, at
+  // first so that each step adds about 2 to the load parameter, then finer.
+  const int first_steps = static_cast<int>(std::clamp(std::ceil(alpha / 2.0), 1.0, 64.0));
+  // The work is capped (kMaxIterations Newton iterations, ~5 integrations each): a tick must
+  // end, and a loading that needs more falls back to the linear model, flagged.
+  for (int steps = first_steps; !converged && steps <= 4 * 256; steps *= 4) {
+    Q.setIdentity();
+    J_inv.setZero();
+    converged = true;
+    for (int k = 1; k <= steps && converged; ++k)
+      converged =
+          solution.iterations < kMaxIterations &&
+          Newton(loads, sorted, double(k) / steps, 20, Q, J_inv, solution.iterations, result);
+  }
+  if (!converged && !Q.allFinite()) {
+    Q.setIdentity();
+    result = Integrate(loads, sorted, 1.0, Q, {});
+  }
+  solution.end_R = Q;
+  solution.jacobian_inv = converged ? J_inv : Eigen::Matrix3d::Zero();
+  solution.root_moment_Nm =
+      result.root_moment.allFinite() ? result.root_moment : Eigen::Vector3d::Zero();
+  solution.converged = converged && result.residual.allFinite();
+  solution.energy_J = std::isfinite(result.energy_J) ? result.energy_J : 0.0;
+  solution.max_moment_Nm = std::isfinite(result.max_moment_Nm) ? result.max_moment_Nm : 0.0;
+  solution.end_m = end;
+  solution.end_p_m = result.end_p.allFinite() ? result.end_p : Eigen::Vector3d(0.0, 0.0, end);
+  return solution;
+}
+
+void Rod::Shape(std::span<const RodLoad> loads, const RodSolution& solution,
+                const RodSamples& samples) const {
+  Order order{};
+  const int count = SortedOrder(loads, order);
+  Integrate(loads, std::span<const int>(order.data(), std::size_t(count)), 1.0, solution.end_R,
+            samples);
+}
+
+bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
+                     std::span<Eigen::Matrix3d> w) const {
+  Order order{};
+  const int count = SortedOrder(loads, order);
+  const std::span<const int> sorted(order.data(), std::size_t(count));
+  assert(w.size() >= std::size_t(count * count));
+  // The loads' arc positions in ascending order (the integration's samples) and back.
+  std::array<double, kMaxLoads> s_sorted{};
+  for (int k = 0; k < count; ++k)
+    s_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].s_m;
+  std::array<Eigen::Vector3d, kMaxLoads> p0, p;
+  std::array<Eigen::Matrix3d, kMaxLoads> R0, R;
+  const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
+  const Eigen::Matrix3d& Q = solution.end_R;
+  const Result base = Integrate(
+      loads, sorted, 1.0, Q,
+      {s_span, std::span(p0.data(), std::size_t(count)), std::span(R0.data(), std::size_t(count))});
+  // Surface points of a perturbed integration, in the loads' own order, minus the base ones.
+  const auto surface_motion = [&](int load_index_sorted) {
+    const RodLoad& load = loads[std::size_t(order[std::size_t(load_index_sorted)])];
+    const std::size_t k = std::size_t(load_index_sorted);
+    return Eigen::Vector3d(p[k] - p0[k] +
+                           (R[k] * R0[k].transpose() - Eigen::Matrix3d::Identity()) * load.r_m);
+  };
+  const RodSamples perturbed{s_span, std::span(p.data(), std::size_t(count)),
+                             std::span(R.data(), std::size_t(count))};
+  // With respect to the end section's turn q.
+  constexpr double kDelta_rad = 1e-6;
+  Eigen::Matrix3d E_u;
+  std::array<Eigen::Matrix3d, kMaxLoads> P_u;
+  for (int c = 0; c < 3; ++c) {
+    const Result r = Integrate(loads, sorted, 1.0,
+                               Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, perturbed);
+    E_u.col(c) = (r.residual - base.residual) / kDelta_rad;
+    for (int k = 0; k < count; ++k) P_u[std::size_t(k)].col(c) = surface_motion(k) / kDelta_rad;
+  }
+  const double det = E_u.determinant();
+  if (!(std::abs(det) > 1e-12) || !E_u.allFinite()) return false;
+  const Eigen::Matrix3d E_u_inv = E_u.inverse();
+  // With respect to each load's force, the root moment held.
+  double force_scale = 0.0;
+  for (const RodLoad& load : loads) force_scale += load.f_N.norm();
+  const double end = std::max(count > 0 ? s_sorted[std::size_t(count - 1)] : 0.0, max_step_m_);
+  const double dF = 1e-6 * std::max(force_scale, EI_ / (end * end));
+  std::array<RodLoad, kMaxLoads> shifted{};
+  std::copy(loads.begin(), loads.end(), shifted.begin());
+  const std::span<const RodLoad> shifted_span(shifted.data(), std::size_t(count));
+  for (int kj = 0; kj < count; ++kj) {
+    const int j = order[std::size_t(kj)];
+    for (int c = 0; c < 3; ++c) {
+      shifted[std::size_t(j)].f_N[c] += dF;
+      const Result r = Integrate(shifted_span, sorted, 1.0, Q, perturbed);
+      shifted[std::size_t(j)].f_N[c] = loads[std::size_t(j)].f_N[c];
+      const Eigen::Vector3d e_F = (r.residual - base.residual) / dF;
+      const Eigen::Vector3d u_F = -E_u_inv * e_F;  // the end's turn that keeps the root clamped
+      for (int ki = 0; ki < count; ++ki) {
+        const int i = order[std::size_t(ki)];
+        w[std::size_t(i * count + j)].col(c) = surface_motion(ki) / dF + P_u[std::size_t(ki)] * u_F;
+      }
+    }
+  }
+  for (int k = 0; k < count * count; ++k)
+    if (!w[std::size_t(k)].allFinite()) return false;
+  return true;
+}
+
+}  // namespace tubeplan::model

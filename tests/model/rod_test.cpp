@@ -1,0 +1,278 @@
+// Tests of the discrete rod (model/rod.hpp), the large-deflection model of loadings the elastica
+// does not cover. References from outside the rod: Mattiasson's published table (physics.md),
+// the closed-form elastica (elliptic integrals, model/elastica.hpp: another method entirely),
+// the textbook beam-column compliances (Timoshenko & Gere) under an axial load, the linear
+// cantilever, and invariants of statics (the root moment of the loads, Maxwell-Betti).
+
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+
+#include <tubeplan/model/elastica.hpp>
+#include <tubeplan/model/rod.hpp>
+
+namespace {
+
+using tubeplan::model::Rod;
+using tubeplan::model::RodLoad;
+using tubeplan::model::RodSamples;
+using tubeplan::model::RodSolution;
+
+constexpr double kPi = std::numbers::pi;
+
+// A force on the centreline (Eigen's vectors are not zeroed by {}: say it).
+RodLoad At(double s_m, const Eigen::Vector3d& f_N) {
+  return RodLoad{s_m, f_N, Eigen::Vector3d::Zero()};
+}
+
+// Tip of a unit rod (E I = 1, l = 1) under a tip force: centre at s = 1.
+Eigen::Vector3d Tip(const Rod& rod, const std::vector<RodLoad>& loads, RodSolution& solution) {
+  solution = rod.Solve(loads, Eigen::Matrix3d::Identity());
+  std::array<double, 1> s{1.0};
+  std::array<Eigen::Vector3d, 1> p;
+  rod.Shape(loads, solution, RodSamples{s, p, {}});
+  return p[0];
+}
+
+}  // namespace
+
+TEST_CASE("Rod: Mattiasson's tip deflections and shortenings under a dead lateral tip load",
+          "[rod]") {
+  // The published table has 5 decimals (rounding 5e-6); the rod's second-order error at steps
+  // of l/2000 is below 1e-6 at alpha = 10 (measured by the order test below): 2e-5 holds both.
+  const Rod rod(1.0, 1.0 / 2000.0);
+  struct Row {
+    double alpha, v, h;
+  };
+  for (const Row row : {Row{1, 0.30172, 0.05643}, Row{2, 0.49346, 0.16064},
+                        Row{5, 0.71379, 0.38763}, Row{10, 0.81061, 0.55500}}) {
+    INFO("alpha = " << row.alpha);
+    RodSolution solution;
+    const Eigen::Vector3d tip = Tip(rod, {At(1.0, Eigen::Vector3d(row.alpha, 0, 0))}, solution);
+    REQUIRE(solution.converged);
+    CHECK(tip.x() == Approx(row.v).margin(2e-5));
+    CHECK(1.0 - tip.z() == Approx(row.h).margin(2e-5));
+    CHECK(std::abs(tip.y()) < 1e-12);  // a load along x bends in the xz plane only
+  }
+}
+
+TEST_CASE("Rod: second-order convergence to the closed-form elastica, any load direction",
+          "[rod]") {
+  // The exact elastica by elliptic integrals (another method), at alpha = 5 and load angles from
+  // a lateral push to a mostly compressive one (the first mode). Halving the step must divide
+  // the error by 4 (second order: the midpoint curvature of each arc), within 3.3 .. 4.7 for
+  // the higher-order terms at these step sizes.
+  for (const double psi : {0.0, 0.6, -0.6, -1.2}) {
+    INFO("psi = " << psi);
+    const double alpha = 5.0;
+    const tubeplan::model::ElasticaSolution exact = tubeplan::model::SolveElastica(alpha, psi);
+    // The elastica's load: |F| (cos psi x + sin psi z).
+    const std::vector<RodLoad> loads{
+        At(1.0, Eigen::Vector3d(alpha * std::cos(psi), 0.0, alpha * std::sin(psi)))};
+    std::array<double, 3> error{};
+    for (int k = 0; k < 3; ++k) {
+      const Rod rod(1.0, 1.0 / (50.0 * (1 << k)));
+      RodSolution solution;
+      const Eigen::Vector3d tip = Tip(rod, loads, solution);
+      REQUIRE(solution.converged);
+      error[std::size_t(k)] =
+          std::hypot(tip.x() - exact.tip.deflection, (1.0 - tip.z()) - exact.tip.shortening);
+      // The energy is the elastica's E I / l * energy (here E I = l = 1).
+      CHECK(solution.energy_J == Approx(exact.tip.energy).epsilon(2e-2));
+    }
+    CHECK(error[0] / error[1] == Approx(4.0).margin(0.7));
+    CHECK(error[1] / error[2] == Approx(4.0).margin(0.7));
+    CHECK(error[2] < 2e-4);
+  }
+}
+
+TEST_CASE("Rod: large loads (alpha to 100) by continuation and by warm starts, on the first mode",
+          "[rod]") {
+  // From the straight rod the solve grows the load in steps (continuation) within its work cap
+  // (Rod::kMaxIterations): alpha = 60 fits. At alpha = 100 a cold start may run out of it, and
+  // must then say so rather than return another branch; from a nearby solution (a tick's warm
+  // start) it converges. Curvature ~14 at the root at alpha = 100: the step's second-order error
+  // at l/2000 is below 1e-5 there (2.5e-5 at l/500 in the convergence test's scaling).
+  const Rod rod(1.0, 1.0 / 2000.0);
+  const auto check = [&](double alpha, const RodSolution& solution) {
+    const tubeplan::model::ElasticaSolution exact = tubeplan::model::SolveElastica(alpha, 0.0);
+    std::array<double, 1> s{1.0};
+    std::array<Eigen::Vector3d, 1> p;
+    const std::vector<RodLoad> loads{At(1.0, Eigen::Vector3d(alpha, 0, 0))};
+    rod.Shape(loads, solution, RodSamples{s, p, {}});
+    CHECK(p[0].x() == Approx(exact.tip.deflection).margin(1e-4));
+    CHECK(1.0 - p[0].z() == Approx(exact.tip.shortening).margin(1e-4));
+    // Inextensible: the tip can never be further from the clamp than the rod is long.
+    CHECK(p[0].norm() <= 1.0);
+  };
+  const RodSolution cold60 = rod.Solve(std::vector<RodLoad>{At(1.0, Eigen::Vector3d(60.0, 0, 0))},
+                                       Eigen::Matrix3d::Identity());
+  REQUIRE(cold60.converged);
+  check(60.0, cold60);
+  const RodSolution cold100 = rod.Solve(std::vector<RodLoad>{At(1.0, Eigen::Vector3d(100.0, 0, 0))},
+                                        Eigen::Matrix3d::Identity());
+  if (cold100.converged) check(100.0, cold100);
+  RodSolution warm = cold60;
+  for (double alpha = 65.0; alpha <= 100.0; alpha += 5.0) {
+    warm = rod.Solve(std::vector<RodLoad>{At(1.0, Eigen::Vector3d(alpha, 0, 0))}, warm);
+    REQUIRE(warm.converged);
+    check(alpha, warm);
+  }
+}
+
+TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the beam-column",
+          "[rod]") {
+  // A cantilever under an axial force P has the lateral tip compliance
+  //   compression: (tan(k l) - k l) / (k^3 E I),  tension: (k l - tanh(k l)) / (k^3 E I),
+  // k = sqrt(P / (E I)) (Timoshenko & Gere, beam-columns), l^3 / (3 E I) without P; the rod is
+  // inextensible, so the axial compliance is zero. The compliance is by differences of the
+  // shooting map (relative steps 1e-6): 1e-5 relative covers them.
+  const double EI = 2.0, l = 0.5;
+  const Rod rod(EI, l / 400.0);
+  const double euler_N = kPi * kPi * EI / (4.0 * l * l);
+  for (const double P : {0.0, 0.5 * euler_N, 0.9 * euler_N, -2.0 * euler_N}) {
+    INFO("axial load " << P << " N (compression > 0)");
+    const std::vector<RodLoad> loads{At(l, Eigen::Vector3d(0.0, 0.0, -P))};
+    const RodSolution solution = rod.Solve(loads, Eigen::Matrix3d::Identity());
+    REQUIRE(solution.converged);
+    std::array<Eigen::Matrix3d, 1> w;
+    REQUIRE(rod.Compliance(loads, solution, w));
+    double expected = l * l * l / (3.0 * EI);
+    if (P > 0.0) {
+      const double k = std::sqrt(P / EI);
+      expected = (std::tan(k * l) - k * l) / (k * k * k * EI);
+    } else if (P < 0.0) {
+      const double k = std::sqrt(-P / EI);
+      expected = (k * l - std::tanh(k * l)) / (k * k * k * EI);
+    }
+    // The discretisation's own error in the compliance is second order: ~1e-5 at l/400.
+    CHECK(w[0](0, 0) == Approx(expected).epsilon(1e-4));
+    CHECK(w[0](1, 1) == Approx(expected).epsilon(1e-4));
+    CHECK(std::abs(w[0](2, 2)) < 1e-6 * expected);
+    CHECK(std::abs(w[0](0, 1)) < 1e-6 * expected);
+  }
+}
+
+TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (Maxwell-Betti)",
+          "[rod]") {
+  // A bent rod under three loads in 3D, two with offsets (the surface points of a side contact and
+  // a rim). The compliance formula (differences of the shooting map with the root moment
+  // eliminated) against central differences of complete solves: another computation of the same
+  // derivative. Without offsets the loads are conservative and the compliance is symmetric.
+  const double EI = 8.2e-3, l = 0.15;  // the shipped rubber tube
+  const Rod rod(EI, l / 200.0);
+  for (const bool offsets : {false, true}) {
+    INFO((offsets ? "with offsets" : "centreline loads"));
+    const std::vector<RodLoad> loads{
+        {0.05, Eigen::Vector3d(0.05, -0.02, 0.01),
+         offsets ? Eigen::Vector3d(-0.008, 0, 0) : Eigen::Vector3d::Zero()},
+        {0.11, Eigen::Vector3d(-0.02, 0.04, -0.03), Eigen::Vector3d::Zero()},
+        {0.15, Eigen::Vector3d(0.03, 0.01, -0.05),
+         offsets ? Eigen::Vector3d(0, 0.008, 0) : Eigen::Vector3d::Zero()}};
+    const RodSolution solution = rod.Solve(loads, Eigen::Matrix3d::Identity());
+    REQUIRE(solution.converged);
+    std::array<Eigen::Matrix3d, 9> w;
+    REQUIRE(rod.Compliance(loads, solution, w));
+    const auto surface = [&](const std::vector<RodLoad>& ls, const RodSolution& sol, int i) {
+      std::array<double, 1> s{ls[std::size_t(i)].s_m};
+      std::array<Eigen::Vector3d, 1> p;
+      std::array<Eigen::Matrix3d, 1> R;
+      rod.Shape(ls, sol, RodSamples{s, p, R});
+      return std::pair{p[0], R[0]};
+    };
+    double largest = 0.0;
+    for (const Eigen::Matrix3d& b : w) largest = std::max(largest, b.cwiseAbs().maxCoeff());
+    const double dF = 1e-5;
+    for (int j = 0; j < 3; ++j)
+      for (int c = 0; c < 3; ++c) {
+        std::vector<RodLoad> plus = loads, minus = loads;
+        plus[std::size_t(j)].f_N[c] += dF;
+        minus[std::size_t(j)].f_N[c] -= dF;
+        const RodSolution sp = rod.Solve(plus, solution.end_R);
+        const RodSolution sm = rod.Solve(minus, solution.end_R);
+        REQUIRE(sp.converged);
+        REQUIRE(sm.converged);
+        for (int i = 0; i < 3; ++i) {
+          const auto [p0, R0] = surface(loads, solution, i);
+          const auto [pp, Rp] = surface(plus, sp, i);
+          const auto [pm, Rm] = surface(minus, sm, i);
+          const Eigen::Vector3d r = loads[std::size_t(i)].r_m;
+          const Eigen::Vector3d dp =
+              ((pp + Rp * R0.transpose() * r) - (pm + Rm * R0.transpose() * r)) / (2.0 * dF);
+          // Forward differences inside the formula (relative 1e-6) and the solves' tolerance.
+          CHECK((w[std::size_t(i * 3 + j)].col(c) - dp).norm() < 2e-5 * largest);
+        }
+      }
+    if (!offsets)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          CHECK((w[std::size_t(i * 3 + j)] - w[std::size_t(j * 3 + i)].transpose())
+                    .cwiseAbs()
+                    .maxCoeff() < 2e-5 * largest);
+  }
+}
+
+TEST_CASE("Rod: statics and length hold exactly on the discrete chain", "[rod]") {
+  // The root moment of the solution is the loads' moment about the clamp at their deformed
+  // points (the moment update is exact for each chord), and the chain keeps its length: no
+  // sample is further along the rod than its arc position allows.
+  const double EI = 8.2e-3, l = 0.15;
+  const Rod rod(EI, l / 48.0);
+  const std::vector<RodLoad> loads{
+      {0.09, Eigen::Vector3d(1.5, -0.4, -2.0), Eigen::Vector3d(0.008, 0, 0)},
+      {0.15, Eigen::Vector3d(-0.3, 1.0, -1.0), Eigen::Vector3d(0, -0.008, 0)}};
+  const RodSolution solution = rod.Solve(loads, Eigen::Matrix3d::Identity());
+  REQUIRE(solution.converged);
+  std::array<double, 2> s{0.09, 0.15};
+  std::array<Eigen::Vector3d, 2> p;
+  rod.Shape(loads, solution, RodSamples{s, p, {}});
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+  for (int j = 0; j < 2; ++j)
+    moment += (p[std::size_t(j)] + loads[std::size_t(j)].r_m).cross(loads[std::size_t(j)].f_N);
+  const double scale = 2.5 * 0.15;  // |F| l
+  CHECK((moment - solution.root_moment_Nm).norm() < 1e-9 * scale);
+  // Length: sampled densely, consecutive points are never further apart than their arc.
+  std::vector<double> dense(301);
+  std::vector<Eigen::Vector3d> q(301);
+  for (std::size_t k = 0; k < dense.size(); ++k) dense[k] = l * double(k) / 300.0;
+  rod.Shape(loads, solution, RodSamples{dense, q, {}});
+  double length = 0.0;
+  for (std::size_t k = 1; k < q.size(); ++k) {
+    const double chord = (q[k] - q[k - 1]).norm();
+    CHECK(chord <= (l / 300.0) * (1.0 + 1e-12));
+    length += chord;
+  }
+  CHECK(length > 0.99 * l);  // and it is bent (a chord falls short of its arc) by ~1 % at most
+  CHECK(solution.max_moment_Nm > 0.0);
+}
+
+TEST_CASE("Rod: no load, no bending; small loads give the linear cantilever", "[rod]") {
+  const double EI = 1.0, l = 1.0;
+  // Steps of l/1000: the trapezoid in the deflection's integral errs by h^2/12 of F l^3/(E I),
+  // 2.5e-7 of the deflection, inside the 1e-6 asked.
+  const Rod rod(EI, l / 1000.0);
+  const RodSolution none = rod.Solve({}, Eigen::Matrix3d::Identity());
+  CHECK(none.converged);
+  CHECK(none.energy_J == 0.0);
+  // A lateral tip force F at alpha = 1e-4: deflection F l^3 / (3 E I) to the series' next term,
+  // (4/105) alpha^3, far below the 1e-9 asked; a couple M at the tip (as an offset force
+  // pair would give): M l^2 / (2 E I).
+  const double F = 1e-4;
+  RodSolution solution;
+  const Eigen::Vector3d tip = Tip(rod, {At(1.0, Eigen::Vector3d(0, F, 0))}, solution);
+  CHECK(tip.y() == Approx(F / 3.0).epsilon(1e-6));
+  const double r = 0.01;  // a force F along -x at offset +z r: moment r z x (-F x) = -r F y
+  const std::vector<RodLoad> couple{{1.0, Eigen::Vector3d(-F, 0, 0), Eigen::Vector3d(0, 0, r)},
+                                    {1.0, Eigen::Vector3d(F, 0, 0), Eigen::Vector3d::Zero()}};
+  const RodSolution c = rod.Solve(couple, Eigen::Matrix3d::Identity());
+  std::array<double, 1> s{1.0};
+  std::array<Eigen::Vector3d, 1> p;
+  rod.Shape(couple, c, RodSamples{s, p, {}});
+  // Moment -r F about y bends the tip towards -x: x = -r F l^2 / (2 E I).
+  CHECK(p[0].x() == Approx(-r * F / 2.0).epsilon(1e-6));
+}
