@@ -58,6 +58,8 @@ std::string_view FlagName(std::uint32_t bit) {
       return "fault";
     case core::kBeyondLinearRange:
       return "beyond_linear";
+    case core::kRodShape:
+      return "rod";
     default:
       return "unknown";
   }

@@ -29,6 +29,10 @@ BeamChain::BeamChain(const scene::Scene& scene)
       // Loads closer than a tube radius act on the same cross-section as far as the tube's
       // bending can tell: they share a cut (e.g. the end face and a wall at the tip's side).
       group_tolerance_m_(scene.tube.outer_radius_m),
+      // The rod's steps: l/48, no longer than the shortest capsule of the chain it draws. Its
+      // error is second order in the step (tests/model/rod_test.cpp): at l/48 the tip of the
+      // rubber tube at alpha = 5 is within ~0.1 % of l of the exact elastica.
+      rod_(EI_, scene.tube.length_m / kMaxCapsules),
       rule_(scene.model.multi_contact) {}
 
 int BeamChain::Assign(std::array<BeamLoad, kMaxLoads>& loads, int total,
@@ -301,6 +305,100 @@ Eigen::Matrix3d BeamChain::ElasticaCompliance(const ElasticaSegment& segment,
   B.col(2) = Eigen::Vector3d::UnitZ();
   const Eigen::Matrix3d basis_H = segment.R_HS * B;
   return basis_H * J_local * basis_H.transpose();
+}
+
+}  // namespace tubeplan::core
+
+namespace tubeplan::core {
+
+int BeamChain::SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
+                             const std::array<int, kMaxLoads>& order,
+                             std::array<RodSegment, kMaxLoads>& segments) const {
+  const bool coupled = rule_ == scene::MultiContactRule::kCoupled;
+  int segment_count = 0;
+  Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();
+  double clamp_m = 0.0;
+  for (int k = 0; k < count;) {
+    // One segment: a group's loads (consecutive in `order`), or every load under the coupled rule.
+    const int group = loads[std::size_t(order[std::size_t(k)])].group;
+    RodSegment& seg = segments[std::size_t(segment_count++)];
+    seg.origin_H = origin_H;
+    seg.R_HS = R_HS;
+    seg.clamp_m = clamp_m;
+    seg.load_count = 0;
+    for (; k < count && (coupled || loads[std::size_t(order[std::size_t(k)])].group == group);
+         ++k) {
+      const int i = order[std::size_t(k)];
+      const BeamLoad& load = loads[std::size_t(i)];
+      const std::size_t q = std::size_t(seg.load_count++);
+      seg.index[q] = i;
+      seg.loads_S[q] = model::RodLoad{std::max(load.s_m - clamp_m, 0.0),
+                                      R_HS.transpose() * load.f_H_N, R_HS.transpose() * load.r_H_m};
+    }
+    const std::span<const model::RodLoad> seg_loads(seg.loads_S.data(),
+                                                    std::size_t(seg.load_count));
+    seg.solution = rod_.Solve(seg_loads, seg.solution);
+    if (!seg.solution.converged) return 0;
+    seg.end_m = clamp_m + seg.solution.end_m;
+    // Carry the clamp to the segment's end: there the next segment starts.
+    origin_H += R_HS * seg.solution.end_p_m;
+    R_HS = R_HS * seg.solution.end_R;
+    clamp_m = seg.end_m;
+  }
+  return segment_count;
+}
+
+bool BeamChain::RodCompliance(
+    const RodSegment& segment,
+    std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const {
+  const int n = segment.load_count;
+  std::array<Eigen::Matrix3d, kMaxLoads * kMaxLoads> w_S;
+  if (!rod_.Compliance(std::span<const model::RodLoad>(segment.loads_S.data(), std::size_t(n)),
+                       segment.solution,
+                       std::span<Eigen::Matrix3d>(w_S.data(), std::size_t(n * n))))
+    return false;
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; b < n; ++b)
+      w[std::size_t(segment.index[std::size_t(a)])][std::size_t(segment.index[std::size_t(b)])] =
+          segment.R_HS * w_S[std::size_t(a * n + b)] * segment.R_HS.transpose();
+  return true;
+}
+
+void BeamChain::RodNodes(const std::array<RodSegment, kMaxLoads>& segments, int segment_count,
+                         std::span<Eigen::Vector3d> nodes) const {
+  const std::size_t count = nodes.size();
+  std::array<double, kMaxCapsules + 1> s_S{};
+  std::size_t k = 0;
+  for (int g = 0; g < segment_count && k < count; ++g) {
+    const RodSegment& seg = segments[std::size_t(g)];
+    const bool last = g + 1 == segment_count;
+    // This segment's nodes: up to its end, or all that are left for the last one (straight
+    // beyond its last load).
+    const std::size_t first = k;
+    for (; k < count; ++k) {
+      const double s = count > 1 ? length_m_ * double(k) / double(count - 1) : length_m_;
+      if (!last && s > seg.end_m) break;
+      s_S[k - first] = std::max(s - seg.clamp_m, 0.0);
+    }
+    const std::size_t n = k - first;
+    if (n == 0) continue;
+    rod_.Shape(
+        std::span<const model::RodLoad>(seg.loads_S.data(), std::size_t(seg.load_count)),
+        seg.solution,
+        model::RodSamples{std::span<const double>(s_S.data(), n), nodes.subspan(first, n), {}});
+    for (std::size_t q = first; q < k; ++q) nodes[q] = seg.origin_H + seg.R_HS * nodes[q];
+  }
+  for (; k < count; ++k)  // no segment: the straight tube
+    nodes[k] = Eigen::Vector3d(0.0, 0.0,
+                               count > 1 ? length_m_ * double(k) / double(count - 1) : length_m_);
+}
+
+Eigen::Vector3d BeamChain::RodTipTangent(const std::array<RodSegment, kMaxLoads>& segments,
+                                         int segment_count) const {
+  if (segment_count == 0) return Eigen::Vector3d::UnitZ();
+  const RodSegment& seg = segments[std::size_t(segment_count - 1)];
+  return (seg.R_HS * seg.solution.end_R).col(2);
 }
 
 }  // namespace tubeplan::core

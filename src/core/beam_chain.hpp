@@ -36,6 +36,7 @@
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/model/elastica.hpp>
+#include <tubeplan/model/rod.hpp>
 
 namespace tubeplan::core {
 
@@ -62,6 +63,19 @@ struct ElasticaSegment {
   Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();   ///< clamp frame S (z along the tangent)
   Eigen::Vector3d bend_x_S = Eigen::Vector3d::UnitX();  ///< bending direction in S
   double clamp_m = 0.0, length_m = 0.0;
+};
+
+/// One segment of the rod chain (the large-deflection model where the elastica does not cover the
+/// loading): a discrete rod (model/rod.hpp) clamped at the cross-section where the previous one
+/// ended, carrying its loads at their own arc positions with their offset moments.
+struct RodSegment {
+  model::RodSolution solution;  ///< its root moment is the next solve's starting guess
+  std::array<model::RodLoad, kMaxLoads> loads_S{};  ///< in the clamp frame S, s from the clamp
+  std::array<int, kMaxLoads> index{};               ///< the BeamLoad each came from
+  int load_count = 0;
+  Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();  ///< clamp cross-section centre
+  Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();  ///< clamp frame S (z along the tangent)
+  double clamp_m = 0.0, end_m = 0.0;                   ///< arc positions of its clamp and end
 };
 
 class BeamChain {
@@ -121,6 +135,25 @@ class BeamChain {
   Eigen::Matrix3d ElasticaCompliance(const ElasticaSegment& segment,
                                      const Eigen::Vector3d& f_H_N) const;
 
+  /// Solves the rod chain for the Assigned loads: the paper's segmented rule cuts it at each
+  /// group (a segment per group, clamped where the previous ended); the coupled rule is one rod
+  /// from the held end carrying every load. Each segment starts from the root moment its slot in
+  /// `segments` holds (last tick's). Returns the number of segments, or 0 if one did not
+  /// converge (the caller falls back to the linear model).
+  int SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
+                    const std::array<int, kMaxLoads>& order,
+                    std::array<RodSegment, kMaxLoads>& segments) const;
+  /// Tangent compliance of a solved segment's loads to each other, frame H, written to
+  /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular.
+  bool RodCompliance(const RodSegment& segment,
+                     std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const;
+  /// The centreline of a solved rod chain at s = k l / (nodes.size() - 1), frame H (straight
+  /// beyond the last segment), and its tangent at the free end.
+  void RodNodes(const std::array<RodSegment, kMaxLoads>& segments, int segment_count,
+                std::span<Eigen::Vector3d> nodes) const;
+  Eigen::Vector3d RodTipTangent(const std::array<RodSegment, kMaxLoads>& segments,
+                                int segment_count) const;
+
   double bending_stiffness_Nm2() const { return EI_; }
   double length_m() const { return length_m_; }
   double outer_radius_m() const { return r1_; }
@@ -131,6 +164,7 @@ class BeamChain {
   double length_m_ = 0.0;
   double r1_ = 0.0;
   double group_tolerance_m_ = 0.0;
+  model::Rod rod_;
   scene::MultiContactRule rule_ = scene::MultiContactRule::kSegmented;
 };
 

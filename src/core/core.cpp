@@ -113,6 +113,18 @@ struct Core::Impl {
   // the contacts hold). The linear model carries the tube until the loads fall below half of
   // those it failed at, or leave.
   bool elastica_held_off = false;
+  // The rod chain where the elastica does not cover the loading (or is held off): its segments
+  // (each root moment is the next solve's starting point) and whether it shaped the last tick.
+  std::array<RodSegment, kMaxLoads> rod_segments{};
+  int rod_segment_count = 0;
+  bool rod_shape = false;
+  // The rod's tangent compliance between the members (by their place in arc order), the loads
+  // and segments it was computed for, and its age in ticks: reused as the elastica's is.
+  std::array<Eigen::Matrix3d, kMaxLoads * kMaxLoads> rod_tangent{};
+  std::array<Eigen::Vector3d, kMaxLoads> rod_tangent_force{};
+  std::array<double, kMaxLoads> rod_tangent_s{};
+  std::array<int, kMaxLoads> rod_tangent_segment{};
+  int rod_tangent_members = 0, rod_tangent_age = 0;
   double held_off_load_N = 0.0;
   std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
   // The elastica's tangent compliance per segment and the loads it was computed for.
@@ -193,6 +205,11 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.elastica_shape = false;
   m.elastica_held_off = false;
   m.held_off_load_N = 0.0;
+  // The rod's starting guesses go too: a replay from here must not depend on what came before.
+  m.rod_segments = {};
+  m.rod_segment_count = 0;
+  m.rod_shape = false;
+  m.rod_tangent_members = 0;
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
   out_.X_WH = X_WH;
@@ -457,12 +474,69 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
     use_elastica = want_elastica && !m.elastica_held_off && members > 0 &&
                    m.beam.ElasticaCovers(m.beam_loads, m.order, members, groups);
-    for (int i = 0; i < load_count; ++i)
-      for (int j = 0; j < load_count; ++j)
-        m.W[std::size_t(i)][std::size_t(j)] =
-            member[std::size_t(j)] ? m.beam.Compliance(m.beam_loads[std::size_t(i)],
-                                                       m.beam_loads[std::size_t(j)], !use_elastica)
-                                   : Eigen::Matrix3d::Zero();
+    const auto linear_compliance = [&] {
+      for (int i = 0; i < load_count; ++i)
+        for (int j = 0; j < load_count; ++j)
+          m.W[std::size_t(i)][std::size_t(j)] =
+              member[std::size_t(j)]
+                  ? m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
+                                      !use_elastica)
+                  : Eigen::Matrix3d::Zero();
+    };
+    linear_compliance();
+    if (want_elastica && !use_elastica && members > 0) {
+      // The elastica does not cover these loads: the rod's tangent, at last tick's forces,
+      // replaces the linear compliance between the loads of each of its segments (a load moves
+      // a later segment's points rigidly with its clamp: linear, as for the elastica). If the rod
+      // does not converge, the linear model stands (flagged at the shape). The tangent only
+      // steers the tick's Newton step, like the elastica's: one computed for loads within 10 %
+      // and arc positions within 1 % of l of these, on the same segments, in the last 50 ticks,
+      // is used again (it costs 4 + 3 n integrations of the rod).
+      const bool coupled = scene_.model.multi_contact == scene::MultiContactRule::kCoupled;
+      const auto segment_of = [&](int k) {
+        return coupled ? 0 : m.beam_loads[std::size_t(m.order[std::size_t(k)])].group;
+      };
+      const double scale_N = m.beam.bending_stiffness_Nm2() / (l * l);
+      bool reuse = m.rod_tangent_members == members && m.rod_tangent_age < 50;
+      for (int k = 0; k < members && reuse; ++k) {
+        const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
+        const std::size_t kk = std::size_t(k);
+        reuse = segment_of(k) == m.rod_tangent_segment[kk] &&
+                std::abs(b.s_m - m.rod_tangent_s[kk]) <= 0.01 * l &&
+                (b.f_H_N - m.rod_tangent_force[kk]).norm() <=
+                    0.1 * m.rod_tangent_force[kk].norm() + 1e-3 * scale_N;
+      }
+      bool ok = true;
+      if (!reuse) {
+        const int segments = m.beam.SolveRodChain(m.beam_loads, members, m.order, m.rod_segments);
+        ok = segments > 0;
+        for (int g = 0; g < segments && ok; ++g)
+          ok = m.beam.RodCompliance(m.rod_segments[std::size_t(g)], m.W);
+        m.rod_tangent_members = 0;
+        if (ok) {
+          m.rod_tangent_members = members;
+          m.rod_tangent_age = 0;
+          for (int a = 0; a < members; ++a) {
+            const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(a)])];
+            m.rod_tangent_force[std::size_t(a)] = b.f_H_N;
+            m.rod_tangent_s[std::size_t(a)] = b.s_m;
+            m.rod_tangent_segment[std::size_t(a)] = segment_of(a);
+            for (int c = 0; c < members; ++c)
+              m.rod_tangent[std::size_t(a * kMaxLoads + c)] =
+                  m.W[std::size_t(m.order[std::size_t(a)])][std::size_t(m.order[std::size_t(c)])];
+          }
+        }
+      }
+      if (ok) {
+        for (int a = 0; a < members; ++a)
+          for (int c = 0; c < members; ++c)
+            if (segment_of(a) == segment_of(c))
+              m.W[std::size_t(m.order[std::size_t(a)])][std::size_t(m.order[std::size_t(c)])] =
+                  m.rod_tangent[std::size_t(a * kMaxLoads + c)];
+      } else {
+        linear_compliance();
+      }
+    }
     if (use_elastica) {
       // Within a segment the elastica's own tangent replaces the linear force compliance; the
       // rotation terms and the loads of earlier segments keep their linear values.
@@ -843,6 +917,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   out.contact_count = kept;
 
   ++m.tangent_age;
+  ++m.rod_tangent_age;
 
   // 8. The shape under the solved loads: the next tick's capsules, energy, strain, markers.
   m.beam_count = beam_count;
@@ -875,6 +950,16 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
     }
   }
+  // Where the elastica does not cover the loading, or is held off, the rod shapes the tube.
+  m.rod_shape = false;
+  if (want_elastica && beam_count > 0 && !m.elastica_shape) {
+    m.rod_segment_count = m.beam.SolveRodChain(m.beam_loads, beam_count, m.order, m.rod_segments);
+    if (m.rod_segment_count > 0) {
+      m.rod_shape = true;
+      m.beam.RodNodes(m.rod_segments, m.rod_segment_count,
+                      std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
+    }
+  }
   const double EI = m.beam.bending_stiffness_Nm2();
   const double r1 = scene_.tube.outer_radius_m;
   double energy_J = 0.0, strain = 0.0;
@@ -897,6 +982,14 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       if (!(seg.length_m > 0.0)) continue;
       energy_J += EI / seg.length_m * seg.solution.tip.energy;
       strain = std::max(strain, r1 * std::abs(seg.solution.tip.root_curvature) / seg.length_m);
+    }
+  } else if (m.rod_shape) {
+    m.segment_count = 0;
+    m.tip_tangent_H = m.beam.RodTipTangent(m.rod_segments, m.rod_segment_count);
+    for (int g = 0; g < m.rod_segment_count; ++g) {
+      const model::RodSolution& solution = m.rod_segments[std::size_t(g)].solution;
+      energy_J += solution.energy_J;
+      strain = std::max(strain, r1 * solution.max_moment_Nm / EI);
     }
   } else {
     m.segment_count = 0;
@@ -931,7 +1024,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
     }
   }
-  if (want_elastica && beam_count > 0 && !m.elastica_shape) out.flags |= kLinearFallback;
+  if (m.rod_shape) out.flags |= kRodShape;
+  if (want_elastica && beam_count > 0 && !m.elastica_shape && !m.rod_shape)
+    out.flags |= kLinearFallback;
   if (beam_count == 0) m.elastica_held_off = false;
   out.energy_J = energy_J;
   out.max_strain = strain;
@@ -940,7 +1035,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // alpha = F l^2 / (E I) = 1) it is 10 % off the exact elastica, and beyond it the deflection
   // grows without bound, the tube drawn longer than it is (docs/core.md). Flagged, so that a
   // replay that went there is not taken for the tube's motion.
-  if (!m.elastica_shape && out.tip_deflection_m > l / 3.0) out.flags |= kBeyondLinearRange;
+  if (!m.elastica_shape && !m.rod_shape && out.tip_deflection_m > l / 3.0)
+    out.flags |= kBeyondLinearRange;
 
   // Markers (contact-states.md): no bending below the threshold; the end face and rim never
   // deform; a side contact is concave or convex by the side of the bend it touches, judged by
@@ -1007,6 +1103,13 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
     Eigen::Vector3d x_H(0.0, 0.0, s);
     if (m.elastica_shape) {
       x_H = m.beam.ElasticaPoint(m.segments, m.segment_count, s);
+    } else if (m.rod_shape) {
+      // The rod's nodes, joined by chords: the capsule count keeps a chord within epsilon / 10
+      // of the arc (ChainCapsuleCount), the accuracy the contacts already work to.
+      const double u = std::clamp(s / l * capsule_count_, 0.0, double(capsule_count_));
+      const int node = std::min(static_cast<int>(u), capsule_count_ - 1);
+      x_H = (1.0 - (u - node)) * m.nodes_H[std::size_t(node)] +
+            (u - node) * m.nodes_H[std::size_t(node) + 1];
     } else {
       for (int j = 0; j < m.beam_count; ++j)
         x_H += m.beam.CentreDisplacement(s, m.beam_loads[std::size_t(j)]);

@@ -58,15 +58,21 @@ enum StepFlag : std::uint32_t {
   kPenetration = 1u << 1,        ///< a tube and a part overlap (d <= 0)
   kProxySeparated = 1u << 2,     ///< the held end is more than epsilon from the hand
   kContactsTruncated = 1u << 3,  ///< more than kMaxContacts PCs; the shallowest were dropped
-  kLinearFallback = 1u << 4,     ///< elastica asked for, but the loading is not one it covers
-  kSolverFault = 1u << 5,        ///< the tick's system was singular or not finite: held still
+  /// Elastica asked for, the loading is not one it covers, and the rod did not converge either:
+  /// the linear model shaped the tube.
+  kLinearFallback = 1u << 4,
+  kSolverFault = 1u << 5,  ///< the tick's system was singular or not finite: held still
   /// The linear model drew the tube (a linear scene, or the fallback) with a tip deflection
   /// beyond l/3, where it is ~10 % off the exact elastica and no longer keeps the tube's length.
   kBeyondLinearRange = 1u << 6,
+  /// Elastica asked for, but the loading is not one it covers (several loads on one cantilever,
+  /// a line contact, a push past buckling): the discrete rod (model/rod.hpp), which keeps the
+  /// tube's length under any load, shaped the tube and gave the tick's compliance.
+  kRodShape = 1u << 7,
 };
 /// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
-inline constexpr int kStepFlagCount = 7;
-static_assert(kBeyondLinearRange == 1u << (kStepFlagCount - 1),
+inline constexpr int kStepFlagCount = 8;
+static_assert(kRodShape == 1u << (kStepFlagCount - 1),
               "kStepFlagCount must follow the last StepFlag bit");
 
 /// One principal contact in a tick, in the core's compact form.
