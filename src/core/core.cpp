@@ -68,8 +68,12 @@ struct Core::Impl {
     double s_m = 0.0;
     double distance_m = 0.0;  // d where x0 is
     Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
-    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();      // surface point at the tick's start
-    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();    // x = base + p + R W R^T F
+    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();    // surface point at the tick's start
+    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();  // x = base + p + R W R^T F
+    // The centreline at s and its tangent at the tick's start (W): the material's motion is
+    // judged from them when the next tick continues this load.
+    Eigen::Vector3d centre0_W = Eigen::Vector3d::Zero();
+    Eigen::Vector3d tangent0_W = Eigen::Vector3d::UnitZ();
     Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  // stuck: held here tangentially
     Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();   // last tick's force (linearisation)
     // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
@@ -353,7 +357,58 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
   // Each load continues last tick's load of the same element pair and end; failing that, the
   // nearest one (within a tube radius) on the same part element, whatever the tube element:
-  // a rim contact that becomes a side contact as the tube lays down keeps its force and anchor.
+  // a rim contact that becomes a side contact as the tube lays down keeps its force and its
+  // stick.
+  //
+  // A stuck contact's state is its tangential stretch: the slip of the tube's material at the
+  // contact relative to the part, accumulated while stuck (the spring Kt carries Kt times it).
+  // Between ticks the load point is found again, the tube's point nearest the part, which need
+  // not be the same material point: a tube bending or rolling over an edge touches it with
+  // another point each tick, a tube drawn along its axis over an edge touches it at the same place
+  // in the world with new material. A world anchor compared with the point found again took that
+  // migration for slip: on the side pressed on an edge (`stability --only "roll over an edge
+  // base"`) 19 um a tick, 0.19 N of friction from no slip, energy the hand never put in. So the
+  // stretch is carried with the contact instead (the tangential spring of the discrete element
+  // method, Cundall and Strack 1979): last tick's final stretch, turned with the contact's normal
+  // into the new tangent plane, plus what the material under last tick's point moved that the
+  // tick's system did not see (its motion in the shape drawn from the solved loads, less the
+  // motion the system predicted and the spring already counted; e.g. the bending by an end
+  // face's moment as its centre of pressure moves). Within the tick the point moves with the
+  // material (x = x0 + the tick's motion), so the stretch grows by the material's tangential
+  // motion there and by nothing else.
+  const auto tangent_at = [&](double s_m) {
+    if (s_m >= l) return Eigen::Vector3d(R_WH * m.tip_tangent_H);
+    const double u = std::clamp(s_m / l * N, 0.0, static_cast<double>(N));
+    const std::size_t k = std::size_t(std::min(static_cast<int>(u), N - 1));
+    return Eigen::Vector3d(R_WH * (m.nodes_H[k + 1] - m.nodes_H[k]).normalized());
+  };
+  // The rotation taking unit a to unit b about a x b, applied to v.
+  const auto rotate_onto = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& v) {
+    const double c = a.dot(b);
+    if (!(c > -0.5)) return v;  // turned over: not a tick's motion (nothing carried)
+    const Eigen::Vector3d k = a.cross(b);
+    return Eigen::Vector3d(v + k.cross(v) + k.cross(k.cross(v)) / (1.0 + c));
+  };
+  const auto carried_stretch = [&](const Load& before, const Load& now) {
+    const Eigen::Vector3d& n0 = before.normal_W;
+    const Eigen::Vector3d& n1 = now.normal_W;
+    const Eigen::Vector3d offset = before.anchor_W - before.x_W;
+    // Turning keeps the stretch's length, the spring's energy.
+    const Eigen::Vector3d stretch = rotate_onto(n0, n1, offset - n0 * n0.dot(offset));
+    // Where the material of last tick's point went: its centre, and its offset turned with the
+    // section.
+    const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(before.s_m);
+    const Eigen::Vector3d r_W = before.x0_W - before.centre0_W;
+    const Eigen::Vector3d moved = centre_W - before.centre0_W +
+                                  rotate_onto(before.tangent0_W, tangent_at(before.s_m), r_W) - r_W;
+    const Eigen::Vector3d unseen = moved - (before.x_W - before.x0_W);
+    // A tick whose system put the point farther from the shape than the contact band (the
+    // elastica's hold-off tolerance, section 8; an undecided tick's last guards) predicted
+    // nothing to correct: the difference is slip, not stretch.
+    if (!(unseen.norm() <= std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m))) return stretch;
+    return Eigen::Vector3d(stretch - (unseen - n1 * n1.dot(unseen)));
+  };
   std::array<bool, kMaxLoads> taken{};
   for (int pass = 0; pass < 2; ++pass) {
     for (int i = 0; i < load_count; ++i) {
@@ -373,7 +428,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Load& before = m.prev[std::size_t(best)];
       taken[std::size_t(best)] = true;
       ld.matched = true;
-      if (before.active && ld.friction) ld.anchor_W = before.anchor_W;
+      if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.force_W;
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
@@ -400,14 +455,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Eigen::Vector3d x0_W = tip_W + R_WH * ld.cop_H_m;
       // The end face is planar: the distance at the new point differs along the normal.
       ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W);
-      if (ld.anchor_W == ld.x0_W) {
-        ld.anchor_W = x0_W;  // a new anchor, not last tick's
-      } else {
-        // The pressure moves over the face, the material does not: a stuck anchor moves with
-        // it, or the tangential spring would carry the shift as a force.
-        const Eigen::Vector3d shift_W = R_WH * step_H;
-        ld.anchor_W += shift_W - ld.normal_W * ld.normal_W.dot(shift_W);
-      }
+      // The pressure moves over the face, the material does not slip: the stretch stays.
+      ld.anchor_W += x0_W - ld.x0_W;
       ld.x0_W = x0_W;
     }
   }
@@ -437,6 +486,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (!ld.ghost) {
       const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(ld.s_m);
       ld.r_H_m = R_WH.transpose() * (ld.x0_W - centre_W);
+      ld.centre0_W = centre_W;
+      ld.tangent0_W = tangent_at(ld.s_m);
     }
     m.beam_loads[std::size_t(i)] =
         BeamLoad{ld.s_m, R_WH.transpose() * ld.f_lin_W, ld.r_H_m, 0.0, 0, ld.pc};
