@@ -45,8 +45,10 @@ TEST_CASE("Stability: push into a wall past the buckling load, the shipped rubbe
 
 TEST_CASE("Stability: strain beyond the linear-elastic range is reported, not accepted",
           "[stability]") {
-  // A tube of 0.1 MPa rolled over an edge bends far beyond 50 % strain.
-  const study::StabilityResult r = RunNamed("roll over an edge E=100000Pa");
+  // A tube of 0.1 MPa squeezed between the walls bends far beyond 50 % strain. (Rolled over the
+  // edge it reached 5.5 only after its stuck contact had made energy, once the linear fallback ran
+  // away as the tip left the edge; with the stick carried with the contact it stays below 0.12.)
+  const study::StabilityResult r = RunNamed("squeeze between walls E=100000Pa");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.warning.find("beyond the linear-elastic") != std::string::npos);
 }
@@ -101,8 +103,12 @@ TEST_CASE(
   CHECK(r.pass);
 }
 
-TEST_CASE("Stability: roll over an edge (core defect: energy created as the side meets the edge)",
-          "[stability][!mayfail]") {
+TEST_CASE("Stability: roll over an edge, the side pressed on it with stuck friction, then drawn",
+          "[stability]") {
+  // The stuck contact's stretch is carried with the contact, not held in the world against a
+  // point found again each tick, and under the elastica it does not see the one-way turn of the
+  // surface point's offset (docs/core.md, "Stuck contacts"). Before, the energy held exceeded the
+  // hand's work by 7 % at tick 63.
   const study::StabilityResult r = RunNamed("roll over an edge base");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
