@@ -68,8 +68,16 @@ struct Core::Impl {
     double s_m = 0.0;
     double distance_m = 0.0;  // d where x0 is
     Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
-    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();      // surface point at the tick's start
-    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();    // x = base + p + R W R^T F
+    Eigen::Vector3d x0_W = Eigen::Vector3d::Zero();          // surface point at the tick's start
+    Eigen::Vector3d base_W = Eigen::Vector3d::Zero();        // x = base + p + R W R^T F
+    Eigen::Vector3d stick_base_W = Eigen::Vector3d::Zero();  // the same for the stuck spring
+    Eigen::Vector3d stick_x_W = Eigen::Vector3d::Zero();     // result: where the spring saw x
+    // The centreline at s and its tangent at the tick's start (W), and whether the stuck spring
+    // saw the turn of the point's offset this tick (section 5): the material's motion is judged
+    // from them when the next tick continues this load.
+    Eigen::Vector3d centre0_W = Eigen::Vector3d::Zero();
+    Eigen::Vector3d tangent0_W = Eigen::Vector3d::UnitZ();
+    bool turn_seen = true;
     Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  // stuck: held here tangentially
     Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();   // last tick's force (linearisation)
     // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
@@ -138,6 +146,10 @@ struct Core::Impl {
   std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_W{};
   std::array<Load, kMaxLoads> loads{};
   std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W{};  // world frame
+  // The part of W_ij that is the turn of load i's section moving its offset surface point,
+  // where the beam does not carry the offsets' moments (the elastica), for loads with friction:
+  // the stuck spring does not see it (section 5).
+  std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W_turn{};  // world frame
   SystemMatrix M;
   SystemVector rhs, z;
   Eigen::PartialPivLU<SystemMatrix> lu;
@@ -370,7 +382,60 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
   // Each load continues last tick's load of the same element pair and end; failing that, the
   // nearest one (within a tube radius) on the same part element, whatever the tube element:
-  // a rim contact that becomes a side contact as the tube lays down keeps its force and anchor.
+  // a rim contact that becomes a side contact as the tube lays down keeps its force and its
+  // stick.
+  //
+  // A stuck contact's state is its tangential stretch: the slip of the tube's material at the
+  // contact relative to the part, accumulated while stuck (the spring Kt carries Kt times it).
+  // Between ticks the load point is found again, the tube's point nearest the part, which need
+  // not be the same material point: a tube bending or rolling over an edge touches it with
+  // another point each tick, a tube drawn along its axis over an edge touches it at the same place
+  // in the world with new material. A world anchor compared with the point found again took that
+  // migration for slip: on the side pressed on an edge (`stability --only "roll over an edge
+  // base"`) 19 um a tick, 0.19 N of friction from no slip, energy the hand never put in. So the
+  // stretch is carried with the contact instead (the tangential spring of the discrete element
+  // method, Cundall and Strack 1979): last tick's final stretch, turned with the contact's normal
+  // into the new tangent plane, plus what the material under last tick's point moved that the
+  // tick's system did not see (its motion in the shape drawn from the solved loads, less the
+  // motion the system predicted and the spring already counted; e.g. the bending by an end
+  // face's moment as its centre of pressure moves). Within the tick the point moves with the
+  // material (x = x0 + the tick's motion), so the stretch grows by the material's tangential
+  // motion there and by nothing else.
+  const auto tangent_at = [&](double s_m) {
+    if (s_m >= l) return Eigen::Vector3d(R_WH * m.tip_tangent_H);
+    const double u = std::clamp(s_m / l * N, 0.0, static_cast<double>(N));
+    const std::size_t k = std::size_t(std::min(static_cast<int>(u), N - 1));
+    return Eigen::Vector3d(R_WH * (m.nodes_H[k + 1] - m.nodes_H[k]).normalized());
+  };
+  // The rotation taking unit a to unit b about a x b, applied to v.
+  const auto rotate_onto = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                              const Eigen::Vector3d& v) {
+    const double c = a.dot(b);
+    if (!(c > -0.5)) return v;  // turned over: not a tick's motion (nothing carried)
+    const Eigen::Vector3d k = a.cross(b);
+    return Eigen::Vector3d(v + k.cross(v) + k.cross(k.cross(v)) / (1.0 + c));
+  };
+  const auto carried_stretch = [&](const Load& before, const Load& now) {
+    const Eigen::Vector3d& n0 = before.normal_W;
+    const Eigen::Vector3d& n1 = now.normal_W;
+    const Eigen::Vector3d offset = before.anchor_W - before.stick_x_W;
+    // Turning keeps the stretch's length, the spring's energy.
+    const Eigen::Vector3d stretch = rotate_onto(n0, n1, offset - n0 * n0.dot(offset));
+    // Where the material of last tick's point went: its centre, and its offset turned with the
+    // section where the spring saw that turn.
+    const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(before.s_m);
+    Eigen::Vector3d moved = centre_W - before.centre0_W;
+    if (before.turn_seen) {
+      const Eigen::Vector3d r_W = before.x0_W - before.centre0_W;
+      moved += rotate_onto(before.tangent0_W, tangent_at(before.s_m), r_W) - r_W;
+    }
+    const Eigen::Vector3d unseen = moved - (before.stick_x_W - before.x0_W);
+    // A tick whose system put the point farther from the shape than the contact band (the
+    // elastica's hold-off tolerance, section 8; an undecided tick's last guards) predicted
+    // nothing to correct: the difference is slip, not stretch.
+    if (!(unseen.norm() <= std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m))) return stretch;
+    return Eigen::Vector3d(stretch - (unseen - n1 * n1.dot(unseen)));
+  };
   std::array<bool, kMaxLoads> taken{};
   for (int pass = 0; pass < 2; ++pass) {
     for (int i = 0; i < load_count; ++i) {
@@ -390,7 +455,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Load& before = m.prev[std::size_t(best)];
       taken[std::size_t(best)] = true;
       ld.matched = true;
-      if (before.active && ld.friction) ld.anchor_W = before.anchor_W;
+      if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.force_W;
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
@@ -417,14 +482,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Eigen::Vector3d x0_W = tip_W + R_WH * ld.cop_H_m;
       // The end face is planar: the distance at the new point differs along the normal.
       ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W);
-      if (ld.anchor_W == ld.x0_W) {
-        ld.anchor_W = x0_W;  // a new anchor, not last tick's
-      } else {
-        // The pressure moves over the face, the material does not: a stuck anchor moves with
-        // it, or the tangential spring would carry the shift as a force.
-        const Eigen::Vector3d shift_W = R_WH * step_H;
-        ld.anchor_W += shift_W - ld.normal_W * ld.normal_W.dot(shift_W);
-      }
+      // The pressure moves over the face, the material does not slip: the stretch stays.
+      ld.anchor_W += x0_W - ld.x0_W;
       ld.x0_W = x0_W;
     }
   }
@@ -454,6 +513,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     if (!ld.ghost) {
       const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(ld.s_m);
       ld.r_H_m = R_WH.transpose() * (ld.x0_W - centre_W);
+      ld.centre0_W = centre_W;
+      ld.tangent0_W = tangent_at(ld.s_m);
     }
     m.beam_loads[std::size_t(i)] =
         BeamLoad{ld.s_m, R_WH.transpose() * ld.f_lin_W, ld.r_H_m, 0.0, 0, ld.pc};
@@ -597,7 +658,44 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       }
     }
   };
+  // What a stuck contact's tangential spring sees of the compliance.
+  //
+  // A force at load j turns load i's section, which moves i's surface point, offset from the
+  // centreline by r_i, by -r_i x (turn): along the axis for a side contact. Where the beam
+  // carries the offsets' moments (the linear model) the converse holds too, a tangential force
+  // at an offset bends the tube (W_ij = W_ji^T, Maxwell-Betti), and a stuck spring on that
+  // compliance is conservative. The elastica carries tip forces only: an axial friction at the
+  // surface bends nothing, yet the surface point still slides along the axis by r1 times the
+  // turn the normal force makes. A stuck spring on such a one-way compliance is a pump: on the
+  // side pressed on an edge the turn stretches it, its force drags the tube along its axis
+  // against the coupling, and the energy the coupling then holds was never paid for by the hand
+  // (the moment that would have made the tube stiffer is not there). So where the moments are
+  // left out the stuck spring sees the point move with the centreline and the held end only,
+  // not with its section's own turn: the one-way term is taken out, the spring stays
+  // conservative. (The normal rows keep it: for a side contact it has no normal part, and an
+  // end face's tilt is the penalty's, not the spring's.)
+  const auto build_stick_compliance = [&] {
+    const Eigen::Matrix3d turn_z = Skew(Eigen::Vector3d::UnitZ());
+    for (int i = 0; i < load_count; ++i) {
+      Load& ld = m.loads[std::size_t(i)];
+      ld.stick_base_W = ld.base_W;
+      ld.turn_seen = !use_elastica;
+      if (!ld.friction) continue;
+      const BeamLoad& bi = m.beam_loads[std::size_t(i)];
+      for (int j = 0; j < load_count; ++j) {
+        Eigen::Matrix3d& Dij = m.W_turn[std::size_t(i)][std::size_t(j)];
+        if (!use_elastica || !member[std::size_t(j)]) {
+          Dij.setZero();
+          continue;
+        }
+        const double slope = m.beam.InfluenceSlope(bi.s_m, m.beam_loads[std::size_t(j)]);
+        Dij = R_WH * (-Skew(bi.r_H_m) * (slope * turn_z)) * R_WH.transpose();
+        ld.stick_base_W += Dij * m.loads[std::size_t(j)].f_lin_W;
+      }
+    }
+  };
   build_compliance();
+  build_stick_compliance();
 
   // 6. Solve contacts, coupling and beam together. Unknowns: the load forces F_i (W) and the
   // held-end position p. Load i: F_i = K n (eps - d_i - n.(x_i - x0_i)) + Kt T (a_i - x_i) when
@@ -643,7 +741,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
       const Eigen::Vector3d n_eff =
           ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
-      const Eigen::Matrix3d G = K * n_eff * nrm.transpose() + (stuck ? Kt : 0.0) * Tp;
+      // The normal part and the stuck spring (which sees the point without the one-way turn of
+      // its offset, section 5).
+      const Eigen::Matrix3d Gn = K * n_eff * nrm.transpose();
+      const Eigen::Matrix3d Gt = (stuck ? Kt : 0.0) * Tp;
+      const Eigen::Matrix3d G = Gn + Gt;
       Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
       if (stuck) b += Kt * (Tp * ld.anchor_W);
       if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
@@ -651,13 +753,16 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       m.M.block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
       for (int j = 0; j < load_count; ++j) {
         const int sj = slot[std::size_t(j)];
-        if (sj >= 0) m.M.block<3, 3>(r, 3 * sj) += G * m.W[std::size_t(i)][std::size_t(j)];
+        if (sj < 0) continue;
+        const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+        m.M.block<3, 3>(r, 3 * sj) += G * Wij;
+        if (stuck) m.M.block<3, 3>(r, 3 * sj) -= Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
       }
       // The held end's turn omega moves the point by omega x r, r from the held end.
       const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
       m.M.block<3, 3>(r, ip) = G;
       m.M.block<3, 3>(r, iw) = -G * Rx;
-      m.rhs.segment<3>(r) = b - G * ld.base_W;
+      m.rhs.segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
       m.M.block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
       if (torque_saturated) m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
     }
@@ -703,7 +808,10 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         if (ld.distance_m + ld.normal_W.dot(x - ld.x0_W) < eps) {
           ld.active = true;
           changed = true;
-          if (!member[std::size_t(i)]) build_compliance();  // it cuts the tube now
+          if (!member[std::size_t(i)]) {
+            build_compliance();  // it cuts the tube now
+            build_stick_compliance();
+          }
         }
         continue;
       }
@@ -852,13 +960,20 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const int sj = slot[std::size_t(j)];
       if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
     }
+    // Where the stuck spring saw the point (section 5): without the one-way turn of its offset.
+    ld.stick_x_W = ld.x_W + (ld.stick_base_W - ld.base_W);
+    for (int j = 0; j < load_count && ld.friction; ++j) {
+      const int sj = slot[std::size_t(j)];
+      if (sj >= 0)
+        ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+    }
     ld.force_W = f_load_W[std::size_t(i)];
     ld.distance_m += ld.normal_W.dot(ld.x_W - ld.x0_W);
     if (!ld.active || !ld.friction) {
-      ld.anchor_W = ld.x_W;
+      ld.anchor_W = ld.stick_x_W;
     } else if (ld.sliding) {
       const Eigen::Vector3d Ft = ld.force_W - ld.normal_W.dot(ld.force_W) * ld.normal_W;
-      ld.anchor_W = ld.x_W + Ft / Kt;
+      ld.anchor_W = ld.stick_x_W + Ft / Kt;
     }
     if (!ld.active) continue;
     force_W += ld.force_W;
