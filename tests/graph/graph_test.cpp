@@ -1,6 +1,7 @@
 // The contact-state graph: pruning against a hand-made graph with known dominance, DOT that
 // Graphviz renders and Boost reads back, and exploration of the shipped groove scene checked by
 // replaying every witness, by --jobs independence and by independent random motions.
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -271,6 +272,38 @@ const ContactGraph& SmallGraph(int jobs) {
     graphs[jobs] = graph::Explore(Groove(), o);
   }
   return graphs[jobs];
+}
+
+TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit", "[graph]") {
+  const scene::Scene s = Groove();
+  const graph::ExploreOptions o;
+  core::Core core(s), again(s);
+  for (const graph::Motion& m : graph::RandomMotions(s, 99, 0, 3, o)) {
+    core.Reset(s.X_WH_start);
+    graph::MotionRunner runner(m, s.X_WH_start, s.model.time_step_s);
+    for (int k = 1; !runner.Done(); ++k) {
+      core.Step(k * s.model.time_step_s, runner.Next(core.last()));
+      if (k % 397 != 0) continue;
+      // The prefix with a move appended: identical up to tick k, then the new move.
+      graph::Motion cut;
+      cut.moves = graph::Prefix(m, runner.move(), runner.move_tick());
+      graph::Move away;
+      away.p_W_m = core.last().X_W_hand.translation() + Eigen::Vector3d(0.0, 0.0, 0.02);
+      cut.moves.push_back(away);
+      INFO("tick " << k);
+      graph::ReplayTo(again, cut, graph::TickRef{0, k, 0, 0});
+      CHECK(again.last().X_W_hand.translation() == core.last().X_W_hand.translation());
+      CHECK(again.last().X_WH.translation() == core.last().X_WH.translation());
+      CHECK(again.last().energy_J == core.last().energy_J);
+      CHECK(again.FormationText() == core.FormationText());
+      // The tick after: the appended move starts from where the hand was.
+      const Eigen::Vector3d p = again.last().X_W_hand.translation();
+      graph::ReplayTo(again, cut, graph::TickRef{0, k + 1, 0, 0});
+      const Eigen::Vector3d step = again.last().X_W_hand.translation() - p;
+      CHECK(step.z() > 0.0);
+      CHECK(step.head<2>().norm() < 1e-12);
+    }
+  }
 }
 
 TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph]") {
