@@ -345,7 +345,7 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
 TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph]") {
   const ContactGraph& one = DefaultGraph(1);
   const ContactGraph& two = DefaultGraph(2);
-  // Saturated within the default budget: every node probed, then `effort` quiet random motions.
+  // Saturated within the default budget: every node probed, the last round found no new one.
   CHECK(one.saturated);
   CHECK(one.probed == static_cast<int>(one.nodes.size()));
   CHECK(one.motions.size() < std::size_t(graph::ExploreOptions{}.max_motions));
@@ -374,7 +374,7 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
 
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph]") {
   // Motions from another seed, run through the core and debounced here on their own (a CF
-  // counts after the same 20 ms dwell), against the graph explored with the default budget.
+  // counts after the same 20 ms dwell), against the graph explored with the default options.
   const scene::Scene s = Groove();
   const graph::ExploreOptions o;
   const ContactGraph& g = DefaultGraph(2);
