@@ -1,4 +1,4 @@
-// `tubeplan graph SCENE [--dot FILE] [--json FILE] [--unpruned] [--seed N] [--effort N]
+// `tubeplan graph SCENE [--dot FILE] [--json FILE] [--unpruned] [--seed N] [--random N]
 // [--jobs N] [--weights friction=1,energy=1,distance=1] [--tolerance T]`: explores the scene with
 // the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
 // JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <thread>
@@ -39,8 +40,8 @@ struct GraphOptions {
   std::string json_path;
   bool unpruned = false;
   std::uint64_t seed = 1;
-  int effort = 40;
-  int budget = 300;
+  int random = 120;
+  int budget = 3000;
   int jobs = 0;  // 0: the machine's cores
   std::string weights;
   std::optional<double> tolerance;
@@ -148,7 +149,7 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
   }
   graph::ExploreOptions explore;
   explore.seed = o.seed;
-  explore.effort = o.effort;
+  explore.random_motions = o.random;
   explore.max_motions = o.budget;
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
   std::optional<std::vector<graph::ReplayedPlan>> verdicts;
@@ -164,10 +165,10 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
 
 void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
   sub->add_option("--seed", o.seed, "seed of the random motions")->capture_default_str();
-  sub->add_option("--effort", o.effort,
-                  "stop after this many random motions in a row found no new state or "
-                  "transition")
-      ->check(CLI::Range(1, 10000))
+  sub->add_option("--random", o.random,
+                  "random motions after the sweeps and aims, before every state found is "
+                  "probed with small motions until no new one appears (saturation)")
+      ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,
                   "stop after this many motions in all, saturated or not (said in the output)")
@@ -251,22 +252,16 @@ int RunGraph(const GraphOptions& o, Streams io) {
     const graph::SaturationPoint& p = g.saturation[i];
     t << " " << p.motions << ": " << p.nodes << "/" << p.arcs;
   }
-  int quiet = 0;  // motions at the end that found nothing new
-  for (std::size_t i = g.saturation.size(); i-- > 1;) {
-    if (g.saturation[i].nodes != g.saturation[i - 1].nodes ||
-        g.saturation[i].arcs != g.saturation[i - 1].arcs)
-      break;
-    ++quiet;
-  }
-  if (quiet >= explore.effort) {
-    t << "  (saturated: " << quiet << " motions in a row found nothing new)\n";
+  if (g.saturated) {
+    constexpr int kProbes =
+        2 * 3 + 2 * 2;  // graph::Explore's probe set: 3 steps, 2 turns, each way
+    t << "  (saturated: every one of the " << g.probed << " states probed from a stay with "
+      << kProbes << " small motions (" << explore.probe_step_m * 1e3
+      << " mm along and against 3 directions, " << explore.probe_turn_rad * 180.0 / std::numbers::pi
+      << " deg about 2 axes), the last round found no new state)\n";
   } else {
-    const std::size_t back = std::min<std::size_t>(100, g.saturation.size() - 1);
-    const graph::SaturationPoint& then = g.saturation[g.saturation.size() - 1 - back];
-    const graph::SaturationPoint& now = g.saturation.back();
-    t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out; the last "
-      << back << " motions still found " << now.nodes - then.nodes << " nodes and "
-      << now.arcs - then.arcs << " arcs)\n";
+    t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out with "
+      << g.probed << " of " << g.nodes.size() << " states probed)\n";
   }
   t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";

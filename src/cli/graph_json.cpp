@@ -26,7 +26,10 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   j["tubeplan_graph"] = kGraphJsonVersion;
   j["scene"] = scene_path;
   j["parameters"] = {{"seed", explore.seed},
-                     {"effort", explore.effort},
+                     {"random_motions", explore.random_motions},
+                     {"budget", explore.max_motions},
+                     {"probe_step_m", explore.probe_step_m},
+                     {"probe_turn_rad", explore.probe_turn_rad},
                      {"push_N", explore.push_N},
                      {"speed_m_per_s", explore.speed_m_per_s},
                      {"substeps", explore.substeps},
@@ -86,14 +89,16 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                        {"turn_rad_per_s", mv.turn_rad_per_s},
                        {"guard_dir", {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()}},
                        {"guard_N", mv.guard_N}});
+      if (mv.min_ticks > 0) moves.back()["min_ticks"] = mv.min_ticks;
+      if (mv.max_ticks > 0) moves.back()["max_ticks"] = mv.max_ticks;
     }
     motions.push_back({{"kind", m.kind}, {"moves", moves}});
+    if (m.prefix_ticks > 0) motions.back()["prefix_ticks"] = m.prefix_ticks;
   }
   j["motions"] = motions;
-  j["stats"] = {{"motions", g.motions.size()},
-                {"ticks", g.ticks},
-                {"refinements", g.refinements},
-                {"seconds", g.seconds},
+  j["stats"] = {{"motions", g.motions.size()},  {"ticks", g.ticks},
+                {"refinements", g.refinements}, {"probed", g.probed},
+                {"saturated", g.saturated},     {"seconds", g.seconds},
                 {"jobs", explore.jobs}};
   return j;
 }

@@ -21,9 +21,10 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 // A motion that has not ended after this long is cut (a safety bound; motions last seconds).
 constexpr int kMaxTicksPerMotion = 30000;
-// Random motions run in batches of this many, whatever the number of threads, so that where
-// saturation stops does not depend on --jobs.
-constexpr int kBatch = 8;
+// Probe moves are short and quick, as the random motions' fastest (a flick of the hand): the
+// probes are most of the exploration's ticks.
+constexpr double kProbeSpeed_m_per_s = 0.15;
+constexpr double kProbeTurn_rad_per_s = 2.0;
 
 using core::KeyOf;
 using CfKey = core::FormationKey;
@@ -32,6 +33,9 @@ struct Sample {  // what a node keeps of its witness tick
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
   double energy_J = 0.0, friction_N = 0.0, friction_limit_N = 0.0, force_N = 0.0;
+  // Where the motion's hand was at that tick (MotionRunner::move, move_tick): a probe motion
+  // starts with the motion's Prefix up to there. Sub-tick witnesses keep the tick before's.
+  int move = 0, move_tick = 0;
 };
 
 Sample SampleOf(const core::StepOutput& out) {
@@ -110,10 +114,14 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   const Eigen::Isometry3d X_start = MotionStart(core.scene());
   core.Reset(X_start);
   MotionRunner runner(motion, X_start, step_s);
+  // Ticks up to here replay another motion to a witness: nothing new there, nothing recorded.
+  const int prefix = motion.prefix_ticks;
   std::vector<Sample> samples(1);  // per tick, [0] unused
   RawRun stable, raw;              // the counted state and the one the core is in
   std::vector<RawRun> brief;       // states since `stable` that did not last `dwell`
-  auto record_stay = [&](const RawRun& run) {
+  auto record_stay = [&](RawRun run) {
+    if (run.end <= prefix) return;
+    run.start = std::max(run.start, prefix + 1);
     const int mid = run.start + (run.end - run.start) / 2;
     result.stays.push_back({run.text, static_cast<int>(run.cf.contacts.size()),
                             TickRef{index, mid, 0, 0}, run.end - run.start + 1, false,
@@ -123,6 +131,7 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
     result.changes.push_back({from.text, to.text, simultaneous, at});
   };
   auto commit = [&](const RawRun& to) {
+    if (to.start <= prefix) return;
     if (PcChanges(stable.cf, to.cf) <= 1) {
       add_change(stable, to, false, {index, to.start});
       return;
@@ -148,9 +157,12 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
         for (std::size_t c = 1; c < chain.size(); ++c) {
           const TickRef at{index, to.start, options.substeps, chain[c].first.start};
           if (c + 1 < chain.size()) {
-            result.stays.push_back(
-                {chain[c].first.text, static_cast<int>(chain[c].first.cf.contacts.size()), at,
-                 chain[c + 1].first.start - chain[c].first.start, true, chain[c].second});
+            Sample sample = chain[c].second;
+            sample.move = samples[std::size_t(to.start - 1)].move;
+            sample.move_tick = samples[std::size_t(to.start - 1)].move_tick;
+            result.stays.push_back({chain[c].first.text,
+                                    static_cast<int>(chain[c].first.cf.contacts.size()), at,
+                                    chain[c + 1].first.start - chain[c].first.start, true, sample});
           }
           add_change(chain[c - 1].first, chain[c].first, false, at);
         }
@@ -165,6 +177,8 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
     samples.push_back(SampleOf(out));
+    samples.back().move = runner.move();
+    samples.back().move_tick = runner.move_tick();
     const CfKey now = KeyOf(out);
     if (k == 1 || now != key) {
       key = now;
@@ -430,6 +444,43 @@ std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Mo
   return results;
 }
 
+// The neighbour probes of a node (docs/contact-states.md: one small motion of the held end takes
+// a CF to its neighbour): from the hand pose of its witness, the hand moves by `step` along and
+// against each of the start frame's three directions, tips the tube down and up and turns it
+// left and right by `turn` about the hand; after each it holds still for longer than the dwell
+// (so the state there counts), goes back and holds again. Unguarded: the step bounds the force
+// (the coupling spring's stiffness times the step).
+std::vector<Move> Probes(const scene::Scene& scene, const Eigen::Isometry3d& X_W_hand,
+                         const ExploreOptions& o) {
+  const Frame f = StartFrame(scene);
+  const int hold = 5 + static_cast<int>(std::lround(o.dwell_s / scene.model.time_step_s));
+  const Eigen::Vector3d p = X_W_hand.translation();
+  const Eigen::Quaterniond q(X_W_hand.linear());
+  const Eigen::Vector3d tip_axis = f.axis.cross(-f.up).normalized();
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Quaterniond>> targets;
+  for (const Eigen::Vector3d& d : {f.lateral, f.axis, f.up})
+    for (double sign : {1.0, -1.0})
+      targets.push_back({ClampToWorkspace(scene, p + sign * o.probe_step_m * d), q});
+  for (const Eigen::Vector3d& axis : {tip_axis, f.up})
+    for (double sign : {1.0, -1.0})
+      targets.push_back(
+          {p, (Eigen::Quaterniond(Eigen::AngleAxisd(sign * o.probe_turn_rad, axis)) * q)
+                  .normalized()});
+  std::vector<Move> moves;
+  auto go = [&](const Eigen::Vector3d& to_p, const Eigen::Quaterniond& to_q) {
+    Move move = MoveTo(to_p, to_q, kProbeSpeed_m_per_s, 0.0, to_p);
+    move.turn_rad_per_s = kProbeTurn_rad_per_s;
+    moves.push_back(move);
+    move.min_ticks = hold;  // the same pose again: held still
+    moves.push_back(move);
+  };
+  for (const auto& [to_p, to_q] : targets) {
+    go(to_p, to_q);
+    go(p, q);
+  }
+  return moves;
+}
+
 class Merger {
  public:
   explicit Merger(ContactGraph& graph) : graph_(graph) {}
@@ -444,6 +495,14 @@ class Merger {
       Best& best = best_[std::size_t(i)];
       const bool better = best.length < 0 || (best.refined && !s.refined) ||
                           (best.refined == s.refined && s.length > best.length);
+      // Probes start from the settled stay that is quickest to replay (any stay if none is).
+      const int ticks = s.witness.substeps > 0 ? s.witness.tick - 1 : s.witness.tick;
+      Entry& entry = entry_[std::size_t(i)];
+      if (entry.ticks < 0 || (entry.refined && !s.refined) ||
+          (entry.refined == s.refined && ticks < entry.ticks)) {
+        entry = {ticks,         s.refined,          s.witness.motion,
+                 s.sample.move, s.sample.move_tick, s.sample.X_W_hand};
+      }
       if (better) {
         best = {s.length, s.refined};
         n.pcs = s.pcs;
@@ -477,10 +536,29 @@ class Merger {
     return graph_.nodes.size() > nodes || graph_.arcs.size() > arcs;
   }
 
+  // Node i's probe motion: the prefix of the motion of its quickest stay to replay, then the
+  // neighbour probes from the hand pose there.
+  Motion ProbeMotion(int i, const scene::Scene& scene, const ExploreOptions& o) const {
+    const Entry& e = entry_[std::size_t(i)];
+    Motion m;
+    m.kind = "probe " + graph_.nodes[std::size_t(i)].cf;
+    m.moves = Prefix(graph_.motions[std::size_t(e.motion)], e.move, e.move_tick);
+    m.prefix_ticks = e.ticks;
+    const std::vector<Move> probes = Probes(scene, e.X_W_hand, o);
+    m.moves.insert(m.moves.end(), probes.begin(), probes.end());
+    return m;
+  }
+
  private:
   struct Best {
     long length = -1;
     bool refined = true;
+  };
+  struct Entry {     // where probes start from (a stay of the node)
+    int ticks = -1;  // ticks of its motion up to there
+    bool refined = true;
+    int motion = 0, move = 0, move_tick = 0;
+    Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
   };
   int NodeOf(const std::string& cf) {
     const auto [it, inserted] = node_of_.try_emplace(cf, int(graph_.nodes.size()));
@@ -489,6 +567,7 @@ class Merger {
       n.cf = cf;
       graph_.nodes.push_back(std::move(n));
       best_.push_back({});
+      entry_.push_back({});
     }
     return it->second;
   }
@@ -496,6 +575,7 @@ class Merger {
   std::map<std::string, int> node_of_;
   std::map<std::pair<int, int>, int> arc_of_;
   std::vector<Best> best_;
+  std::vector<Entry> entry_;
 };
 
 std::set<std::string> ReachedElements(const ContactGraph& graph) {
@@ -637,28 +717,31 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
       if (!reached.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
     run(Aims(scene, probe, unseen, o));
   }
-  int quiet = 0;
-  while (quiet < o.effort && static_cast<int>(graph.motions.size()) < o.max_motions) {
+  // Random motions from the seed, all merged (they reach pressed, tipped and wedged states the
+  // sweeps and aims do not).
+  const int random =
+      std::min(o.random_motions, o.max_motions - static_cast<int>(graph.motions.size()));
+  if (random > 0) run(RandomMotionsIn(scene, box, o.seed, 0, random, o));
+  // Neighbour probing in rounds, each probing the nodes found since the last, until a round finds
+  // no new node: saturated. Every node has then been probed, and probing one again from the same
+  // stay replays the same motion (the core is deterministic), which finds nothing new; the
+  // effort is stated by the probe set (Probes) and the random motions before it.
+  std::size_t probed = 0;  // nodes [0, probed) have had their probe motion
+  while (probed < graph.nodes.size()) {
     const int first = static_cast<int>(graph.motions.size());
-    const int count = std::min(kBatch, o.max_motions - first);
-    // Random motions are numbered from 0 whatever came before, so a seed names the same motions.
-    const int random_first =
-        first - static_cast<int>(std::count_if(graph.motions.begin(), graph.motions.end(),
-                                               [](const Motion& m) { return m.kind != "random"; }));
-    std::vector<Motion> batch = RandomMotionsIn(scene, box, o.seed, random_first, count, o);
-    graph.motions.insert(graph.motions.end(), batch.begin(), batch.end());
-    std::vector<MotionResult> results = RunAll(scene, graph.motions, first, count, o, cores);
-    // Merge in order and stop at the motion that saturates, so the graph does not depend on how
-    // many threads ran the batch.
-    int merged = 0;
-    for (const MotionResult& r : results) {
-      ++merged;
-      quiet = merger.Add(r) ? 0 : quiet + 1;
+    const int count =
+        std::min(static_cast<int>(graph.nodes.size() - probed), o.max_motions - first);
+    if (count <= 0) break;
+    for (int i = 0; i < count; ++i)
+      graph.motions.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
+    probed += std::size_t(count);
+    for (const MotionResult& r : RunAll(scene, graph.motions, first, count, o, cores)) {
+      merger.Add(r);
       if (progress) progress(graph.saturation.back());
-      if (quiet >= o.effort) break;
     }
-    graph.motions.resize(std::size_t(first + merged));
   }
+  graph.probed = static_cast<int>(probed);
+  graph.saturated = probed == graph.nodes.size();
 
   graph.goal = graph.FindNode(states::ToString(scene.goal));
   if (graph.start >= 0 && graph.start < static_cast<int>(graph.nodes.size()))

@@ -26,11 +26,12 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
       const double angle_rad = q_from_W_.angularDistance(move.q_W);
       const double duration_s = std::max(distance_m / std::max(move.speed_m_per_s, 1e-6),
                                          angle_rad / std::max(move.turn_rad_per_s, 1e-6));
-      move_ticks_ = std::max(1, static_cast<int>(std::ceil(duration_s / step_s_ - 1e-9)));
+      move_ticks_ =
+          std::max({1, move.min_ticks, static_cast<int>(std::ceil(duration_s / step_s_ - 1e-9))});
       move_tick_ = 0;
     }
     const bool guarded = move.guard_N > 0.0 && move_tick_ > 0;
-    if (move_tick_ == move_ticks_ ||
+    if (move_tick_ == move_ticks_ || (move.max_ticks > 0 && move_tick_ >= move.max_ticks) ||
         (guarded && last.force_W_N.dot(move.guard_dir_W) > move.guard_N)) {
       ++move_;
       move_ticks_ = 0;
@@ -46,6 +47,18 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
   X.linear() = q_W_.normalized().toRotationMatrix();
   X.translation() = p_W_m_;
   return X;
+}
+
+std::vector<Move> Prefix(const Motion& motion, int move, int move_tick) {
+  const std::size_t whole =
+      std::min(static_cast<std::size_t>(std::max(move, 0)), motion.moves.size());
+  std::vector<Move> moves(motion.moves.begin(), motion.moves.begin() + static_cast<long>(whole));
+  if (whole < motion.moves.size() && move_tick > 0) {
+    Move cut = motion.moves[whole];
+    cut.max_ticks = cut.max_ticks > 0 ? std::min(cut.max_ticks, move_tick) : move_tick;
+    moves.push_back(cut);
+  }
+  return moves;
 }
 
 Eigen::Isometry3d MotionStart(const scene::Scene& scene) { return scene.X_WH_start; }

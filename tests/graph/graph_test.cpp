@@ -1,6 +1,7 @@
 // The contact-state graph: pruning against a hand-made graph with known dominance, DOT that
 // Graphviz renders and Boost reads back, and exploration of the shipped groove scene checked by
 // replaying every witness, by --jobs independence and by independent random motions.
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -266,11 +267,55 @@ const ContactGraph& SmallGraph(int jobs) {
   static std::map<int, ContactGraph> graphs;
   if (!graphs.contains(jobs)) {
     graph::ExploreOptions o;
-    o.max_motions = 110;  // the sweeps, the aims and some 30 random motions
+    o.random_motions = 5;
+    o.max_motions = 110;  // the 81 sweeps and aims, 5 random motions and 24 probe motions
     o.jobs = jobs;
     graphs[jobs] = graph::Explore(Groove(), o);
   }
   return graphs[jobs];
+}
+
+// The exploration with the default options, as `tubeplan graph scenes/groove.yaml` runs it.
+const ContactGraph& DefaultGraph(int jobs) {
+  static std::map<int, ContactGraph> graphs;
+  if (!graphs.contains(jobs)) {
+    graph::ExploreOptions o;
+    o.jobs = jobs;
+    graphs[jobs] = graph::Explore(Groove(), o);
+  }
+  return graphs[jobs];
+}
+
+TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit", "[graph]") {
+  const scene::Scene s = Groove();
+  const graph::ExploreOptions o;
+  core::Core core(s), again(s);
+  for (const graph::Motion& m : graph::RandomMotions(s, 99, 0, 3, o)) {
+    core.Reset(s.X_WH_start);
+    graph::MotionRunner runner(m, s.X_WH_start, s.model.time_step_s);
+    for (int k = 1; !runner.Done(); ++k) {
+      core.Step(k * s.model.time_step_s, runner.Next(core.last()));
+      if (k % 397 != 0) continue;
+      // The prefix with a move appended: identical up to tick k, then the new move.
+      graph::Motion cut;
+      cut.moves = graph::Prefix(m, runner.move(), runner.move_tick());
+      graph::Move away;
+      away.p_W_m = core.last().X_W_hand.translation() + Eigen::Vector3d(0.0, 0.0, 0.02);
+      cut.moves.push_back(away);
+      INFO("tick " << k);
+      graph::ReplayTo(again, cut, graph::TickRef{0, k, 0, 0});
+      CHECK(again.last().X_W_hand.translation() == core.last().X_W_hand.translation());
+      CHECK(again.last().X_WH.translation() == core.last().X_WH.translation());
+      CHECK(again.last().energy_J == core.last().energy_J);
+      CHECK(again.FormationText() == core.FormationText());
+      // The tick after: the appended move starts from where the hand was.
+      const Eigen::Vector3d p = again.last().X_W_hand.translation();
+      graph::ReplayTo(again, cut, graph::TickRef{0, k + 1, 0, 0});
+      const Eigen::Vector3d step = again.last().X_W_hand.translation() - p;
+      CHECK(step.z() > 0.0);
+      CHECK(step.head<2>().norm() < 1e-12);
+    }
+  }
 }
 
 TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph]") {
@@ -279,6 +324,10 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
   REQUIRE(g.nodes.size() > 20);
   CHECK(g.goal >= 0);
   CHECK(g.nodes[std::size_t(g.start)].cf == "{}");
+  // Some witnesses are in probe motions, which replay another motion's prefix first.
+  CHECK(std::any_of(g.nodes.begin(), g.nodes.end(), [&](const Node& n) {
+    return g.motions[std::size_t(n.witness.motion)].prefix_ticks > 0;
+  }));
   core::Core core(s);
   for (const Node& n : g.nodes) {
     INFO(n.cf << " witness motion " << n.witness.motion << " tick " << n.witness.tick);
@@ -293,9 +342,19 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
   for (const Arc& a : g.arcs) CHECK(a.witness.tick >= 1);
 }
 
-TEST_CASE("The same graph from one thread and from two", "[graph]") {
-  const ContactGraph& one = SmallGraph(1);
-  const ContactGraph& two = SmallGraph(2);
+TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph]") {
+  const ContactGraph& one = DefaultGraph(1);
+  const ContactGraph& two = DefaultGraph(2);
+  // Saturated within the default budget: every node probed, the last round found no new one.
+  CHECK(one.saturated);
+  CHECK(one.probed == static_cast<int>(one.nodes.size()));
+  CHECK(one.motions.size() < std::size_t(graph::ExploreOptions{}.max_motions));
+  WARN("default exploration: " << one.nodes.size() << " CFs, " << one.arcs.size()
+                               << " transitions, " << one.motions.size() << " motions, "
+                               << one.ticks << " ticks; " << one.seconds << " s on 1 thread, "
+                               << two.seconds << " s on 2");
+  CHECK(one.saturated == two.saturated);
+  CHECK(one.motions.size() == two.motions.size());
   REQUIRE(one.nodes.size() == two.nodes.size());
   REQUIRE(one.arcs.size() == two.arcs.size());
   for (std::size_t i = 0; i < one.nodes.size(); ++i) {
@@ -313,13 +372,12 @@ TEST_CASE("The same graph from one thread and from two", "[graph]") {
   CHECK(one.ticks == two.ticks);
 }
 
-TEST_CASE("Independent random motions mostly stay inside the explored graph", "[graph]") {
+TEST_CASE("Independent random motions stay inside the explored graph", "[graph]") {
   // Motions from another seed, run through the core and debounced here on their own (a CF
-  // counts after the same 20 ms dwell), against the graph explored with the default budget.
+  // counts after the same 20 ms dwell), against the graph explored with the default options.
   const scene::Scene s = Groove();
-  graph::ExploreOptions o;
-  o.jobs = 2;
-  const ContactGraph g = graph::Explore(s, o);
+  const graph::ExploreOptions o;
+  const ContactGraph& g = DefaultGraph(2);
   std::set<std::string> nodes;
   std::set<std::pair<std::string, std::string>> arcs;
   for (const Node& n : g.nodes) nodes.insert(n.cf);
@@ -361,16 +419,31 @@ TEST_CASE("Independent random motions mostly stay inside the explored graph", "[
   });
   for (const std::string& n : seen_nodes)
     if (!nodes.contains(n)) UNSCOPED_INFO("CF not in the graph: " << n);
+  for (const auto& a : seen_arcs) {
+    if (arcs.contains(a)) continue;
+    const bool via = std::any_of(nodes.begin(), nodes.end(), [&](const std::string& c) {
+      return arcs.contains({a.first, c}) && arcs.contains({c, a.second});
+    });
+    if (!via)
+      UNSCOPED_INFO("transition not in the graph: "
+                    << a.first << " -> " << a.second << " ("
+                    << graph::PcChanges(Cf(a.first.c_str()), Cf(a.second.c_str()))
+                    << " PC changes)");
+  }
   const double node_coverage = double(covered_nodes) / double(seen_nodes.size());
   const double arc_coverage = double(covered_arcs) / double(seen_arcs.size());
   WARN("coverage of 30 independent random motions: CFs "
-       << covered_nodes << "/" << seen_nodes.size() << ", transitions " << covered_arcs << "/"
-       << seen_arcs.size());
-  // The graph is not saturated within its budget (docs/graph.md): the groove has a long tail
-  // of rare CFs. The bounds are what the default budget achieved when measured, less a margin,
-  // so that a change that makes exploration miss common states fails here.
-  CHECK(node_coverage >= 0.85);
-  CHECK(arc_coverage >= 0.75);
+       << covered_nodes << "/" << seen_nodes.size() << " (" << 100.0 * node_coverage
+       << " %), transitions " << covered_arcs << "/" << seen_arcs.size() << " ("
+       << 100.0 * arc_coverage << " %)");
+  // The exploration saturates (every CF it found was probed, docs/graph.md). Measured then:
+  // every CF these motions go through is in the graph, and 140 of their 143 transitions; the
+  // three missing are two- and three-PC jumps between wedged states (the tube against the floor
+  // and a wall, or round the floor's edge). Every CF is required; the transitions keep a margin
+  // of about four misses beyond those three, so that exploration that misses common
+  // transitions fails here.
+  CHECK(covered_nodes == static_cast<long>(seen_nodes.size()));
+  CHECK(arc_coverage >= 0.95);
 }
 
 }  // namespace

@@ -69,6 +69,8 @@ struct ContactGraph {
   long ticks = 0;                               ///< core ticks run, refinements included
   int refinements = 0;                          ///< multi-PC steps that were sub-stepped
   double seconds = 0.0;                         ///< wall time of the exploration
+  int probed = 0;          ///< nodes whose neighbour probes ran (the first `probed` nodes)
+  bool saturated = false;  ///< every node probed within the budget
 
   int FindNode(const std::string& cf) const;
 };

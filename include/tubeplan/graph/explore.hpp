@@ -5,7 +5,10 @@
 //  2. aims: for each element of a reachable part that no PC has touched yet, motions that bring
 //     the tube's tip and then its side against that element (elements whose outside is covered
 //     by another part are not aimed at);
-//  3. random guarded motions from a seed, until `effort` motions in a row add no node or arc.
+//  3. `random_motions` random guarded motions from a seed;
+//  4. neighbour probes: from a stay of each node (its motion replayed up to there), small moves
+//     of the hand along and against three directions and small turns, each held and undone;
+//     every node found is probed in turn until all have been (saturated) or the budget is spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
 // into sub-ticks; what the sub-ticks produce is recorded, and a change that stays multiple is
 // flagged simultaneous. Motions run in parallel on `jobs` threads, each with its own core, and
@@ -21,11 +24,11 @@ namespace tubeplan::graph {
 
 struct ExploreOptions {
   std::uint64_t seed = 1;
-  /// Saturation: stop after this many random motions in a row added no node and no arc.
-  int effort = 40;
-  /// A bound whatever happens: the groove's graph has a long tail of rare transitions (corners
-  /// of parts, three-PC wedges) that random motions keep finding one at a time.
-  int max_motions = 300;
+  /// Random guarded motions from `seed` run after the sweeps and aims, before probing.
+  int random_motions = 120;
+  /// A bound whatever happens (sweeps, aims, random and probe motions together); the graph says
+  /// whether it saturated (every node probed) within it.
+  int max_motions = 3000;
   int jobs = 1;
   double push_N = 2.0;          ///< guard force of the probing moves
   double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)
@@ -33,6 +36,10 @@ struct ExploreOptions {
   /// A CF counts once the core has kept it this long (the plan judge's dwell); briefer states
   /// are flicker, not nodes, unless they bridge a two-PC change.
   double dwell_s = 0.020;
+  /// Neighbour probes from each node's witness: the hand moves this far along and against the
+  /// start frame's three directions and turns this much about two axes, and back.
+  double probe_step_m = 0.006;
+  double probe_turn_rad = 5.0 * 3.14159265358979323846 / 180.0;
 };
 
 /// Number of PC changes between two CFs: a PC added, removed or re-marked counts one; a PC that

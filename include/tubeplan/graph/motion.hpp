@@ -28,11 +28,19 @@ struct Move {
   double turn_rad_per_s = 1.0;
   Eigen::Vector3d guard_dir_W = Eigen::Vector3d::Zero();
   double guard_N = 0.0;
+  /// > 0: the move lasts at least this many ticks (a move to where the hand is holds it still).
+  int min_ticks = 0;
+  /// > 0: the move ends after this many ticks, on the path it would have followed whole (how a
+  /// motion is cut at a witness tick to go on from there, see Prefix).
+  int max_ticks = 0;
 };
 
 struct Motion {
-  std::string kind;  ///< "sweep", "aim", "random": how the explorer made it
+  std::string kind;  ///< "sweep", "aim", "random", "probe": how the explorer made it
   std::vector<Move> moves;
+  /// Ticks at the start that replay another motion up to a witness (Prefix): what they produce
+  /// is known already, so the explorer records only what comes after.
+  int prefix_ticks = 0;
 };
 
 /// Where a motion is refined: between ticks tick-1 and tick the hand's step is split into
@@ -51,6 +59,9 @@ class MotionRunner {
   MotionRunner(const Motion& motion, const Eigen::Isometry3d& X_W_start, double time_step_s);
 
   bool Done() const { return move_ >= moves_.size(); }
+  /// Where the hand is along the motion after the last Next: the move and its tick.
+  int move() const { return static_cast<int>(move_); }
+  int move_tick() const { return move_tick_; }
   /// The hand pose for the next tick, given the core's last output (its force drives the guards).
   Eigen::Isometry3d Next(const core::StepOutput& last);
 
@@ -65,6 +76,11 @@ class MotionRunner {
   int move_tick_ = 0;
   int move_ticks_ = 0;
 };
+
+/// The moves of `motion` up to tick `move_tick` of move `move` (a MotionRunner's move() and
+/// move_tick() after some tick k): run, they put the hand where `motion` had it at tick k, bit for
+/// bit, and moves appended to them go on from there.
+std::vector<Move> Prefix(const Motion& motion, int move, int move_tick);
 
 /// The held-end pose a motion's start puts the hand at (the scene's start pose).
 Eigen::Isometry3d MotionStart(const scene::Scene& scene);
