@@ -127,9 +127,8 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
       const double sin_half = 0.5 * (t - t_before).norm();
       const double cos_half = 0.5 * (t + t_before).norm();
       const double s2 = sin_half * sin_half;
-      const double chord = s2 < 6.25e-4
-                               ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2)
-                               : h * sin_half / std::atan2(sin_half, cos_half);
+      const double chord = s2 < 6.25e-4 ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2)
+                                        : h * sin_half / std::atan2(sin_half, cos_half);
       const Eigen::Vector3d dx =
           cos_half > 1e-12 ? Eigen::Vector3d(chord * (t + t_before) / (2.0 * cos_half)) : t * h;
       m += dx.cross(n);  // exact for the chord: equilibrium of the discrete chain
