@@ -54,11 +54,10 @@ int ChainCapsuleCount(const scene::Scene& scene) {
       std::clamp(n, static_cast<double>(kMinCapsules), static_cast<double>(kMaxCapsules)));
 }
 
-struct Core::Impl {
-  Impl(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsules,
-       std::vector<std::array<int, 64>> element_of)
-      : collision(scene, parts, capsules, std::move(element_of)), beam(scene) {}
-
+// Everything a tick reads that an earlier tick wrote, and the tick's scratch: a Snapshot copies
+// it whole. The scratch goes too (~40 of its ~70 kB): simpler and safer than proving each scratch
+// array is written before it is read, and a snapshot is a driver's occasional act, not a tick's.
+struct Core::State {
   // One load point of a PC in a tick.
   struct Load {
     int pc = 0;   // index into the tick's PCs
@@ -98,9 +97,6 @@ struct Core::Impl {
       return tube == o.tube && part_element == o.part_element && end == o.end;
     }
   };
-
-  Collision collision;
-  BeamChain beam;
 
   // State carried between ticks.
   std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_H{};  // centreline at s_k = k l / N
@@ -154,6 +150,61 @@ struct Core::Impl {
   SystemVector rhs, z;
   Eigen::PartialPivLU<SystemMatrix> lu;
 };
+
+// The set-up that ticks only read (Collision's GJK solver carries nothing between queries: its
+// cached guess is off), over the state.
+struct Core::Impl : Core::State {
+  Impl(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsules,
+       std::vector<std::array<int, 64>> element_of)
+      : collision(scene, parts, capsules, std::move(element_of)), beam(scene) {}
+
+  Collision collision;
+  BeamChain beam;
+};
+
+Core::Snapshot::Snapshot() = default;
+Core::Snapshot::~Snapshot() = default;
+Core::Snapshot::Snapshot(const Snapshot& other)
+    : state_(other.state_ ? std::make_unique<State>(*other.state_) : nullptr),
+      out_(other.out_),
+      capsules_(other.capsules_),
+      elements_(other.elements_) {}
+Core::Snapshot& Core::Snapshot::operator=(const Snapshot& other) {
+  if (this != &other) {
+    if (!other.state_) {
+      state_.reset();
+    } else if (state_) {
+      *state_ = *other.state_;
+    } else {
+      state_ = std::make_unique<State>(*other.state_);
+    }
+    out_ = other.out_;
+    capsules_ = other.capsules_;
+    elements_ = other.elements_;
+  }
+  return *this;
+}
+
+void Core::Save(Snapshot& snapshot) const {
+  if (snapshot.state_) {
+    *snapshot.state_ = static_cast<const State&>(*impl_);
+  } else {
+    snapshot.state_ = std::make_unique<State>(static_cast<const State&>(*impl_));
+  }
+  snapshot.out_ = out_;
+  snapshot.capsules_ = capsule_count_;
+  snapshot.elements_ = elements_.size();
+}
+
+bool Core::Restore(const Snapshot& snapshot) {
+  // A core of another scene would read the state with other sizes: refused where it shows.
+  if (!snapshot.state_ || snapshot.capsules_ != capsule_count_ ||
+      snapshot.elements_ != elements_.size())
+    return false;
+  static_cast<State&>(*impl_) = *snapshot.state_;
+  out_ = snapshot.out_;
+  return true;
+}
 
 Core::Core(const scene::Scene& scene) : scene_(scene) {
   const model::TubeSpec& tube = scene_.tube;

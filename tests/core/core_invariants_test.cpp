@@ -65,11 +65,12 @@ struct Hash {
   }
 };
 
-std::uint64_t RunDemo(const scene::Scene& s, const std::vector<plan::HandSample>& ticks) {
-  core::Core c(s);
-  c.Reset(Pose(ticks.front()));
+// The hash of ticks [first, ticks.size()) run on `c` as it is.
+std::uint64_t HashTicks(core::Core& c, const std::vector<plan::HandSample>& ticks,
+                        std::size_t first) {
   Hash hash;
-  for (const plan::HandSample& sample : ticks) {
+  for (std::size_t k = first; k < ticks.size(); ++k) {
+    const plan::HandSample& sample = ticks[k];
     const core::StepOutput& out = c.Step(sample.t_s, Pose(sample));
     hash.Add(out.force_W_N);
     hash.Add(out.torque_W_Nm);
@@ -84,6 +85,12 @@ std::uint64_t RunDemo(const scene::Scene& s, const std::vector<plan::HandSample>
     }
   }
   return hash.h;
+}
+
+std::uint64_t RunDemo(const scene::Scene& s, const std::vector<plan::HandSample>& ticks) {
+  core::Core c(s);
+  c.Reset(Pose(ticks.front()));
+  return HashTicks(c, ticks, 0);
 }
 
 }  // namespace
@@ -120,6 +127,64 @@ TEST_CASE("The same inputs give the same bits, in any thread", "[core][determini
   tb.join();
   CHECK(a == first);
   CHECK(b == first);
+}
+
+TEST_CASE("A snapshot puts a core back where it was, bit for bit, in another core too",
+          "[core][determinism]") {
+  const scene::Scene s = LoadScene("scenes/groove.yaml");
+  const std::vector<plan::HandSample> ticks = DemoTicks();
+  // Snapshots at ticks in each kind of state the demo has: free, the elastica, the rod (the side
+  // on the floor, carried by the rod's solution and tangent), and in contact with friction.
+  core::Core a(s);
+  a.Reset(Pose(ticks.front()));
+  std::vector<std::size_t> at;
+  bool free_seen = false, elastica_seen = false, rod_seen = false;
+  for (std::size_t k = 0; k < ticks.size(); ++k) {
+    const core::StepOutput& out = a.Step(ticks[k].t_s, Pose(ticks[k]));
+    const bool rod = (out.flags & core::kRodShape) != 0;
+    if (out.contact_count == 0 && !free_seen && k > 10) {
+      free_seen = true;
+      at.push_back(k + 1);
+    } else if (out.contact_count > 0 && !rod && !elastica_seen) {
+      elastica_seen = true;
+      at.push_back(k + 1);
+    } else if (rod && !rod_seen) {
+      rod_seen = true;
+      at.push_back(k + 20);  // well into the rod's stretch: its warm start is carried
+    }
+  }
+  REQUIRE(at.size() == 3);
+  for (const std::size_t first : at) {
+    CAPTURE(first);
+    core::Core c(s);
+    c.Reset(Pose(ticks.front()));
+    for (std::size_t k = 0; k < first; ++k) c.Step(ticks[k].t_s, Pose(ticks[k]));
+    core::Core::Snapshot snapshot;
+    CHECK(snapshot.empty());
+    c.Save(snapshot);
+    const core::Core::Snapshot copy = snapshot;  // a copy restores as well
+    const std::uint64_t expected = HashTicks(c, ticks, first);
+    // The same core, after it has run on to the end.
+    REQUIRE(c.Restore(snapshot));
+    CHECK(HashTicks(c, ticks, first) == expected);
+    // Another core whose own state is elsewhere (it ran the whole demo, then was reset away).
+    core::Core other(s);
+    other.Reset(Pose(ticks.front()));
+    HashTicks(other, ticks, 0);
+    REQUIRE(other.Restore(copy));
+    CHECK(HashTicks(other, ticks, first) == expected);
+  }
+  // Refused: an empty snapshot, and one from a core of another shape (another capsule count).
+  core::Core c(s);
+  core::Core::Snapshot empty;
+  CHECK_FALSE(c.Restore(empty));
+  scene::Scene coarser = s;
+  coarser.model.capsules = core::kMinCapsules;
+  REQUIRE(core::ChainCapsuleCount(coarser) != c.capsule_count());
+  core::Core coarse(coarser);
+  core::Core::Snapshot of_coarse;
+  coarse.Save(of_coarse);
+  CHECK_FALSE(c.Restore(of_coarse));
 }
 
 TEST_CASE("The shipped insertion replays to its golden hash", "[core][determinism]") {

@@ -139,6 +139,8 @@ int ChainCapsuleCount(const scene::Scene& scene);
 
 class Core {
  public:
+  struct State;  // what ticks carry, and their scratch (src/core)
+
   /// Set-up (allocates): elements, reachable parts, FCL shapes, the coupling. The scene must be
   /// valid (the loader checks it); the held end starts at scene.X_WH_start with the hand there.
   explicit Core(const scene::Scene& scene);
@@ -151,6 +153,31 @@ class Core {
 
   /// One tick of scene.model.time_step at time t_s with the hand at X_W_hand. No allocation.
   const StepOutput& Step(double t_s, const Eigen::Isometry3d& X_W_hand);
+
+  /// Everything the core carries from one tick to the next. Restore puts a core made from the
+  /// same scene back where Save found it, bit for bit: the ticks after it are those that followed
+  /// the Save. Graph exploration branches from a tick with it instead of replaying the motion up
+  /// to there. Cold path: Save allocates when the snapshot is empty (~70 kB), Restore never.
+  class Snapshot {
+   public:
+    Snapshot();
+    ~Snapshot();
+    Snapshot(const Snapshot& other);
+    Snapshot& operator=(const Snapshot& other);
+    bool empty() const { return state_ == nullptr; }
+
+   private:
+    friend class Core;
+    std::unique_ptr<State> state_;
+    StepOutput out_;
+    int capsules_ = 0;
+    std::size_t elements_ = 0;
+  };
+  void Save(Snapshot& snapshot) const;
+  /// False, the core untouched, if the snapshot is empty or from a core of another shape (its
+  /// capsule or element count differs; a snapshot of another scene of the same shape is the
+  /// caller's error).
+  bool Restore(const Snapshot& snapshot);
 
   /// The deformed centreline at `count` points equally spaced in arc length, in W. Computed only
   /// when asked (the "shape only when a consumer asks" rule); no allocation.
@@ -171,7 +198,7 @@ class Core {
   double coupling_stiffness_N_per_m() const { return coupling_stiffness_; }
   double coupling_damping_Ns_per_m() const { return coupling_damping_; }
 
-  struct Impl;  // collision and beam internals (src/core)
+  struct Impl;  // State, and the collision and beam set-up (src/core)
 
  private:
   scene::Scene scene_;
