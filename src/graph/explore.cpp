@@ -25,6 +25,10 @@ constexpr int kMaxTicksPerMotion = 30000;
 // probes are most of the exploration's ticks.
 constexpr double kProbeSpeed_m_per_s = 0.15;
 constexpr double kProbeTurn_rad_per_s = 2.0;
+// A motion's run keeps a checkpoint every this many ticks (a core snapshot is ~70 kB, copied in
+// about the time of a tick or two): a refinement or a probe starts from the one before its tick
+// and replays at most this many ticks, not the whole motion up to it.
+constexpr int kCheckpointTicks = 64;
 
 using core::KeyOf;
 using CfKey = core::FormationKey;
@@ -66,38 +70,58 @@ struct Change {
   TickRef at;
 };
 
+// A stretch of ticks [start, end] of a motion in one CF, as the core classified them, and the
+// sample of its first tick.
+struct RawRun {
+  std::string text;
+  states::ContactFormation cf;
+  int start = 0, end = 0;
+  Sample first;
+};
+
+// A run of a motion after some tick, whole: the core and the runner (Checkpoint) and RunMotion's
+// own state there (which CF counts, which are brief, the tick's sample). A run that goes on from
+// it records what a run from the motion's start would, bit for bit.
+struct RunPoint {
+  Checkpoint at;
+  CfKey key{};
+  RawRun stable, raw;
+  std::vector<RawRun> brief;
+  Sample sample;
+};
+using RunPointPtr = std::shared_ptr<const RunPoint>;
+
 struct MotionResult {
   std::vector<Stay> stays;
   std::vector<Change> changes;
   long ticks = 0;
   int refinements = 0;
-};
-
-// A stretch of ticks [start, end] of a motion in one CF, as the core classified them.
-struct RawRun {
-  std::string text;
-  states::ContactFormation cf;
-  int start = 0, end = 0;
+  // For stays of CFs the graph did not have when the motion started: the run's point at or
+  // before the stay's witness, from which a probe of that CF starts (null: none kept).
+  std::vector<RunPointPtr> stay_points;
 };
 
 // Sub-steps tick `tick` of the motion and returns the CFs the sub-ticks went through, in order,
 // starting with `from` (the state before the tick), with the sub-tick each was entered at.
 std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Motion& motion,
                                               int tick, const RawRun& from, int substeps,
-                                              long& ticks) {
+                                              const Checkpoint* checkpoint, long& ticks) {
   std::vector<std::pair<RawRun, Sample>> chain = {{from, Sample{}}};
-  ReplaySubsteps(refine_core, motion, tick, substeps, [&](int j, const core::StepOutput& out) {
-    ++ticks;
-    states::ContactFormation c = refine_core.Formation();
-    if (c == chain.back().first.cf) return true;
-    RawRun run;
-    run.text = states::ToString(c);
-    run.cf = std::move(c);
-    run.start = run.end = j;
-    chain.push_back({std::move(run), SampleOf(out)});
-    return true;
-  });
-  ticks += tick - 1;
+  ReplaySubsteps(
+      refine_core, motion, tick, substeps,
+      [&](int j, const core::StepOutput& out) {
+        ++ticks;
+        states::ContactFormation c = refine_core.Formation();
+        if (c == chain.back().first.cf) return true;
+        RawRun run;
+        run.text = states::ToString(c);
+        run.cf = std::move(c);
+        run.start = run.end = j;
+        chain.push_back({std::move(run), SampleOf(out)});
+        return true;
+      },
+      checkpoint);
+  ticks += tick - 1 - (checkpoint != nullptr ? checkpoint->tick : 0);
   return chain;
 }
 
@@ -106,26 +130,65 @@ std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Mot
 // for a tick or two is not a node. A transition between counted states that changes more than
 // one PC is bridged by a brief state in between when one is a single change from both, else
 // refined by sub-stepping the tick where it happened, else flagged simultaneous.
+// `resume`, if given, is a point of a run of a motion whose moves are the same as this one's up to
+// it (the motion this one's Prefix was cut from): the run goes on from there. `may_enter` says
+// whether a stay (CF, refined, tick) could become the place its CF's probe starts from: those
+// keep a run point.
+using MayEnter = std::function<bool(const std::string&, bool, int)>;
 MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion, int index,
-                       const ExploreOptions& options) {
+                       const ExploreOptions& options, const RunPointPtr& resume,
+                       const MayEnter& may_enter) {
   MotionResult result;
   const double step_s = core.scene().model.time_step_s;
   const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
   const Eigen::Isometry3d X_start = MotionStart(core.scene());
-  core.Reset(X_start);
   MotionRunner runner(motion, X_start, step_s);
   // Ticks up to here replay another motion to a witness: nothing new there, nothing recorded.
   const int prefix = motion.prefix_ticks;
-  std::vector<Sample> samples(1);  // per tick, [0] unused
-  RawRun stable, raw;              // the counted state and the one the core is in
-  std::vector<RawRun> brief;       // states since `stable` that did not last `dwell`
+  RawRun stable, raw;         // the counted state and the one the core is in
+  std::vector<RawRun> brief;  // states since `stable` that did not last `dwell`
+  CfKey key{};
+  int k = 1;
+  if (options.resume_runs && resume != nullptr && resume->at.tick <= prefix &&
+      core.Restore(resume->at.core)) {
+    runner.Resume(resume->at.runner);
+    key = resume->key;
+    stable = resume->stable;
+    raw = resume->raw;
+    brief = resume->brief;
+    k = resume->at.tick + 1;
+  } else {
+    core.Reset(X_start);
+  }
+  const int base = k - 1;          // samples[i] is tick base + i's
+  std::vector<Sample> samples(1);  // [0]: tick base's (unused when base is 0)
+  if (base > 0) samples[0] = resume->sample;
+  auto sample = [&](int tick) -> const Sample& { return samples[std::size_t(tick - base)]; };
+  // Run points every kCheckpointTicks ticks (the one resumed from first), for refinements and for
+  // the probes of the CFs this motion finds.
+  std::vector<RunPointPtr> points;
+  if (base > 0) points.push_back(resume);
+  auto point_before = [&](int tick) -> RunPointPtr {
+    for (auto it = points.rbegin(); it != points.rend(); ++it)
+      if ((*it)->at.tick <= tick) return *it;
+    return nullptr;
+  };
+  // The CFs a stay has been recorded for with a run point (refined or not).
+  std::set<std::pair<std::string, bool>> pointed;
+  auto add_stay = [&](Stay stay) {
+    RunPointPtr point;
+    if (stay.witness.substeps == 0 && may_enter(stay.cf, stay.refined, stay.witness.tick) &&
+        pointed.insert({stay.cf, stay.refined}).second)
+      point = point_before(stay.witness.tick);
+    result.stays.push_back(std::move(stay));
+    result.stay_points.push_back(std::move(point));
+  };
   auto record_stay = [&](RawRun run) {
     if (run.end <= prefix) return;
     run.start = std::max(run.start, prefix + 1);
     const int mid = run.start + (run.end - run.start) / 2;
-    result.stays.push_back({run.text, static_cast<int>(run.cf.contacts.size()),
-                            TickRef{index, mid, 0, 0}, run.end - run.start + 1, false,
-                            samples[std::size_t(mid)]});
+    add_stay({run.text, static_cast<int>(run.cf.contacts.size()), TickRef{index, mid, 0, 0},
+              run.end - run.start + 1, false, sample(mid)});
   };
   auto add_change = [&](const RawRun& from, const RawRun& to, bool simultaneous, TickRef at) {
     result.changes.push_back({from.text, to.text, simultaneous, at});
@@ -138,9 +201,8 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
     }
     for (auto it = brief.rbegin(); it != brief.rend(); ++it) {
       if (PcChanges(stable.cf, it->cf) <= 1 && PcChanges(it->cf, to.cf) <= 1) {
-        result.stays.push_back({it->text, static_cast<int>(it->cf.contacts.size()),
-                                TickRef{index, it->start, 0, 0}, it->end - it->start + 1, true,
-                                samples[std::size_t(it->start)]});
+        add_stay({it->text, static_cast<int>(it->cf.contacts.size()),
+                  TickRef{index, it->start, 0, 0}, it->end - it->start + 1, true, it->first});
         add_change(stable, *it, false, {index, it->start});
         add_change(*it, to, false, {index, to.start});
         return;
@@ -148,8 +210,9 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
     }
     if (brief.empty() && options.substeps > 1) {
       ++result.refinements;
-      const auto chain =
-          Refine(refine_core, motion, to.start, stable, options.substeps, result.ticks);
+      const RunPointPtr point = point_before(to.start - 1);
+      const auto chain = Refine(refine_core, motion, to.start, stable, options.substeps,
+                                point ? &point->at : nullptr, result.ticks);
       bool single = chain.back().first.cf == to.cf;
       for (std::size_t c = 1; c < chain.size(); ++c)
         single = single && PcChanges(chain[c - 1].first.cf, chain[c].first.cf) <= 1;
@@ -157,12 +220,11 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
         for (std::size_t c = 1; c < chain.size(); ++c) {
           const TickRef at{index, to.start, options.substeps, chain[c].first.start};
           if (c + 1 < chain.size()) {
-            Sample sample = chain[c].second;
-            sample.move = samples[std::size_t(to.start - 1)].move;
-            sample.move_tick = samples[std::size_t(to.start - 1)].move_tick;
-            result.stays.push_back({chain[c].first.text,
-                                    static_cast<int>(chain[c].first.cf.contacts.size()), at,
-                                    chain[c + 1].first.start - chain[c].first.start, true, sample});
+            Sample s = chain[c].second;
+            s.move = sample(to.start - 1).move;
+            s.move_tick = sample(to.start - 1).move_tick;
+            add_stay({chain[c].first.text, static_cast<int>(chain[c].first.cf.contacts.size()), at,
+                      chain[c + 1].first.start - chain[c].first.start, true, s});
           }
           add_change(chain[c - 1].first, chain[c].first, false, at);
         }
@@ -172,8 +234,6 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
     add_change(stable, to, true, {index, to.start});
   };
 
-  int k = 1;
-  CfKey key{};
   for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
     samples.push_back(SampleOf(out));
@@ -186,6 +246,7 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
       next.cf = core.Formation();
       next.text = states::ToString(next.cf);
       next.start = next.end = k;
+      next.first = samples.back();
       if (k == 1) {
         stable = raw = next;
         continue;
@@ -205,8 +266,20 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
       stable = raw;
       brief.clear();
     }
+    if (options.resume_runs && k % kCheckpointTicks == 0) {
+      auto point = std::make_shared<RunPoint>();
+      point->at.tick = k;
+      core.Save(point->at.core);
+      point->at.runner = runner.position();
+      point->key = key;
+      point->stable = stable;
+      point->raw = raw;
+      point->brief = brief;
+      point->sample = samples.back();
+      points.push_back(std::move(point));
+    }
   }
-  result.ticks += k - 1;
+  result.ticks += k - 1 - base;
   if (raw.end - raw.start + 1 >= dwell || result.stays.empty()) record_stay(raw);
   return result;
 }
@@ -421,9 +494,11 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   return motions;
 }
 
-// Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each.
+// Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each; motion
+// first + i goes on from resumes[i] where there is one.
 std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Motion>& motions,
-                                 int first, int count, const ExploreOptions& o,
+                                 int first, int count, const std::vector<RunPointPtr>& resumes,
+                                 const MayEnter& may_enter, const ExploreOptions& o,
                                  std::vector<std::unique_ptr<core::Core>>& cores) {
   std::vector<MotionResult> results(static_cast<std::size_t>(count));
   const int jobs = std::clamp(o.jobs, 1, std::max(1, count));
@@ -434,7 +509,8 @@ std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Mo
     for (int i = next++; i < count; i = next++) {
       results[std::size_t(i)] =
           RunMotion(*cores[std::size_t(2 * worker)], *cores[std::size_t(2 * worker + 1)],
-                    motions[std::size_t(first + i)], first + i, o);
+                    motions[std::size_t(first + i)], first + i, o,
+                    std::size_t(i) < resumes.size() ? resumes[std::size_t(i)] : nullptr, may_enter);
     }
   };
   std::vector<std::thread> threads;
@@ -488,7 +564,8 @@ class Merger {
   // Returns whether the result added a node or an arc.
   bool Add(const MotionResult& r) {
     const std::size_t nodes = graph_.nodes.size(), arcs = graph_.arcs.size();
-    for (const Stay& s : r.stays) {
+    for (std::size_t j = 0; j < r.stays.size(); ++j) {
+      const Stay& s = r.stays[j];
       const int i = NodeOf(s.cf);
       Node& n = graph_.nodes[std::size_t(i)];
       if (!s.refined) n.ticks += s.length;
@@ -500,8 +577,13 @@ class Merger {
       Entry& entry = entry_[std::size_t(i)];
       if (entry.ticks < 0 || (entry.refined && !s.refined) ||
           (entry.refined == s.refined && ticks < entry.ticks)) {
-        entry = {ticks,         s.refined,          s.witness.motion,
-                 s.sample.move, s.sample.move_tick, s.sample.X_W_hand};
+        entry = {ticks,
+                 s.refined,
+                 s.witness.motion,
+                 s.sample.move,
+                 s.sample.move_tick,
+                 s.sample.X_W_hand,
+                 s.witness.substeps == 0 ? r.stay_points[j] : nullptr};
       }
       if (better) {
         best = {s.length, s.refined};
@@ -536,6 +618,21 @@ class Merger {
     return graph_.nodes.size() > nodes || graph_.arcs.size() > arcs;
   }
 
+  // A run point of node i's probe motion at or before its prefix's end (null: replay it whole).
+  // Handed over once: the merger keeps no snapshots of probed nodes.
+  RunPointPtr TakeProbePoint(int i) { return std::move(entry_[std::size_t(i)].point); }
+  // Whether a stay of `cf` (refined or not, at `ticks` of its motion) would become the place its
+  // probe starts from, as Add chooses it, if no stay merged after now beat it; nodes [0, probed)
+  // have had their probe.
+  bool MayEnter(const std::string& cf, bool refined, int ticks, std::size_t probed) const {
+    const auto it = node_of_.find(cf);
+    if (it == node_of_.end()) return true;
+    if (std::size_t(it->second) < probed) return false;
+    const Entry& entry = entry_[std::size_t(it->second)];
+    return entry.ticks < 0 || (entry.refined && !refined) ||
+           (entry.refined == refined && ticks < entry.ticks);
+  }
+
   // Node i's probe motion: the prefix of the motion of its quickest stay to replay, then the
   // neighbour probes from the hand pose there.
   Motion ProbeMotion(int i, const scene::Scene& scene, const ExploreOptions& o) const {
@@ -559,6 +656,7 @@ class Merger {
     bool refined = true;
     int motion = 0, move = 0, move_tick = 0;
     Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
+    RunPointPtr point;
   };
   int NodeOf(const std::string& cf) {
     const auto [it, inserted] = node_of_.try_emplace(cf, int(graph_.nodes.size()));
@@ -697,11 +795,17 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   core::Core& probe = *cores.front();
   const Box box = PartsBox(scene, probe.reachable_parts());
   // Sweeps and aims run whole, merged in order (saturation counts random motions only).
+  std::size_t probed = 0;  // nodes [0, probed) have had their probe motion
+  // Read by the threads of a batch, while the merger stands still.
+  const MayEnter may_enter = [&](const std::string& cf, bool refined, int ticks) {
+    return merger.MayEnter(cf, refined, ticks, probed);
+  };
   auto run = [&](std::vector<Motion> batch) {
     const int first = static_cast<int>(graph.motions.size());
     const int count = static_cast<int>(batch.size());
     for (Motion& m : batch) graph.motions.push_back(std::move(m));
-    for (const MotionResult& r : RunAll(scene, graph.motions, first, count, o, cores)) {
+    for (const MotionResult& r :
+         RunAll(scene, graph.motions, first, count, {}, may_enter, o, cores)) {
       merger.Add(r);
       if (progress) progress(graph.saturation.back());
     }
@@ -726,16 +830,21 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   // no new node: saturated. Every node has then been probed, and probing one again from the same
   // stay replays the same motion (the core is deterministic), which finds nothing new; the
   // effort is stated by the probe set (Probes) and the random motions before it.
-  std::size_t probed = 0;  // nodes [0, probed) have had their probe motion
   while (probed < graph.nodes.size()) {
     const int first = static_cast<int>(graph.motions.size());
     const int count =
         std::min(static_cast<int>(graph.nodes.size() - probed), o.max_motions - first);
     if (count <= 0) break;
-    for (int i = 0; i < count; ++i)
+    // Each goes on from the run point kept at its start stay, if there is one: the same bits as
+    // replaying its prefix.
+    std::vector<RunPointPtr> resumes;
+    for (int i = 0; i < count; ++i) {
       graph.motions.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
+      resumes.push_back(merger.TakeProbePoint(static_cast<int>(probed) + i));
+    }
     probed += std::size_t(count);
-    for (const MotionResult& r : RunAll(scene, graph.motions, first, count, o, cores)) {
+    for (const MotionResult& r :
+         RunAll(scene, graph.motions, first, count, resumes, may_enter, o, cores)) {
       merger.Add(r);
       if (progress) progress(graph.saturation.back());
     }

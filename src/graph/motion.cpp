@@ -14,6 +14,27 @@ MotionRunner::MotionRunner(const Motion& motion, const Eigen::Isometry3d& X_W_st
       p_from_W_m_(p_W_m_),
       q_from_W_(q_W_) {}
 
+MotionRunner::Position MotionRunner::position() const {
+  return {move_, move_tick_, move_ticks_, p_W_m_, p_from_W_m_, q_W_, q_from_W_};
+}
+
+void MotionRunner::Resume(const Position& at) {
+  move_ = at.move;
+  move_tick_ = at.move_tick;
+  move_ticks_ = at.move_ticks;
+  p_W_m_ = at.p_W_m;
+  p_from_W_m_ = at.p_from_W_m;
+  q_W_ = at.q_W;
+  q_from_W_ = at.q_from_W;
+}
+
+Eigen::Isometry3d MotionRunner::Pose() const {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = q_W_.normalized().toRotationMatrix();
+  X.translation() = p_W_m_;
+  return X;
+}
+
 Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
   while (move_ < moves_.size()) {
     const Move& move = moves_[move_];
@@ -43,10 +64,7 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
     q_W_ = q_from_W_.slerp(u, move.q_W);
     break;
   }
-  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = q_W_.normalized().toRotationMatrix();
-  X.translation() = p_W_m_;
-  return X;
+  return Pose();
 }
 
 std::vector<Move> Prefix(const Motion& motion, int move, int move_tick) {
@@ -64,14 +82,22 @@ std::vector<Move> Prefix(const Motion& motion, int move, int move_tick) {
 Eigen::Isometry3d MotionStart(const scene::Scene& scene) { return scene.X_WH_start; }
 
 void ReplaySubsteps(core::Core& core, const Motion& motion, int tick, int substeps,
-                    const std::function<bool(int, const core::StepOutput&)>& on_substep) {
+                    const std::function<bool(int, const core::StepOutput&)>& on_substep,
+                    const Checkpoint* from) {
   const scene::Scene& scene = core.scene();
   const double step_s = scene.model.time_step_s;
   const Eigen::Isometry3d X_start = MotionStart(scene);
-  core.Reset(X_start);
   MotionRunner runner(motion, X_start, step_s);
   Eigen::Isometry3d X_prev = X_start;
-  for (int k = 1; k < tick; ++k) {
+  int k = 1;
+  if (from != nullptr && from->tick < tick && core.Restore(from->core)) {
+    runner.Resume(from->runner);
+    X_prev = runner.Pose();
+    k = from->tick + 1;
+  } else {
+    core.Reset(X_start);
+  }
+  for (; k < tick; ++k) {
     X_prev = runner.Next(core.last());
     core.Step(k * step_s, X_prev);
   }

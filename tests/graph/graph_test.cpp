@@ -342,6 +342,55 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
   for (const Arc& a : g.arcs) CHECK(a.witness.tick >= 1);
 }
 
+TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them", "[graph]") {
+  // Probes of the second round start from stays found by probes of the first, whose runs were
+  // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
+  // prefix and every refinement from the motion's start (an independent path to the same bits).
+  // The groove's floor alone: the same kinds of states (ends and sides on faces and edges,
+  // stuck and sliding, the rod and the elastica) in fewer of them, explored to saturation.
+  scene::Scene floor = Groove();
+  floor.parts.resize(1);
+  REQUIRE(floor.parts[0].name == "floor");
+  graph::ExploreOptions o;
+  o.random_motions = 0;
+  o.jobs = 2;
+  const ContactGraph resumed = graph::Explore(floor, o);
+  o.resume_runs = false;
+  const ContactGraph replayed = graph::Explore(floor, o);
+  // The budget reaches into the second probe round: more motions than the sweeps and aims and
+  // a probe for every node they found.
+  const std::size_t before_probes = std::size_t(
+      std::count_if(resumed.motions.begin(), resumed.motions.end(),
+                    [](const graph::Motion& m) { return m.kind.rfind("probe", 0) != 0; }));
+  REQUIRE(resumed.motions.size() >
+          before_probes + std::size_t(resumed.saturation[before_probes - 1].nodes));
+  REQUIRE(resumed.nodes.size() == replayed.nodes.size());
+  REQUIRE(resumed.arcs.size() == replayed.arcs.size());
+  for (std::size_t i = 0; i < resumed.nodes.size(); ++i) {
+    const Node &a = resumed.nodes[i], &b = replayed.nodes[i];
+    CHECK(a.cf == b.cf);
+    CHECK(a.ticks == b.ticks);
+    CHECK(a.witness.motion == b.witness.motion);
+    CHECK(a.witness.tick == b.witness.tick);
+    CHECK(a.energy_J == b.energy_J);
+    CHECK(a.X_WH.translation() == b.X_WH.translation());
+  }
+  for (std::size_t i = 0; i < resumed.arcs.size(); ++i) {
+    const Arc &a = resumed.arcs[i], &b = replayed.arcs[i];
+    CHECK(a.from == b.from);
+    CHECK(a.to == b.to);
+    CHECK(a.count == b.count);
+    CHECK(a.simultaneous == b.simultaneous);
+    CHECK(a.witness.tick == b.witness.tick);
+  }
+  CHECK(resumed.refinements == replayed.refinements);
+  // And it is the point: fewer ticks run.
+  WARN("ticks resumed " << resumed.ticks << ", replayed " << replayed.ticks << "; "
+                        << resumed.nodes.size() << " nodes, " << resumed.motions.size()
+                        << " motions, " << before_probes << " before probing");
+  CHECK(resumed.ticks < replayed.ticks);
+}
+
 TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph]") {
   const ContactGraph& one = DefaultGraph(1);
   const ContactGraph& two = DefaultGraph(2);

@@ -6,7 +6,7 @@
 //     the tube's tip and then its side against that element (elements whose outside is covered
 //     by another part are not aimed at);
 //  3. `random_motions` random guarded motions from a seed;
-//  4. neighbour probes: from a stay of each node (its motion replayed up to there), small moves
+//  4. neighbour probes: from a stay of each node (its motion resumed there), small moves
 //     of the hand along and against three directions and small turns, each held and undone;
 //     every node found is probed in turn until all have been (saturated) or the budget is spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
@@ -40,6 +40,11 @@ struct ExploreOptions {
   /// start frame's three directions and turns this much about two axes, and back.
   double probe_step_m = 0.006;
   double probe_turn_rad = 5.0 * 3.14159265358979323846 / 180.0;
+  /// A run keeps a core snapshot every 64 ticks; a probe goes on from the one at or before its
+  /// start stay and a refinement from the one before its tick, instead of replaying the motion
+  /// up to there (the same bits, so the same graph, in ~half the ticks). false: every prefix is
+  /// replayed (the check that snapshots change nothing).
+  bool resume_runs = true;
 };
 
 /// Number of PC changes between two CFs: a PC added, removed or re-marked counts one; a PC that

@@ -58,6 +58,20 @@ class MotionRunner {
  public:
   MotionRunner(const Motion& motion, const Eigen::Isometry3d& X_W_start, double time_step_s);
 
+  /// Where a runner is between ticks: Resume puts a runner of a motion whose moves are the
+  /// same up to there (the motion itself, or one made with Prefix) at the same place.
+  struct Position {
+    std::size_t move = 0;
+    int move_tick = 0, move_ticks = 0;
+    Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero(), p_from_W_m = Eigen::Vector3d::Zero();
+    Eigen::Quaterniond q_W = Eigen::Quaterniond::Identity();
+    Eigen::Quaterniond q_from_W = Eigen::Quaterniond::Identity();
+  };
+  Position position() const;
+  void Resume(const Position& at);
+  /// The hand pose the last Next returned (the start pose before the first).
+  Eigen::Isometry3d Pose() const;
+
   bool Done() const { return move_ >= moves_.size(); }
   /// Where the hand is along the motion after the last Next: the move and its tick.
   int move() const { return static_cast<int>(move_); }
@@ -77,6 +91,14 @@ class MotionRunner {
   int move_ticks_ = 0;
 };
 
+/// A point of a motion's run to go on from without replaying the motion up to it: the core's
+/// state and the runner's position after tick `tick`.
+struct Checkpoint {
+  int tick = 0;
+  core::Core::Snapshot core;
+  MotionRunner::Position runner;
+};
+
 /// The moves of `motion` up to tick `move_tick` of move `move` (a MotionRunner's move() and
 /// move_tick() after some tick k): run, they put the hand where `motion` had it at tick k, bit for
 /// bit, and moves appended to them go on from there.
@@ -91,8 +113,11 @@ const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const T
 
 /// Runs ticks 1 .. tick-1 of `motion`, then splits the hand's step of `tick` into `substeps`
 /// sub-ticks and runs them, calling on_substep(j, output) after sub-tick j; stops when it
-/// returns false. ReplayTo uses it, so a refined witness replays bit for bit.
+/// returns false. ReplayTo uses it, so a refined witness replays bit for bit. With `from` (a
+/// checkpoint of a run of `motion` before `tick`), the ticks up to the checkpoint's are not run
+/// but restored: the same bits, sooner.
 void ReplaySubsteps(core::Core& core, const Motion& motion, int tick, int substeps,
-                    const std::function<bool(int, const core::StepOutput&)>& on_substep);
+                    const std::function<bool(int, const core::StepOutput&)>& on_substep,
+                    const Checkpoint* from = nullptr);
 
 }  // namespace tubeplan::graph
