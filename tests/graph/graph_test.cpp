@@ -262,6 +262,25 @@ scene::Scene Groove() {
   return *loaded.scene;
 }
 
+// The groove's floor alone: the same kinds of states as the groove (ends and sides on faces and
+// edges, stuck and sliding, the rod and the elastica) in fewer of them (~55 against ~270).
+scene::Scene FloorOnly() {
+  scene::Scene floor = Groove();
+  floor.parts.resize(1);
+  REQUIRE(floor.parts[0].name == "floor");
+  return floor;
+}
+
+// The scene the exploration tests explore. Under the sanitizers (15-20x slower) the groove's
+// default exploration takes half an hour of CI per test: there they explore the floor alone,
+// which runs the same code (every kind of motion, probe rounds to saturation, refinements, resumed
+// runs); the release build explores the groove.
+#ifdef TUBEPLAN_SANITIZED
+scene::Scene ExploredScene() { return FloorOnly(); }
+#else
+scene::Scene ExploredScene() { return Groove(); }
+#endif
+
 // A small exploration of the shipped scene, shared by the tests below (it costs seconds).
 const ContactGraph& SmallGraph(int jobs) {
   static std::map<int, ContactGraph> graphs;
@@ -270,7 +289,7 @@ const ContactGraph& SmallGraph(int jobs) {
     o.random_motions = 5;
     o.max_motions = 110;  // the 81 sweeps and aims, 5 random motions and 24 probe motions
     o.jobs = jobs;
-    graphs[jobs] = graph::Explore(Groove(), o);
+    graphs[jobs] = graph::Explore(ExploredScene(), o);
   }
   return graphs[jobs];
 }
@@ -281,7 +300,7 @@ const ContactGraph& DefaultGraph(int jobs) {
   if (!graphs.contains(jobs)) {
     graph::ExploreOptions o;
     o.jobs = jobs;
-    graphs[jobs] = graph::Explore(Groove(), o);
+    graphs[jobs] = graph::Explore(ExploredScene(), o);
   }
   return graphs[jobs];
 }
@@ -319,7 +338,7 @@ TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit"
 }
 
 TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph]") {
-  const scene::Scene s = Groove();
+  const scene::Scene s = ExploredScene();
   const ContactGraph& g = SmallGraph(2);
   REQUIRE(g.nodes.size() > 20);
   CHECK(g.goal >= 0);
@@ -346,11 +365,8 @@ TEST_CASE("Resuming runs from snapshots explores the same graph as replaying the
   // Probes of the second round start from stays found by probes of the first, whose runs were
   // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
   // prefix and every refinement from the motion's start (an independent path to the same bits).
-  // The groove's floor alone: the same kinds of states (ends and sides on faces and edges,
-  // stuck and sliding, the rod and the elastica) in fewer of them, explored to saturation.
-  scene::Scene floor = Groove();
-  floor.parts.resize(1);
-  REQUIRE(floor.parts[0].name == "floor");
+  // The groove's floor alone, explored to saturation.
+  const scene::Scene floor = FloorOnly();
   graph::ExploreOptions o;
   o.random_motions = 0;
   o.jobs = 2;
@@ -424,7 +440,7 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph]") {
   // Motions from another seed, run through the core and debounced here on their own (a CF
   // counts after the same 20 ms dwell), against the graph explored with the default options.
-  const scene::Scene s = Groove();
+  const scene::Scene s = ExploredScene();
   const graph::ExploreOptions o;
   const ContactGraph& g = DefaultGraph(2);
   std::set<std::string> nodes;
