@@ -67,8 +67,38 @@ Rod::Rod(double bending_stiffness_Nm2, double max_step_m)
     throw std::invalid_argument("Rod: bending stiffness and step must be positive and finite");
 }
 
+// Forward sensitivities: the linearisation of each step of the integration applied to a set of
+// directions of its inputs alongside it. They are the derivatives of the discrete map itself (not
+// of the continuous rod), so Newton on them converges as on the exact Jacobian and the compliance
+// is the discrete chain's; one integration carries them all, where differences took one per
+// direction. Direction c < 3 turns the end section by the unit turn about axis c (Q -> Exp(e_c) Q,
+// clamp frame, as Newton's step); direction 3 + 3 j + c, when asked for, moves load j's force
+// (its index in the caller's span) along axis c by a unit at the integration's scale.
+template <int kMaxDirections>
+struct Rod::Tangent {
+  int directions = 0;  ///< 3 (the end's turn), or 3 + 3 count (and each load's force)
+  /// Per direction, at the current node: the section's turn w (R -> Exp(w) R), the moment's and
+  /// the force's derivatives, and the centre's (relative to the end, as the integration's x).
+  std::array<Eigen::Vector3d, kMaxDirections> turn, m, n, x;
+  /// At the root: the residual's derivative per direction.
+  std::array<Eigen::Vector3d, kMaxDirections> residual;
+  /// At the samples, when the caller gives `surface_r_m` (one offset per sample): the derivative
+  /// of the sample's surface point p + R R*^T r (R* the integration's own frame there), relative
+  /// to the root like the samples' positions. surface[k * kMaxDirections + c].
+  std::span<const Eigen::Vector3d> surface_r_m;
+  std::array<Eigen::Vector3d, std::size_t(kMaxDirections) * Rod::kMaxLoads> surface;
+};
+
 Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
                            const Eigen::Matrix3d& Q, const RodSamples& samples) const {
+  return Integrate<0>(loads, order, scale, Q, samples, nullptr);
+}
+
+template <int kMaxDirections>
+Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                           const Eigen::Matrix3d& Q, const RodSamples& samples,
+                           Tangent<kMaxDirections>* tangent) const {
+  constexpr bool kTangent = kMaxDirections > 0;
   const int count = static_cast<int>(order.size());
   const double end = count > 0 ? loads[std::size_t(order[std::size_t(count - 1)])].s_m : 0.0;
   // From the last load back to the clamp: beyond it the moment and force are zero; passing a
@@ -82,6 +112,21 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
     const Eigen::Vector3d t = R.col(2);
     return (v - v.dot(t) * t).norm();
   };
+  int directions = 0;
+  bool force_directions = false;  // whether any direction moves a force (else dn = 0 throughout)
+  if constexpr (kTangent) {
+    directions = tangent->directions;
+    assert(directions <= kMaxDirections && (directions == 3 || directions == 3 + 3 * count));
+    force_directions = directions > 3;
+    for (int c = 0; c < directions; ++c) {
+      const std::size_t cc = std::size_t(c);
+      tangent->turn[cc] =
+          c < 3 ? Eigen::Vector3d(Eigen::Vector3d::Unit(c)) : Eigen::Vector3d::Zero();
+      tangent->m[cc].setZero();
+      tangent->n[cc].setZero();
+      tangent->x[cc].setZero();
+    }
+  }
   const std::size_t sample_count = samples.s_m.size();
   std::size_t beyond = sample_count;  // samples at s > end: straight, set at the end
   while (beyond > 0 && samples.s_m[beyond - 1] > end) --beyond;
@@ -91,17 +136,34 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
       --next_sample;
       samples.p_m[next_sample] = x;
       if (!samples.R.empty()) samples.R[next_sample] = R;
+      if constexpr (kTangent) {
+        if (!tangent->surface_r_m.empty()) {
+          const Eigen::Vector3d& r = tangent->surface_r_m[next_sample];
+          for (int c = 0; c < directions; ++c)
+            tangent->surface[next_sample * kMaxDirections + std::size_t(c)] =
+                tangent->x[std::size_t(c)] + tangent->turn[std::size_t(c)].cross(r);
+        }
+      }
     }
   };
   double s = end;
   int next_load = count - 1;
   for (;;) {
     while (next_load >= 0 && loads[std::size_t(order[std::size_t(next_load)])].s_m >= s) {
-      const RodLoad& load = loads[std::size_t(order[std::size_t(next_load--)])];
+      const int j = order[std::size_t(next_load--)];
+      const RodLoad& load = loads[std::size_t(j)];
       const Eigen::Vector3d f = scale * load.f_N;
       m += load.r_m.cross(f);
       n += f;
       result.max_moment_Nm = std::max(result.max_moment_Nm, perp_norm(m));
+      if constexpr (kTangent) {
+        if (force_directions)
+          for (int c = 0; c < 3; ++c) {
+            const std::size_t cc = std::size_t(3 + 3 * j + c);
+            tangent->n[cc] += scale * Eigen::Vector3d::Unit(c);
+            tangent->m[cc] += scale * load.r_m.cross(Eigen::Vector3d::Unit(c));
+          }
+      }
     }
     record(s);
     if (s <= 0.0) break;
@@ -117,20 +179,80 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
       // here backwards); the step turns the section by h times the curvature there (across the
       // tangent: the rod does not twist).
       const Eigen::Vector3d m_mid = m + 0.5 * h * t.cross(n);
-      const Eigen::Vector3d t_mid = (t - (0.5 * h / EI_) * m_mid.cross(t)).normalized();
-      const Eigen::Vector3d kappa = (m_mid - m_mid.dot(t_mid) * t_mid) / EI_;
-      const Eigen::Matrix3d R_before = Rotation(-h * kappa) * R;
+      const double c_u = 0.5 * h / EI_;
+      const Eigen::Vector3d u = t - c_u * m_mid.cross(t);
+      const double u_norm = u.norm();
+      const Eigen::Vector3d t_mid = u / u_norm;
+      const double m_along = m_mid.dot(t_mid);
+      const Eigen::Vector3d kappa = (m_mid - m_along * t_mid) / EI_;
+      const Eigen::Vector3d turn = -h * kappa;
+      const Eigen::Matrix3d G = Rotation(turn);
+      const Eigen::Matrix3d R_before = G * R;
       const Eigen::Vector3d t_before = R_before.col(2);
       // The chord of an arc of length h whose tangent turns from t_before to t.
       // sin(half) / half with sin(half) = s: s / asin(s) = 1 - s^2/6 - 17 s^4/360 - ..., whose
       // next term is below 1e-10 for turns up to 0.05 rad.
-      const double sin_half = 0.5 * (t - t_before).norm();
-      const double cos_half = 0.5 * (t + t_before).norm();
+      const Eigen::Vector3d t_diff = t - t_before, t_sum = t + t_before;
+      const double sin_half = 0.5 * t_diff.norm();
+      const double cos_half = 0.5 * t_sum.norm();
       const double s2 = sin_half * sin_half;
-      const double chord = s2 < 6.25e-4 ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2)
-                                        : h * sin_half / std::atan2(sin_half, cos_half);
-      const Eigen::Vector3d dx =
-          cos_half > 1e-12 ? Eigen::Vector3d(chord * (t + t_before) / (2.0 * cos_half)) : t * h;
+      const bool series = s2 < 6.25e-4;
+      const double half = series ? 0.0 : std::atan2(sin_half, cos_half);
+      const double chord =
+          series ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2) : h * sin_half / half;
+      const bool arc = cos_half > 1e-12;
+      const Eigen::Vector3d dx = arc ? Eigen::Vector3d(chord * t_sum / (2.0 * cos_half)) : t * h;
+      if constexpr (kTangent) {
+        // The step's linearisation: the same formulas differentiated, in the same order.
+        // d Exp(v) = [J_l(v) dv]x Exp(v), J_l = I + b [v]x + c [v]x^2 with b = (1 - cos)/theta^2
+        // and c = (theta - sin)/theta^3, by series below the same 0.05 rad as Rotation.
+        const double theta2 = turn.squaredNorm();
+        double b, c;
+        if (theta2 < 2.5e-3) {
+          b = 0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0);
+          c = 1.0 / 6.0 - theta2 / 120.0 * (1.0 - theta2 / 42.0);
+        } else {
+          const double theta = std::sqrt(theta2);
+          b = (1.0 - std::cos(theta)) / theta2;
+          c = (theta - std::sin(theta)) / (theta2 * theta);
+        }
+        // d chord / d s2, s2 = sin(half)^2 = |t - t_before|^2 / 4.
+        const double dchord_ds2 =
+            series ? h * (-1.0 / 6.0 - 17.0 / 180.0 * s2)
+                   : h * (half * cos_half - sin_half) / (half * half * 2.0 * sin_half * cos_half);
+        const Eigen::Vector3d along = t_sum / (2.0 * cos_half);  // the chord's direction
+        for (int d = 0; d < directions; ++d) {
+          const std::size_t dd = std::size_t(d);
+          Eigen::Vector3d& w = tangent->turn[dd];
+          Eigen::Vector3d& dm = tangent->m[dd];
+          const Eigen::Vector3d& dn = tangent->n[dd];
+          const Eigen::Vector3d dt = w.cross(t);
+          Eigen::Vector3d dm_mid = dm + 0.5 * h * dt.cross(n);
+          if (force_directions) dm_mid += 0.5 * h * t.cross(dn);
+          const Eigen::Vector3d du = dt - c_u * (dm_mid.cross(t) + m_mid.cross(dt));
+          const Eigen::Vector3d dt_mid = (du - t_mid.dot(du) * t_mid) / u_norm;
+          const Eigen::Vector3d dturn =
+              (-h / EI_) *
+              (dm_mid - (t_mid.dot(dm_mid) + m_mid.dot(dt_mid)) * t_mid - m_along * dt_mid);
+          const Eigen::Vector3d v_x_dturn = turn.cross(dturn);
+          const Eigen::Vector3d w_before =
+              dturn + b * v_x_dturn + c * turn.cross(v_x_dturn) + G * w;
+          const Eigen::Vector3d dt_before = w_before.cross(t_before);
+          Eigen::Vector3d ddx;
+          if (arc) {
+            const double ds2 = 0.5 * t_diff.dot(dt - dt_before);
+            const Eigen::Vector3d dsum = dt + dt_before;
+            const Eigen::Vector3d dalong = (dsum - along.dot(dsum) * along) / (2.0 * cos_half);
+            ddx = dchord_ds2 * ds2 * along + chord * dalong;
+          } else {
+            ddx = h * dt;
+          }
+          dm += ddx.cross(n);
+          if (force_directions) dm += dx.cross(dn);
+          tangent->x[dd] -= ddx;
+          w = w_before;
+        }
+      }
       m += dx.cross(n);  // exact for the chord: equilibrium of the discrete chain
       x -= dx;
       R = R_before;
@@ -153,6 +275,19 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
   result.residual = 2.0 * q.vec();
   result.root_moment = m;
+  if constexpr (kTangent) {
+    // R -> Exp(w) R moves the quaternion by (0, w/2) q to first order: d (2 vec) = q_w w + w x vec.
+    for (int d = 0; d < directions; ++d) {
+      const std::size_t dd = std::size_t(d);
+      const Eigen::Vector3d& w = tangent->turn[dd];
+      tangent->residual[dd] = q.w() * w + w.cross(q.vec());
+    }
+    // The samples' surface points are relative to the root: its motion comes off them.
+    if (!tangent->surface_r_m.empty())
+      for (std::size_t k = 0; k < beyond; ++k)
+        for (int d = 0; d < directions; ++d)
+          tangent->surface[k * kMaxDirections + std::size_t(d)] -= tangent->x[std::size_t(d)];
+  }
   return result;
 }
 
@@ -176,17 +311,28 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     Q = trial;
     result = r;
   }
+  // Newton, its Jacobian carried by the integrations (Tangent): each trial's is the next
+  // iteration's, so an iteration costs one integration with three directions.
+  Tangent<3> tangent;
+  tangent.directions = 3;
+  bool have_jacobian = false;
+  Eigen::Matrix3d J;
+  const auto jacobian = [&] {
+    for (int c = 0; c < 3; ++c) J.col(c) = tangent.residual[std::size_t(c)];
+  };
+  // Converged: the Jacobian at the solution itself (its trial's, free) is handed to the next solve.
+  const auto done = [&] {
+    if (have_jacobian && std::abs(J.determinant()) > 1e-12 && J.allFinite())
+      jacobian_inv = J.inverse();
+    return result.residual.allFinite();
+  };
   for (int it = 0; it < max_iterations; ++it) {
-    if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
+    if (!(result.residual.norm() > kTolerance_rad)) return done();
     ++iterations;
-    constexpr double kDelta_rad = 1e-7;
-    Eigen::Matrix3d J;
-    for (int c = 0; c < 3; ++c)
-      J.col(c) =
-          (Integrate(loads, order, scale, Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, {})
-               .residual -
-           result.residual) /
-          kDelta_rad;
+    if (!have_jacobian) {
+      result = Integrate(loads, order, scale, Q, {}, &tangent);
+      jacobian();
+    }
     const double det = J.determinant();
     if (!(std::abs(det) > 1e-12) || !J.allFinite()) return false;
     jacobian_inv = J.inverse();
@@ -197,17 +343,19 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     bool improved = false;
     for (double lambda = 1.0; lambda > 1.0 / 128.0; lambda *= 0.5) {
       const Eigen::Matrix3d trial = Rotation(lambda * step) * Q;
-      const Result r = Integrate(loads, order, scale, trial, {});
+      const Result r = Integrate(loads, order, scale, trial, {}, &tangent);
       if (r.residual.allFinite() && r.residual.norm() < result.residual.norm()) {
         Q = trial;
         result = r;
+        jacobian();
+        have_jacobian = true;
         improved = true;
         break;
       }
     }
     if (!improved) return false;
   }
-  return !(result.residual.norm() > kTolerance_rad) && result.residual.allFinite();
+  return !(result.residual.norm() > kTolerance_rad) && done();
 }
 
 RodSolution Rod::Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const {
