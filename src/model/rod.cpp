@@ -439,61 +439,41 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
   assert(w.size() >= std::size_t(count * count));
-  // The loads' arc positions in ascending order (the integration's samples) and back.
+  // The loads' arc positions in ascending order (the integration's samples) and their offsets.
   std::array<double, kMaxLoads> s_sorted{};
-  for (int k = 0; k < count; ++k)
+  std::array<Eigen::Vector3d, kMaxLoads> r_sorted;
+  for (int k = 0; k < count; ++k) {
     s_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].s_m;
-  std::array<Eigen::Vector3d, kMaxLoads> p0, p;
-  std::array<Eigen::Matrix3d, kMaxLoads> R0, R;
-  const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
-  const Eigen::Matrix3d& Q = solution.end_R;
-  const Result base = Integrate(
-      loads, sorted, 1.0, Q,
-      {s_span, std::span(p0.data(), std::size_t(count)), std::span(R0.data(), std::size_t(count))});
-  // Surface points of a perturbed integration, in the loads' own order, minus the base ones.
-  const auto surface_motion = [&](int load_index_sorted) {
-    const RodLoad& load = loads[std::size_t(order[std::size_t(load_index_sorted)])];
-    const std::size_t k = std::size_t(load_index_sorted);
-    return Eigen::Vector3d(p[k] - p0[k] +
-                           (R[k] * R0[k].transpose() - Eigen::Matrix3d::Identity()) * load.r_m);
-  };
-  const RodSamples perturbed{s_span, std::span(p.data(), std::size_t(count)),
-                             std::span(R.data(), std::size_t(count))};
-  // With respect to the end section's turn q.
-  constexpr double kDelta_rad = 1e-6;
-  Eigen::Matrix3d E_u;
-  std::array<Eigen::Matrix3d, kMaxLoads> P_u;
-  for (int c = 0; c < 3; ++c) {
-    const Result r = Integrate(loads, sorted, 1.0,
-                               Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, perturbed);
-    E_u.col(c) = (r.residual - base.residual) / kDelta_rad;
-    for (int k = 0; k < count; ++k) P_u[std::size_t(k)].col(c) = surface_motion(k) / kDelta_rad;
+    r_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].r_m;
   }
+  std::array<Eigen::Vector3d, kMaxLoads> p;
+  const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
+  // One integration carries the derivatives along the end's turn q and every force F_j: the
+  // surface points S and the clamp residual e move by dS/dq, dS/dF, de/dq, de/dF.
+  constexpr int kMaxDirections = 3 + 3 * kMaxLoads;
+  Tangent<kMaxDirections> tangent;
+  tangent.directions = 3 + 3 * count;
+  tangent.surface_r_m = std::span<const Eigen::Vector3d>(r_sorted.data(), std::size_t(count));
+  Integrate(loads, sorted, 1.0, solution.end_R,
+            {s_span, std::span(p.data(), std::size_t(count)), {}}, &tangent);
+  Eigen::Matrix3d E_u;
+  for (int c = 0; c < 3; ++c) E_u.col(c) = tangent.residual[std::size_t(c)];
   const double det = E_u.determinant();
   if (!(std::abs(det) > 1e-12) || !E_u.allFinite()) return false;
   const Eigen::Matrix3d E_u_inv = E_u.inverse();
-  // With respect to each load's force, the root moment held.
-  double force_scale = 0.0;
-  for (const RodLoad& load : loads) force_scale += load.f_N.norm();
-  const double end = std::max(count > 0 ? s_sorted[std::size_t(count - 1)] : 0.0, max_step_m_);
-  const double dF = 1e-6 * std::max(force_scale, EI_ / (end * end));
-  std::array<RodLoad, kMaxLoads> shifted{};
-  std::copy(loads.begin(), loads.end(), shifted.begin());
-  const std::span<const RodLoad> shifted_span(shifted.data(), std::size_t(count));
-  for (int kj = 0; kj < count; ++kj) {
-    const int j = order[std::size_t(kj)];
+  for (int j = 0; j < count; ++j)
     for (int c = 0; c < 3; ++c) {
-      shifted[std::size_t(j)].f_N[c] += dF;
-      const Result r = Integrate(shifted_span, sorted, 1.0, Q, perturbed);
-      shifted[std::size_t(j)].f_N[c] = loads[std::size_t(j)].f_N[c];
-      const Eigen::Vector3d e_F = (r.residual - base.residual) / dF;
-      const Eigen::Vector3d u_F = -E_u_inv * e_F;  // the end's turn that keeps the root clamped
+      const std::size_t d = std::size_t(3 + 3 * j + c);
+      // The end's turn that keeps the root clamped as F_j moves.
+      const Eigen::Vector3d u_F = -E_u_inv * tangent.residual[d];
       for (int ki = 0; ki < count; ++ki) {
+        const std::size_t at = std::size_t(ki) * kMaxDirections;
         const int i = order[std::size_t(ki)];
-        w[std::size_t(i * count + j)].col(c) = surface_motion(ki) / dF + P_u[std::size_t(ki)] * u_F;
+        w[std::size_t(i * count + j)].col(c) =
+            tangent.surface[at + d] + tangent.surface[at + 0] * u_F.x() +
+            tangent.surface[at + 1] * u_F.y() + tangent.surface[at + 2] * u_F.z();
       }
     }
-  }
   for (int k = 0; k < count * count; ++k)
     if (!w[std::size_t(k)].allFinite()) return false;
   return true;

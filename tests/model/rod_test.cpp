@@ -130,8 +130,8 @@ TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the b
   // A cantilever under an axial force P has the lateral tip compliance
   //   compression: (tan(k l) - k l) / (k^3 E I),  tension: (k l - tanh(k l)) / (k^3 E I),
   // k = sqrt(P / (E I)) (Timoshenko & Gere, beam-columns), l^3 / (3 E I) without P; the rod is
-  // inextensible, so the axial compliance is zero. The compliance is by differences of the
-  // shooting map (relative steps 1e-6): 1e-5 relative covers them.
+  // inextensible, so the axial compliance is zero. The compliance is the discrete map's exact
+  // derivative (its rounding ~1e-13 relative).
   const double EI = 2.0, l = 0.5;
   const Rod rod(EI, l / 400.0);
   const double euler_N = kPi * kPi * EI / (4.0 * l * l);
@@ -161,7 +161,7 @@ TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the b
 TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (Maxwell-Betti)",
           "[rod]") {
   // A bent rod under three loads in 3D, two with offsets (the surface points of a side contact and
-  // a rim). The compliance formula (differences of the shooting map with the root moment
+  // a rim). The compliance formula (derivatives of the shooting map with the root moment
   // eliminated) against central differences of complete solves: another computation of the same
   // derivative. Without offsets the loads are conservative and the compliance is symmetric.
   const double EI = 8.2e-3, l = 0.15;  // the shipped rubber tube
@@ -204,7 +204,9 @@ TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (
           const Eigen::Vector3d r = loads[std::size_t(i)].r_m;
           const Eigen::Vector3d dp =
               ((pp + Rp * R0.transpose() * r) - (pm + Rm * R0.transpose() * r)) / (2.0 * dF);
-          // Forward differences inside the formula (relative 1e-6) and the solves' tolerance.
+          // The central differences' truncation (dF^2 / 6 of third derivatives) and the solves'
+          // tolerance; the formula itself is exact to rounding (it once held forward differences
+          // of relative step 1e-6, for which this tolerance was set).
           CHECK((w[std::size_t(i * 3 + j)].col(c) - dp).norm() < 2e-5 * largest);
         }
       }

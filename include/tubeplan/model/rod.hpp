@@ -90,9 +90,10 @@ class Rod {
 
   /// Tangent compliance at a solution: w[i * count + j] = d p_i / d F_j [m/N] for the surface
   /// points p_i = centre(s_i) + R(s_i) R*(s_i)^T r_i of the loads (R* the solved frame), the end
-  /// frame following the loads so that the rod stays clamped. By differences of the shooting
-  /// map, 3 + 3 count integrations: p_i and the clamp residual e move with the end frame's
-  /// rotation q and with F_j, and d p / d F = dp/dF - dp/dq (de/dq)^-1 de/dF.
+  /// frame following the loads so that the rod stays clamped: p_i and the clamp residual e move
+  /// with the end frame's rotation q and with F_j, and d p / d F = dp/dF - dp/dq (de/dq)^-1
+  /// de/dF, all from one integration carrying the 3 + 3 count directions (exact derivatives of
+  /// the discrete map).
   /// False if the shooting Jacobian is singular (at a bifurcation).
   bool Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
                   std::span<Eigen::Matrix3d> w) const;
