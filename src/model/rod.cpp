@@ -299,7 +299,10 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
   const double kTolerance_rad = 1e-14 * std::max(1.0, end / max_step_m_);
   result = Integrate(loads, order, scale, Q, {});
   // Chord iterations with the Jacobian of an earlier solve, while each at least halves the
-  // residual (a rod loaded a little differently from last tick: two or three suffice).
+  // residual (a rod loaded a little differently from last tick). Each accepted step corrects
+  // the inverse Jacobian by Broyden's rank-one update (the secant through the two iterates), so
+  // the iterations converge superlinearly where the old Jacobian alone contracts only by the
+  // loads' relative change per step.
   for (int it = 0; it < 6 && !jacobian_inv.isZero(0.0); ++it) {
     if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
     Eigen::Vector3d step = -jacobian_inv * result.residual;
@@ -308,6 +311,11 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     const Result r = Integrate(loads, order, scale, trial, {});
     ++iterations;
     if (!(r.residual.norm() < 0.5 * result.residual.norm())) break;
+    // H += (s - H y) s^T H / (s^T H y), y the residual's change over the step s.
+    const Eigen::Vector3d H_y = jacobian_inv * (r.residual - result.residual);
+    const double s_H_y = step.dot(H_y);
+    if (std::abs(s_H_y) > 1e-3 * step.squaredNorm())
+      jacobian_inv += (step - H_y) * (step.transpose() * jacobian_inv) / s_H_y;
     Q = trial;
     result = r;
   }

@@ -48,9 +48,9 @@ struct RodSolution {
   /// the next solve's starting guess.
   Eigen::Matrix3d end_R = Eigen::Matrix3d::Identity();
   /// The inverse Jacobian of the shooting map (clamp residual per turn of the end) at the
-  /// solution, when Newton ran: the next solve's iterations use it while it still contracts (a
-  /// chord method: one plain integration an iteration instead of one carrying the derivatives).
-  /// Zero when there is none.
+  /// solution when Newton ran, else the last one as the chord steps corrected it (Broyden): the
+  /// next solve's iterations use it while it still contracts (a chord method: one plain
+  /// integration an iteration instead of one carrying the derivatives). Zero when there is none.
   Eigen::Matrix3d jacobian_inv = Eigen::Matrix3d::Zero();
   bool converged = false;
   int iterations = 0;          ///< Newton iterations used
