@@ -35,7 +35,7 @@ int SortedOrder(std::span<const RodLoad> loads, Order& order) {
 // The rotation matrix of rotation vector w (Rodrigues). A step of the rod turns by h kappa,
 // rarely more than 0.05 rad: there the series to theta^4 leave out theta^6 / 5040 < 4e-12 and
 // spare the sine and cosine that otherwise dominate the integration's cost.
-Eigen::Matrix3d Rotation(const Eigen::Vector3d& w) {
+inline Eigen::Matrix3d Rotation(const Eigen::Vector3d& w) {
   const double theta2 = w.squaredNorm();
   double a, b;  // sin(theta) / theta, (1 - cos(theta)) / theta^2
   if (theta2 < 2.5e-3) {
@@ -46,9 +46,16 @@ Eigen::Matrix3d Rotation(const Eigen::Vector3d& w) {
     a = std::sin(theta) / theta;
     b = (1.0 - std::cos(theta)) / theta2;
   }
-  Eigen::Matrix3d W;
-  W << 0.0, -w.z(), w.y(), w.z(), 0.0, -w.x(), -w.y(), w.x(), 0.0;
-  return Eigen::Matrix3d::Identity() + a * W + b * (W * W);
+  // I + a W + b W^2 with W^2 = w w^T - theta^2 I, entry by entry: a third of the products of
+  // forming W^2 (a rotation a step, the integration's largest cost after the frame's product).
+  const double diagonal = 1.0 - b * theta2;
+  const double bxy = b * w.x() * w.y(), bxz = b * w.x() * w.z(), byz = b * w.y() * w.z();
+  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
+  Eigen::Matrix3d G;
+  G << diagonal + b * w.x() * w.x(), bxy - az, bxz + ay,  //
+      bxy + az, diagonal + b * w.y() * w.y(), byz - ax,   //
+      bxz - ay, byz + ax, diagonal + b * w.z() * w.z();
+  return G;
 }
 
 // The largest moment the loads can make about the clamp (each force by its lever along the
@@ -67,8 +74,38 @@ Rod::Rod(double bending_stiffness_Nm2, double max_step_m)
     throw std::invalid_argument("Rod: bending stiffness and step must be positive and finite");
 }
 
+// Forward sensitivities: the linearisation of each step of the integration applied to a set of
+// directions of its inputs alongside it. They are the derivatives of the discrete map itself (not
+// of the continuous rod), so Newton on them converges as on the exact Jacobian and the compliance
+// is the discrete chain's; one integration carries them all, where differences took one per
+// direction. Direction c < 3 turns the end section by the unit turn about axis c (Q -> Exp(e_c) Q,
+// clamp frame, as Newton's step); direction 3 + 3 j + c, when asked for, moves load j's force
+// (its index in the caller's span) along axis c by a unit at the integration's scale.
+template <int kMaxDirections>
+struct Rod::Tangent {
+  int directions = 0;  ///< 3 (the end's turn), or 3 + 3 count (and each load's force)
+  /// Per direction, at the current node: the section's turn w (R -> Exp(w) R), the moment's and
+  /// the force's derivatives, and the centre's (relative to the end, as the integration's x).
+  std::array<Eigen::Vector3d, kMaxDirections> turn, m, n, x;
+  /// At the root: the residual's derivative per direction.
+  std::array<Eigen::Vector3d, kMaxDirections> residual;
+  /// At the samples, when the caller gives `surface_r_m` (one offset per sample): the derivative
+  /// of the sample's surface point p + R R*^T r (R* the integration's own frame there), relative
+  /// to the root like the samples' positions. surface[k * kMaxDirections + c].
+  std::span<const Eigen::Vector3d> surface_r_m;
+  std::array<Eigen::Vector3d, std::size_t(kMaxDirections) * Rod::kMaxLoads> surface;
+};
+
 Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
                            const Eigen::Matrix3d& Q, const RodSamples& samples) const {
+  return Integrate<0>(loads, order, scale, Q, samples, nullptr);
+}
+
+template <int kMaxDirections>
+Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                           const Eigen::Matrix3d& Q, const RodSamples& samples,
+                           Tangent<kMaxDirections>* tangent) const {
+  constexpr bool kTangent = kMaxDirections > 0;
   const int count = static_cast<int>(order.size());
   const double end = count > 0 ? loads[std::size_t(order[std::size_t(count - 1)])].s_m : 0.0;
   // From the last load back to the clamp: beyond it the moment and force are zero; passing a
@@ -82,6 +119,21 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
     const Eigen::Vector3d t = R.col(2);
     return (v - v.dot(t) * t).norm();
   };
+  int directions = 0;
+  bool force_directions = false;  // whether any direction moves a force (else dn = 0 throughout)
+  if constexpr (kTangent) {
+    directions = tangent->directions;
+    assert(directions <= kMaxDirections && (directions == 3 || directions == 3 + 3 * count));
+    force_directions = directions > 3;
+    for (int c = 0; c < directions; ++c) {
+      const std::size_t cc = std::size_t(c);
+      tangent->turn[cc] =
+          c < 3 ? Eigen::Vector3d(Eigen::Vector3d::Unit(c)) : Eigen::Vector3d::Zero();
+      tangent->m[cc].setZero();
+      tangent->n[cc].setZero();
+      tangent->x[cc].setZero();
+    }
+  }
   const std::size_t sample_count = samples.s_m.size();
   std::size_t beyond = sample_count;  // samples at s > end: straight, set at the end
   while (beyond > 0 && samples.s_m[beyond - 1] > end) --beyond;
@@ -91,17 +143,34 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
       --next_sample;
       samples.p_m[next_sample] = x;
       if (!samples.R.empty()) samples.R[next_sample] = R;
+      if constexpr (kTangent) {
+        if (!tangent->surface_r_m.empty()) {
+          const Eigen::Vector3d& r = tangent->surface_r_m[next_sample];
+          for (int c = 0; c < directions; ++c)
+            tangent->surface[next_sample * kMaxDirections + std::size_t(c)] =
+                tangent->x[std::size_t(c)] + tangent->turn[std::size_t(c)].cross(r);
+        }
+      }
     }
   };
   double s = end;
   int next_load = count - 1;
   for (;;) {
     while (next_load >= 0 && loads[std::size_t(order[std::size_t(next_load)])].s_m >= s) {
-      const RodLoad& load = loads[std::size_t(order[std::size_t(next_load--)])];
+      const int j = order[std::size_t(next_load--)];
+      const RodLoad& load = loads[std::size_t(j)];
       const Eigen::Vector3d f = scale * load.f_N;
       m += load.r_m.cross(f);
       n += f;
       result.max_moment_Nm = std::max(result.max_moment_Nm, perp_norm(m));
+      if constexpr (kTangent) {
+        if (force_directions)
+          for (int c = 0; c < 3; ++c) {
+            const std::size_t cc = std::size_t(3 + 3 * j + c);
+            tangent->n[cc] += scale * Eigen::Vector3d::Unit(c);
+            tangent->m[cc] += scale * load.r_m.cross(Eigen::Vector3d::Unit(c));
+          }
+      }
     }
     record(s);
     if (s <= 0.0) break;
@@ -117,20 +186,80 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
       // here backwards); the step turns the section by h times the curvature there (across the
       // tangent: the rod does not twist).
       const Eigen::Vector3d m_mid = m + 0.5 * h * t.cross(n);
-      const Eigen::Vector3d t_mid = (t - (0.5 * h / EI_) * m_mid.cross(t)).normalized();
-      const Eigen::Vector3d kappa = (m_mid - m_mid.dot(t_mid) * t_mid) / EI_;
-      const Eigen::Matrix3d R_before = Rotation(-h * kappa) * R;
+      const double c_u = 0.5 * h / EI_;
+      const Eigen::Vector3d u = t - c_u * m_mid.cross(t);
+      const double u_norm = u.norm();
+      const Eigen::Vector3d t_mid = u / u_norm;
+      const double m_along = m_mid.dot(t_mid);
+      const Eigen::Vector3d kappa = (m_mid - m_along * t_mid) / EI_;
+      const Eigen::Vector3d turn = -h * kappa;
+      const Eigen::Matrix3d G = Rotation(turn);
+      const Eigen::Matrix3d R_before = G * R;
       const Eigen::Vector3d t_before = R_before.col(2);
       // The chord of an arc of length h whose tangent turns from t_before to t.
       // sin(half) / half with sin(half) = s: s / asin(s) = 1 - s^2/6 - 17 s^4/360 - ..., whose
       // next term is below 1e-10 for turns up to 0.05 rad.
-      const double sin_half = 0.5 * (t - t_before).norm();
-      const double cos_half = 0.5 * (t + t_before).norm();
+      const Eigen::Vector3d t_diff = t - t_before, t_sum = t + t_before;
+      const double sin_half = 0.5 * t_diff.norm();
+      const double cos_half = 0.5 * t_sum.norm();
       const double s2 = sin_half * sin_half;
-      const double chord = s2 < 6.25e-4 ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2)
-                                        : h * sin_half / std::atan2(sin_half, cos_half);
-      const Eigen::Vector3d dx =
-          cos_half > 1e-12 ? Eigen::Vector3d(chord * (t + t_before) / (2.0 * cos_half)) : t * h;
+      const bool series = s2 < 6.25e-4;
+      const double half = series ? 0.0 : std::atan2(sin_half, cos_half);
+      const double chord =
+          series ? h * (1.0 - s2 / 6.0 - 17.0 / 360.0 * s2 * s2) : h * sin_half / half;
+      const bool arc = cos_half > 1e-12;
+      const Eigen::Vector3d dx = arc ? Eigen::Vector3d(chord * t_sum / (2.0 * cos_half)) : t * h;
+      if constexpr (kTangent) {
+        // The step's linearisation: the same formulas differentiated, in the same order.
+        // d Exp(v) = [J_l(v) dv]x Exp(v), J_l = I + b [v]x + c [v]x^2 with b = (1 - cos)/theta^2
+        // and c = (theta - sin)/theta^3, by series below the same 0.05 rad as Rotation.
+        const double theta2 = turn.squaredNorm();
+        double b, c;
+        if (theta2 < 2.5e-3) {
+          b = 0.5 - theta2 / 24.0 * (1.0 - theta2 / 30.0);
+          c = 1.0 / 6.0 - theta2 / 120.0 * (1.0 - theta2 / 42.0);
+        } else {
+          const double theta = std::sqrt(theta2);
+          b = (1.0 - std::cos(theta)) / theta2;
+          c = (theta - std::sin(theta)) / (theta2 * theta);
+        }
+        // d chord / d s2, s2 = sin(half)^2 = |t - t_before|^2 / 4.
+        const double dchord_ds2 =
+            series ? h * (-1.0 / 6.0 - 17.0 / 180.0 * s2)
+                   : h * (half * cos_half - sin_half) / (half * half * 2.0 * sin_half * cos_half);
+        const Eigen::Vector3d along = t_sum / (2.0 * cos_half);  // the chord's direction
+        for (int d = 0; d < directions; ++d) {
+          const std::size_t dd = std::size_t(d);
+          Eigen::Vector3d& w = tangent->turn[dd];
+          Eigen::Vector3d& dm = tangent->m[dd];
+          const Eigen::Vector3d& dn = tangent->n[dd];
+          const Eigen::Vector3d dt = w.cross(t);
+          Eigen::Vector3d dm_mid = dm + 0.5 * h * dt.cross(n);
+          if (force_directions) dm_mid += 0.5 * h * t.cross(dn);
+          const Eigen::Vector3d du = dt - c_u * (dm_mid.cross(t) + m_mid.cross(dt));
+          const Eigen::Vector3d dt_mid = (du - t_mid.dot(du) * t_mid) / u_norm;
+          const Eigen::Vector3d dturn =
+              (-h / EI_) *
+              (dm_mid - (t_mid.dot(dm_mid) + m_mid.dot(dt_mid)) * t_mid - m_along * dt_mid);
+          const Eigen::Vector3d v_x_dturn = turn.cross(dturn);
+          const Eigen::Vector3d w_before =
+              dturn + b * v_x_dturn + c * turn.cross(v_x_dturn) + G * w;
+          const Eigen::Vector3d dt_before = w_before.cross(t_before);
+          Eigen::Vector3d ddx;
+          if (arc) {
+            const double ds2 = 0.5 * t_diff.dot(dt - dt_before);
+            const Eigen::Vector3d dsum = dt + dt_before;
+            const Eigen::Vector3d dalong = (dsum - along.dot(dsum) * along) / (2.0 * cos_half);
+            ddx = dchord_ds2 * ds2 * along + chord * dalong;
+          } else {
+            ddx = h * dt;
+          }
+          dm += ddx.cross(n);
+          if (force_directions) dm += dx.cross(dn);
+          tangent->x[dd] -= ddx;
+          w = w_before;
+        }
+      }
       m += dx.cross(n);  // exact for the chord: equilibrium of the discrete chain
       x -= dx;
       R = R_before;
@@ -153,6 +282,19 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
   if (q.w() < 0.0) q.coeffs() = -q.coeffs();
   result.residual = 2.0 * q.vec();
   result.root_moment = m;
+  if constexpr (kTangent) {
+    // R -> Exp(w) R moves the quaternion by (0, w/2) q to first order: d (2 vec) = q_w w + w x vec.
+    for (int d = 0; d < directions; ++d) {
+      const std::size_t dd = std::size_t(d);
+      const Eigen::Vector3d& w = tangent->turn[dd];
+      tangent->residual[dd] = q.w() * w + w.cross(q.vec());
+    }
+    // The samples' surface points are relative to the root: its motion comes off them.
+    if (!tangent->surface_r_m.empty())
+      for (std::size_t k = 0; k < beyond; ++k)
+        for (int d = 0; d < directions; ++d)
+          tangent->surface[k * kMaxDirections + std::size_t(d)] -= tangent->x[std::size_t(d)];
+  }
   return result;
 }
 
@@ -164,7 +306,10 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
   const double kTolerance_rad = 1e-14 * std::max(1.0, end / max_step_m_);
   result = Integrate(loads, order, scale, Q, {});
   // Chord iterations with the Jacobian of an earlier solve, while each at least halves the
-  // residual (a rod loaded a little differently from last tick: two or three suffice).
+  // residual (a rod loaded a little differently from last tick). Each accepted step corrects
+  // the inverse Jacobian by Broyden's rank-one update (the secant through the two iterates), so
+  // the iterations converge superlinearly where the old Jacobian alone contracts only by the
+  // loads' relative change per step.
   for (int it = 0; it < 6 && !jacobian_inv.isZero(0.0); ++it) {
     if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
     Eigen::Vector3d step = -jacobian_inv * result.residual;
@@ -173,20 +318,36 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     const Result r = Integrate(loads, order, scale, trial, {});
     ++iterations;
     if (!(r.residual.norm() < 0.5 * result.residual.norm())) break;
+    // H += (s - H y) s^T H / (s^T H y), y the residual's change over the step s.
+    const Eigen::Vector3d H_y = jacobian_inv * (r.residual - result.residual);
+    const double s_H_y = step.dot(H_y);
+    if (std::abs(s_H_y) > 1e-3 * step.squaredNorm())
+      jacobian_inv += (step - H_y) * (step.transpose() * jacobian_inv) / s_H_y;
     Q = trial;
     result = r;
   }
+  // Newton, its Jacobian carried by the integrations (Tangent): each trial's is the next
+  // iteration's, so an iteration costs one integration with three directions.
+  Tangent<3> tangent;
+  tangent.directions = 3;
+  bool have_jacobian = false;
+  Eigen::Matrix3d J;
+  const auto jacobian = [&] {
+    for (int c = 0; c < 3; ++c) J.col(c) = tangent.residual[std::size_t(c)];
+  };
+  // Converged: the Jacobian at the solution itself (its trial's, free) is handed to the next solve.
+  const auto done = [&] {
+    if (have_jacobian && std::abs(J.determinant()) > 1e-12 && J.allFinite())
+      jacobian_inv = J.inverse();
+    return result.residual.allFinite();
+  };
   for (int it = 0; it < max_iterations; ++it) {
-    if (!(result.residual.norm() > kTolerance_rad)) return result.residual.allFinite();
+    if (!(result.residual.norm() > kTolerance_rad)) return done();
     ++iterations;
-    constexpr double kDelta_rad = 1e-7;
-    Eigen::Matrix3d J;
-    for (int c = 0; c < 3; ++c)
-      J.col(c) =
-          (Integrate(loads, order, scale, Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, {})
-               .residual -
-           result.residual) /
-          kDelta_rad;
+    if (!have_jacobian) {
+      result = Integrate(loads, order, scale, Q, {}, &tangent);
+      jacobian();
+    }
     const double det = J.determinant();
     if (!(std::abs(det) > 1e-12) || !J.allFinite()) return false;
     jacobian_inv = J.inverse();
@@ -197,17 +358,19 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     bool improved = false;
     for (double lambda = 1.0; lambda > 1.0 / 128.0; lambda *= 0.5) {
       const Eigen::Matrix3d trial = Rotation(lambda * step) * Q;
-      const Result r = Integrate(loads, order, scale, trial, {});
+      const Result r = Integrate(loads, order, scale, trial, {}, &tangent);
       if (r.residual.allFinite() && r.residual.norm() < result.residual.norm()) {
         Q = trial;
         result = r;
+        jacobian();
+        have_jacobian = true;
         improved = true;
         break;
       }
     }
     if (!improved) return false;
   }
-  return !(result.residual.norm() > kTolerance_rad) && result.residual.allFinite();
+  return !(result.residual.norm() > kTolerance_rad) && done();
 }
 
 RodSolution Rod::Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const {
@@ -291,61 +454,41 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
   assert(w.size() >= std::size_t(count * count));
-  // The loads' arc positions in ascending order (the integration's samples) and back.
+  // The loads' arc positions in ascending order (the integration's samples) and their offsets.
   std::array<double, kMaxLoads> s_sorted{};
-  for (int k = 0; k < count; ++k)
+  std::array<Eigen::Vector3d, kMaxLoads> r_sorted;
+  for (int k = 0; k < count; ++k) {
     s_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].s_m;
-  std::array<Eigen::Vector3d, kMaxLoads> p0, p;
-  std::array<Eigen::Matrix3d, kMaxLoads> R0, R;
-  const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
-  const Eigen::Matrix3d& Q = solution.end_R;
-  const Result base = Integrate(
-      loads, sorted, 1.0, Q,
-      {s_span, std::span(p0.data(), std::size_t(count)), std::span(R0.data(), std::size_t(count))});
-  // Surface points of a perturbed integration, in the loads' own order, minus the base ones.
-  const auto surface_motion = [&](int load_index_sorted) {
-    const RodLoad& load = loads[std::size_t(order[std::size_t(load_index_sorted)])];
-    const std::size_t k = std::size_t(load_index_sorted);
-    return Eigen::Vector3d(p[k] - p0[k] +
-                           (R[k] * R0[k].transpose() - Eigen::Matrix3d::Identity()) * load.r_m);
-  };
-  const RodSamples perturbed{s_span, std::span(p.data(), std::size_t(count)),
-                             std::span(R.data(), std::size_t(count))};
-  // With respect to the end section's turn q.
-  constexpr double kDelta_rad = 1e-6;
-  Eigen::Matrix3d E_u;
-  std::array<Eigen::Matrix3d, kMaxLoads> P_u;
-  for (int c = 0; c < 3; ++c) {
-    const Result r = Integrate(loads, sorted, 1.0,
-                               Rotation(kDelta_rad * Eigen::Vector3d::Unit(c)) * Q, perturbed);
-    E_u.col(c) = (r.residual - base.residual) / kDelta_rad;
-    for (int k = 0; k < count; ++k) P_u[std::size_t(k)].col(c) = surface_motion(k) / kDelta_rad;
+    r_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].r_m;
   }
+  std::array<Eigen::Vector3d, kMaxLoads> p;
+  const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
+  // One integration carries the derivatives along the end's turn q and every force F_j: the
+  // surface points S and the clamp residual e move by dS/dq, dS/dF, de/dq, de/dF.
+  constexpr int kMaxDirections = 3 + 3 * kMaxLoads;
+  Tangent<kMaxDirections> tangent;
+  tangent.directions = 3 + 3 * count;
+  tangent.surface_r_m = std::span<const Eigen::Vector3d>(r_sorted.data(), std::size_t(count));
+  Integrate(loads, sorted, 1.0, solution.end_R,
+            {s_span, std::span(p.data(), std::size_t(count)), {}}, &tangent);
+  Eigen::Matrix3d E_u;
+  for (int c = 0; c < 3; ++c) E_u.col(c) = tangent.residual[std::size_t(c)];
   const double det = E_u.determinant();
   if (!(std::abs(det) > 1e-12) || !E_u.allFinite()) return false;
   const Eigen::Matrix3d E_u_inv = E_u.inverse();
-  // With respect to each load's force, the root moment held.
-  double force_scale = 0.0;
-  for (const RodLoad& load : loads) force_scale += load.f_N.norm();
-  const double end = std::max(count > 0 ? s_sorted[std::size_t(count - 1)] : 0.0, max_step_m_);
-  const double dF = 1e-6 * std::max(force_scale, EI_ / (end * end));
-  std::array<RodLoad, kMaxLoads> shifted{};
-  std::copy(loads.begin(), loads.end(), shifted.begin());
-  const std::span<const RodLoad> shifted_span(shifted.data(), std::size_t(count));
-  for (int kj = 0; kj < count; ++kj) {
-    const int j = order[std::size_t(kj)];
+  for (int j = 0; j < count; ++j)
     for (int c = 0; c < 3; ++c) {
-      shifted[std::size_t(j)].f_N[c] += dF;
-      const Result r = Integrate(shifted_span, sorted, 1.0, Q, perturbed);
-      shifted[std::size_t(j)].f_N[c] = loads[std::size_t(j)].f_N[c];
-      const Eigen::Vector3d e_F = (r.residual - base.residual) / dF;
-      const Eigen::Vector3d u_F = -E_u_inv * e_F;  // the end's turn that keeps the root clamped
+      const std::size_t d = std::size_t(3 + 3 * j + c);
+      // The end's turn that keeps the root clamped as F_j moves.
+      const Eigen::Vector3d u_F = -E_u_inv * tangent.residual[d];
       for (int ki = 0; ki < count; ++ki) {
+        const std::size_t at = std::size_t(ki) * kMaxDirections;
         const int i = order[std::size_t(ki)];
-        w[std::size_t(i * count + j)].col(c) = surface_motion(ki) / dF + P_u[std::size_t(ki)] * u_F;
+        w[std::size_t(i * count + j)].col(c) =
+            tangent.surface[at + d] + tangent.surface[at + 0] * u_F.x() +
+            tangent.surface[at + 1] * u_F.y() + tangent.surface[at + 2] * u_F.z();
       }
     }
-  }
   for (int k = 0; k < count * count; ++k)
     if (!w[std::size_t(k)].allFinite()) return false;
   return true;

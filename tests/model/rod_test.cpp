@@ -130,8 +130,8 @@ TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the b
   // A cantilever under an axial force P has the lateral tip compliance
   //   compression: (tan(k l) - k l) / (k^3 E I),  tension: (k l - tanh(k l)) / (k^3 E I),
   // k = sqrt(P / (E I)) (Timoshenko & Gere, beam-columns), l^3 / (3 E I) without P; the rod is
-  // inextensible, so the axial compliance is zero. The compliance is by differences of the
-  // shooting map (relative steps 1e-6): 1e-5 relative covers them.
+  // inextensible, so the axial compliance is zero. The compliance is the discrete map's exact
+  // derivative (its rounding ~1e-13 relative).
   const double EI = 2.0, l = 0.5;
   const Rod rod(EI, l / 400.0);
   const double euler_N = kPi * kPi * EI / (4.0 * l * l);
@@ -161,7 +161,7 @@ TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the b
 TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (Maxwell-Betti)",
           "[rod]") {
   // A bent rod under three loads in 3D, two with offsets (the surface points of a side contact and
-  // a rim). The compliance formula (differences of the shooting map with the root moment
+  // a rim). The compliance formula (derivatives of the shooting map with the root moment
   // eliminated) against central differences of complete solves: another computation of the same
   // derivative. Without offsets the loads are conservative and the compliance is symmetric.
   const double EI = 8.2e-3, l = 0.15;  // the shipped rubber tube
@@ -204,7 +204,9 @@ TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (
           const Eigen::Vector3d r = loads[std::size_t(i)].r_m;
           const Eigen::Vector3d dp =
               ((pp + Rp * R0.transpose() * r) - (pm + Rm * R0.transpose() * r)) / (2.0 * dF);
-          // Forward differences inside the formula (relative 1e-6) and the solves' tolerance.
+          // The central differences' truncation (dF^2 / 6 of third derivatives) and the solves'
+          // tolerance; the formula itself is exact to rounding (it once held forward differences
+          // of relative step 1e-6, for which this tolerance was set).
           CHECK((w[std::size_t(i * 3 + j)].col(c) - dp).norm() < 2e-5 * largest);
         }
       }
@@ -275,4 +277,70 @@ TEST_CASE("Rod: no load, no bending; small loads give the linear cantilever", "[
   rod.Shape(couple, c, RodSamples{s, p, {}});
   // Moment -r F about y bends the tip towards -x: x = -r F l^2 / (2 E I).
   CHECK(p[0].x() == Approx(-r * F / 2.0).epsilon(1e-6));
+}
+
+TEST_CASE("Rod: the shooting map's Jacobian (forward sensitivities) equals its central differences",
+          "[rod]") {
+  // Newton's Jacobian is carried through the integration (the derivative of each discrete step)
+  // and handed on, inverted, in RodSolution::jacobian_inv, at the solution: a solve from a
+  // nearby end frame without a Jacobian (no chord steps, no continuation) is Newton's alone.
+  // The shooting map
+  // itself is reachable through Shape: the section frame at s = 0 for a given end frame, the
+  // residual twice its quaternion's vector part. Central differences of that map: with turns of
+  // 1e-5 their truncation (delta^2 / 6 times third derivatives of order alpha <= 10) is ~2e-10
+  // and their rounding (1e-16 per step, <= 200 steps, over 1e-5) ~2e-9 of |J| ~ 1 (measured:
+  // 4e-12 and 7e-10): 1e-7 holds both. Two rods: the rubber tube under three loads in 3D with
+  // offsets (steps of l/200, the small-turn series), and a unit rod at alpha = 9.5 in 20 steps
+  // (turns of ~0.4 rad a step: the trigonometric branches), where a term left out of the
+  // linearisation shows (measured: the chord's change of length 3e-4, the second-order term of
+  // the turn's Jacobian 2e-3).
+  const auto residual = [](const Rod& rod, const std::vector<RodLoad>& loads,
+                           const RodSolution& solution, const Eigen::Matrix3d& end_R) {
+    RodSolution moved = solution;
+    moved.end_R = end_R;
+    std::array<double, 1> s{0.0};
+    std::array<Eigen::Vector3d, 1> p;
+    std::array<Eigen::Matrix3d, 1> R;
+    rod.Shape(loads, moved, RodSamples{s, p, R});
+    Eigen::Quaterniond q(R[0]);
+    if (q.w() < 0.0) q.coeffs() = -q.coeffs();
+    return Eigen::Vector3d(2.0 * q.vec());
+  };
+  const double l = 0.15;
+  struct Case {
+    Rod rod;
+    std::vector<RodLoad> loads;
+  };
+  const std::array<Case, 2> cases{
+      Case{Rod(8.2e-3, l / 200.0),
+           {{0.05, Eigen::Vector3d(0.05, -0.02, 0.01), Eigen::Vector3d(-0.008, 0, 0)},
+            {0.11, Eigen::Vector3d(-0.02, 0.04, -0.03), Eigen::Vector3d::Zero()},
+            {0.15, Eigen::Vector3d(0.03, 0.01, -0.05), Eigen::Vector3d(0, 0.008, 0)}}},
+      Case{Rod(1.0, 1.0 / 20.0), {At(1.0, Eigen::Vector3d(9.0, 0.0, 3.0))}}};
+  for (const Case& c : cases) {
+    INFO("steps of " << c.rod.max_step_m() << " m");
+    std::vector<RodLoad> nearby = c.loads;
+    for (RodLoad& load : nearby) load.f_N *= 0.98;
+    const RodSolution start = c.rod.Solve(nearby, Eigen::Matrix3d::Identity());
+    REQUIRE(start.converged);
+    const RodSolution solution = c.rod.Solve(c.loads, start.end_R);
+    REQUIRE(solution.converged);
+    REQUIRE(solution.iterations > 0);  // Newton ran: the Jacobian is its own
+    REQUIRE(std::abs(solution.jacobian_inv.determinant()) > 0.0);
+    const Eigen::Matrix3d J = solution.jacobian_inv.inverse();
+    constexpr double kDelta_rad = 1e-5;
+    Eigen::Matrix3d J_differences;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d turn = kDelta_rad * Eigen::Vector3d::Unit(k);
+      const Eigen::Matrix3d plus =
+          Eigen::AngleAxisd(turn.norm(), turn.normalized()).toRotationMatrix() * solution.end_R;
+      const Eigen::Matrix3d minus =
+          Eigen::AngleAxisd(-turn.norm(), turn.normalized()).toRotationMatrix() * solution.end_R;
+      J_differences.col(k) =
+          (residual(c.rod, c.loads, solution, plus) - residual(c.rod, c.loads, solution, minus)) /
+          (2.0 * kDelta_rad);
+    }
+    INFO("J\n" << J << "\ndifferences\n" << J_differences);
+    CHECK((J - J_differences).cwiseAbs().maxCoeff() < 1e-7 * J.cwiseAbs().maxCoeff());
+  }
 }

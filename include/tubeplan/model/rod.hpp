@@ -11,10 +11,11 @@
 // The curvature is kappa = m_perp / (E I), the tangent turns as t' = kappa x t. Beyond the last
 // load the moment is exactly zero, so the integration runs from there back to the clamp, and
 // the unknown is the orientation of the section at the last load: Newton on it makes the section
-// at s = 0 the clamp's (a shooting method, its Jacobian by differences). Shooting from the free
-// end is the classical choice for the cantilever: the map from the end's angle to the root's is
-// monotone along the first mode (the pendulum analogy), where shooting from the clamp with the
-// root moment as unknown winds through several modes already at F l^2 / (E I) ~ 15.
+// at s = 0 the clamp's (a shooting method, its Jacobian the exact derivative of the discrete map,
+// carried through the integration step by step). Shooting from the free end is the classical
+// choice for the cantilever: the map from the end's angle to the root's is monotone along the
+// first mode (the pendulum analogy), where shooting from the clamp with the root moment as
+// unknown winds through several modes already at F l^2 / (E I) ~ 15.
 //
 // Discretisation. Steps of at most `max_step_m` between breakpoints (the loads and the arc
 // positions asked for). Each step is an arc: its rotation h kappa(s + h/2) from the moment
@@ -46,9 +47,10 @@ struct RodSolution {
   /// The section frame at the last load (z: tangent), clamp frame: the unknown solved for, and
   /// the next solve's starting guess.
   Eigen::Matrix3d end_R = Eigen::Matrix3d::Identity();
-  /// The inverse Jacobian of the shooting map (clamp residual per turn of the end) where Newton
-  /// last computed it: the next solve's iterations use it while it still contracts (a chord
-  /// method: one integration an iteration instead of four). Zero when there is none.
+  /// The inverse Jacobian of the shooting map (clamp residual per turn of the end) at the
+  /// solution when Newton ran, else the last one as the chord steps corrected it (Broyden): the
+  /// next solve's iterations use it while it still contracts (a chord method: one plain
+  /// integration an iteration instead of one carrying the derivatives). Zero when there is none.
   Eigen::Matrix3d jacobian_inv = Eigen::Matrix3d::Zero();
   bool converged = false;
   int iterations = 0;          ///< Newton iterations used
@@ -88,9 +90,10 @@ class Rod {
 
   /// Tangent compliance at a solution: w[i * count + j] = d p_i / d F_j [m/N] for the surface
   /// points p_i = centre(s_i) + R(s_i) R*(s_i)^T r_i of the loads (R* the solved frame), the end
-  /// frame following the loads so that the rod stays clamped. By differences of the shooting
-  /// map, 3 + 3 count integrations: p_i and the clamp residual e move with the end frame's
-  /// rotation q and with F_j, and d p / d F = dp/dF - dp/dq (de/dq)^-1 de/dF.
+  /// frame following the loads so that the rod stays clamped: p_i and the clamp residual e move
+  /// with the end frame's rotation q and with F_j, and d p / d F = dp/dF - dp/dq (de/dq)^-1
+  /// de/dF, all from one integration carrying the 3 + 3 count directions (exact derivatives of
+  /// the discrete map).
   /// False if the shooting Jacobian is singular (at a bifurcation).
   bool Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
                   std::span<Eigen::Matrix3d> w) const;
@@ -99,7 +102,8 @@ class Rod {
   double max_step_m() const { return max_step_m_; }
 
   static constexpr int kMaxLoads = 16;
-  /// Newton iterations one Solve may spend, continuation included (each ~5 integrations).
+  /// Newton iterations one Solve may spend, continuation included (each one integration
+  /// carrying its Jacobian, ~2.5 plain ones, and more if the step is damped).
   static constexpr int kMaxIterations = 320;
 
  private:
@@ -109,9 +113,16 @@ class Rod {
     double energy_J = 0.0, max_moment_Nm = 0.0;
     Eigen::Vector3d end_p = Eigen::Vector3d::Zero();
   };
+  // The derivatives of an integration along directions of its inputs, carried with it (rod.cpp).
+  template <int kMaxDirections>
+  struct Tangent;
   // Integrates from the last load (frame Q) back to the clamp with the loads scaled by `scale`;
-  // writes the centre (relative to the root's) and frame at the sample positions (ascending).
-  // Loads must be sorted by s (order).
+  // writes the centre (relative to the root's) and frame at the sample positions (ascending), and
+  // the derivatives when `tangent` is given. Loads must be sorted by s (order).
+  template <int kMaxDirections>
+  Result Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
+                   const Eigen::Matrix3d& Q, const RodSamples& samples,
+                   Tangent<kMaxDirections>* tangent) const;
   Result Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
                    const Eigen::Matrix3d& Q, const RodSamples& samples) const;
   bool Newton(std::span<const RodLoad> loads, std::span<const int> order, double scale,
