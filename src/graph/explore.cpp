@@ -96,8 +96,9 @@ struct MotionResult {
   std::vector<Change> changes;
   long ticks = 0;
   int refinements = 0;
-  // For stays of CFs the graph did not have when the motion started: the run's point at or
-  // before the stay's witness, from which a probe of that CF starts (null: none kept).
+  // Per stay: the run's point at or before its witness, from which its CF's probe can start,
+  // kept for the first stay of each CF (refined or not) that could become that probe's start
+  // (Merger::MayEnter); null for the others.
   std::vector<RunPointPtr> stay_points;
 };
 
