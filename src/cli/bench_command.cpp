@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -30,6 +31,7 @@ namespace {
 struct BenchOptions {
   std::string scene_path = "scenes/groove.yaml";
   bool beam_only = false;
+  std::vector<std::string> only;  // name prefixes; empty: every scenario
   int samples = 2000;
   bool json = false;
 };
@@ -270,6 +272,24 @@ int RunBench(const BenchOptions& o, Streams io) {
     std::vector<Scenario> core_scenarios = MakeCoreScenarios(*loaded.scene);
     scenarios.insert(scenarios.end(), core_scenarios.begin(), core_scenarios.end());
   }
+  if (!o.only.empty()) {
+    const auto wanted = [&](const Scenario& s) {
+      return std::any_of(o.only.begin(), o.only.end(),
+                         [&](const std::string& p) { return s.name.starts_with(p); });
+    };
+    std::vector<Scenario> kept;
+    for (Scenario& s : scenarios)
+      if (wanted(s)) kept.push_back(std::move(s));
+    if (kept.empty()) {
+      io.err << "tubeplan bench: error: no scenario's name starts with";
+      for (const std::string& p : o.only) io.err << " '" << p << "'";
+      io.err << ", and one was expected; the scenarios are:";
+      for (const Scenario& s : scenarios) io.err << " " << s.name;
+      io.err << "\n";
+      return kExitBadInput;
+    }
+    scenarios = std::move(kept);
+  }
   double sink = 0.0;
   nlohmann::json results = nlohmann::json::array();
   if (!o.json) {
@@ -348,6 +368,9 @@ Command AddBenchCommand(CLI::App& app, Streams streams) {
                   "the scene of the core scenarios and the tube of the beam ones (default "
                   "scenes/groove.yaml, relative to the working directory)");
   sub->add_flag("--beam-only", options->beam_only, "only the beam models' scenarios");
+  sub->add_option("--only", options->only,
+                  "only the scenarios whose names start with this (repeatable), e.g. "
+                  "--only core.end_stuck");
   sub->add_option("--samples", options->samples, "timed samples per scenario")
       ->check(CLI::Range(10, 10000000));
   sub->add_flag("--json", options->json, "print one JSON document (times in microseconds)");
