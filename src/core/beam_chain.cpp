@@ -241,19 +241,17 @@ void BeamChain::ElasticaNodes(const std::array<ElasticaSegment, kMaxLoads>& segm
     const double L = seg.length_m;
     if (!(L > 0.0)) continue;
     constexpr int n = kElasticaSamples;
-    std::array<double, n> s_unit{};
     std::array<Eigen::Vector2d, n> xz{};
-    std::array<double, n> theta{};
-    for (int j = 0; j < n; ++j) s_unit[std::size_t(j)] = double(j) / (n - 1);
-    model::ElasticaCentreline(seg.solution, s_unit, xz, theta);
+    std::array<Eigen::Vector2d, n> tangent_xz{};
+    model::ElasticaSamples(seg.solution, xz, tangent_xz);
     const Eigen::Vector3d x_H = seg.R_HS * seg.bend_x_S;
     const Eigen::Vector3d z_H = seg.R_HS.col(2);
     // The samples' points and unit tangents (d/ds of the position), each computed once: every
-    // node between two samples needs both samples' (a sine and a cosine each).
+    // node between two samples needs both samples'.
     std::array<Eigen::Vector3d, n> point, tangent;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
       point[j] = seg.origin_H + L * (xz[j].x() * x_H + xz[j].y() * z_H);
-      tangent[j] = std::sin(theta[j]) * x_H + std::cos(theta[j]) * z_H;
+      tangent[j] = tangent_xz[j].x() * x_H + tangent_xz[j].y() * z_H;
     }
     const double h = L / (n - 1);
     for (; k < count && step_m * double(k) <= seg.clamp_m + L; ++k) {

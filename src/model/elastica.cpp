@@ -517,41 +517,111 @@ void SolveElliptic(const Loading& load, ElasticaSolution& solution) {
 struct FromTip {
   double along = 0.0;
   double across = 0.0;
-  double theta = 0.0;
+  // A/2 - phi/2 = atan2(gap_y, gap_x), so theta = theta(1) - 2 atan2(gap_y, gap_x); kept as the
+  // pair so that a caller wanting the tangent's sine and cosine needs no atan2 and no sincos.
+  double gap_x = 1.0;
+  double gap_y = 0.0;
 };
+
+double Theta(const ElasticaSolution& solution, const FromTip& f) {
+  return solution.tip.tip_angle_rad - 2.0 * std::atan2(f.gap_y, f.gap_x);
+}
+
+// (sin theta, cos theta) = the unit tangent (dx/ds, dz/ds), by the double-angle formulas.
+Eigen::Vector2d Tangent(double sin_tip, double cos_tip, double gap_x, double gap_y) {
+  const double m = std::max(std::abs(gap_x), std::abs(gap_y));  // > 0: gap_x >= k'^2 > 0
+  const double x = gap_x / m, y = gap_y / m;
+  const double r_sq = x * x + y * y;
+  const double cos_2h = (x * x - y * y) / r_sq;
+  const double sin_2h = 2.0 * x * y / r_sq;
+  return {sin_tip * cos_2h - cos_tip * sin_2h, cos_tip * cos_2h + sin_tip * sin_2h};
+}
+
+// The shape figures from sn, cn, dn at w and D(w) = w - E(w) = int_0^w k^2 sn^2 (Jacobi's
+// epsilon function E): every sample of the shape comes through here, however those were found.
+FromTip FromJacobi(const ElasticaSolution& solution, double sqrt_alpha, double s, double sn,
+                   double cn, double dn, double big_d) {
+  const double k = solution.modulus_k;
+  const double kc = solution.modulus_kc;
+  FromTip out;
+  // int_s^1 sin(phi) = 2 k k' sd(w) / sqrt(alpha);
+  // int_s^1 -cos(phi) = (2 int_0^w k^2 cd^2 - w) / sqrt(alpha) with
+  // int_0^w k^2 cd^2 = D(w) + k^2 sn cd.
+  out.across = 2.0 * k * kc * sn / (dn * sqrt_alpha);
+  const double cd_integral = big_d + k * k * sn * cn / dn;
+  out.along = 2.0 * cd_integral / sqrt_alpha - (1.0 - s);
+  // A/2 - phi/2 = atan(k k' (1 - cn) / (k'^2 + k^2 cn)) with 1 - cn = sn^2 / (1 + cn).
+  out.gap_y = k * kc * sn * sn / (1.0 + cn);
+  out.gap_x = kc * kc + k * k * cn;
+  return out;
+}
+
+// D(z) = z - E(z) = (k^2 / 3) sn^3 R_D(cn^2, dn^2, 1).
+double EpsilonDefect(double k, const Jacobi& j) {
+  return k * k * j.sn * j.sn * j.sn * Rd(j.cn * j.cn, j.dn * j.dn, 1.0) / 3.0;
+}
+
+// sn, cn, dn at w from those at tau = K - w: sn(K - tau) = cd(tau), cn(K - tau) = k' sd(tau),
+// dn(K - tau) = k' nd(tau); and D(K - tau) = D(K) - D(tau) - k^2 sn(tau) cd(tau) (the addition
+// theorem of E), D(K) = (k^2 / 3) R_D(0, k'^2, 1).
+struct Reflected {
+  Jacobi at_w;
+  double big_d = 0.0;
+};
+Reflected Reflect(double k, double kc, const Jacobi& at_tau, double d_tau, double d_complete) {
+  Reflected r;
+  r.at_w.sn = at_tau.cn / at_tau.dn;
+  r.at_w.cn = kc * at_tau.sn / at_tau.dn;
+  r.at_w.dn = kc / at_tau.dn;
+  r.big_d = d_complete - d_tau - k * k * at_tau.sn * r.at_w.sn;
+  return r;
+}
 
 FromTip ShapeFromTip(const ElasticaSolution& solution, const LandenChain& chain, double sqrt_alpha,
                      double tau0, double s) {
   const double k = solution.modulus_k;
-  const double kc = solution.modulus_kc;
   const double w = sqrt_alpha * (1.0 - s);
   const double tau = tau0 + sqrt_alpha * s;  // = K - w
-  Jacobi tipside;                            // sn, cn, dn at w
   if (w <= tau) {
-    tipside = JacobiFunctions(w, chain);
-  } else {
-    // Reflection about K/2: sn(K - tau) = cd(tau), cn(K - tau) = k' sd(tau), dn = k' nd(tau).
-    const Jacobi rootside = JacobiFunctions(tau, chain);
-    tipside.sn = rootside.cn / rootside.dn;
-    tipside.cn = kc * rootside.sn / rootside.dn;
-    tipside.dn = kc / rootside.dn;
+    const Jacobi j = JacobiFunctions(w, chain);
+    return FromJacobi(solution, sqrt_alpha, s, j.sn, j.cn, j.dn, EpsilonDefect(k, j));
   }
-  const double sn = tipside.sn;
-  const double cn = tipside.cn;
-  const double dn = tipside.dn;
-  FromTip out;
-  // int_s^1 sin(phi) = 2 k k' sd(w) / sqrt(alpha);
-  // int_s^1 -cos(phi) = (2 int_0^w k^2 cd^2 - w) / sqrt(alpha) with
-  // int_0^w k^2 cd^2 = (k^2/3) sn^3 R_D(cn^2, dn^2, 1) + k^2 sn cd.
-  out.across = 2.0 * k * kc * sn / (dn * sqrt_alpha);
-  const double cd_integral =
-      k * k * (sn * sn * sn * Rd(cn * cn, dn * dn, 1.0) / 3.0 + sn * cn / dn);
-  out.along = 2.0 * cd_integral / sqrt_alpha - (1.0 - s);
-  // A/2 - phi/2 = atan(k k' (1 - cn) / (k'^2 + k^2 cn)) with 1 - cn = sn^2 / (1 + cn).
-  const double half_gap = std::atan2(k * kc * sn * sn / (1.0 + cn), kc * kc + k * k * cn);
-  out.theta = solution.tip.tip_angle_rad - 2.0 * half_gap;
+  // Reflection about K/2 keeps the Landen forms at arguments <= K/2. D(w) straight from R_D at
+  // the reflected sn, cn, dn: accurate, and one R_D as the direct branch.
+  const Jacobi rootside = JacobiFunctions(tau, chain);
+  Jacobi j;
+  j.sn = rootside.cn / rootside.dn;
+  j.cn = solution.modulus_kc * rootside.sn / rootside.dn;
+  j.dn = solution.modulus_kc / rootside.dn;
+  return FromJacobi(solution, sqrt_alpha, s, j.sn, j.cn, j.dn, EpsilonDefect(k, j));
+}
+
+// sn, cn, dn and D at u + v from those at u and v (the addition theorems). The denominator
+// 1 - k^2 sn^2(u) sn^2(v) is written as cn^2(u) + sn^2(u) dn^2(v), a sum of positive terms; the
+// numerators of cn and dn subtract, losing a factor up to ~exp(2 v) of their relative accuracy
+// as k -> 1, so callers keep v <= 1.
+struct Stepped {
+  Jacobi j;
+  double big_d = 0.0;
+};
+Stepped AddArgument(double k_sq, const Stepped& u, const Stepped& v) {
+  const double su = u.j.sn, cu = u.j.cn, du = u.j.dn;
+  const double sv = v.j.sn, cv = v.j.cn, dv = v.j.dn;
+  const double den = cu * cu + su * su * dv * dv;
+  Stepped out;
+  out.j.sn = (su * cv * dv + sv * cu * du) / den;
+  out.j.cn = (cu * cv - su * sv * du * dv) / den;
+  out.j.dn = (du * dv - k_sq * su * sv * cu * cv) / den;
+  out.big_d = u.big_d + v.big_d + k_sq * su * sv * out.j.sn;
   return out;
 }
+
+// The addition theorems step functions that decay like exp(-u) as k -> 1 (cn, dn): an error
+// made in them grows like exp(2 u) along the walk (measured: 1e-9 of l after a walk of K/2 ~ 8
+// at alpha = 260). So sn, cn and dn are evaluated afresh (Landen) once the walk since the last
+// fresh evaluation reaches kJacobiAnchor, which bounds the growth by exp(2 * 0.5) ~ 2.7; D only
+// adds positive terms made of sn and needs no anchor.
+constexpr double kJacobiAnchor = 0.5;
 
 }  // namespace
 
@@ -627,7 +697,118 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
     const double across = root.across - here.across;
     xz_out[i] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s[i] * error_x,
                                 along * load.sin_psi + across * load.cos_psi + s[i] * error_z);
-    theta_out[i] = (s[i] == 0.0) ? 0.0 : here.theta;
+    theta_out[i] = (s[i] == 0.0) ? 0.0 : Theta(solution, here);
+  }
+}
+
+void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d> xz_out,
+                     std::span<Eigen::Vector2d> tangent_out) {
+  const std::size_t n = xz_out.size();
+  if (tangent_out.size() != n || n < 2) {
+    throw std::invalid_argument(
+        "ElasticaSamples: xz_out and tangent_out must have the same size, at least 2");
+  }
+  const double last = double(n - 1);
+  const auto s_of = [&](std::size_t j) { return j + 1 == n ? 1.0 : double(j) / last; };
+  const ElasticaTip& tip = solution.tip;
+  if (tip.tip_angle_rad == 0.0 && tip.deflection == 0.0) {
+    for (std::size_t j = 0; j < n; ++j) {
+      xz_out[j] = Eigen::Vector2d(0.0, s_of(j));
+      tangent_out[j] = Eigen::Vector2d(0.0, 1.0);
+    }
+    return;
+  }
+  const Loading load = MakeLoading(solution.psi_rad);
+  if (solution.series) {
+    const SeriesShape shape = BuildSeries(solution.alpha, load);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double s = s_of(j);
+      xz_out[j] = Eigen::Vector2d(EvalPolynomial(shape.x, s), s - EvalPolynomial(shape.h, s));
+      const double theta = EvalPolynomial(shape.theta, s);
+      tangent_out[j] = Eigen::Vector2d(std::sin(theta), std::cos(theta));
+    }
+    return;
+  }
+  // The samples' figures from the tip, (along, across) into xz_out and (gap_x, gap_y) into
+  // tangent_out, then turned into positions and tangents below.
+  const double sqrt_alpha = std::sqrt(solution.alpha);
+  const double sin_u0 = std::sin(solution.u0);
+  const double cos_u0 = std::cos(solution.u0);
+  const double tau0 = sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
+  const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
+  const auto store = [&](std::size_t j, const FromTip& f) {
+    xz_out[j] = Eigen::Vector2d(f.along, f.across);
+    tangent_out[j] = Eigen::Vector2d(f.gap_x, f.gap_y);
+  };
+  // The arguments w = sqrt(alpha) (1 - s) (from the tip) and tau = tau0 + sqrt(alpha) s (from the
+  // root) both step by sqrt(alpha) / (n - 1) from sample to sample: the addition theorems carry
+  // sn, cn, dn and D from one sample to the next, so a segment costs two Landen evaluations and
+  // three R_D instead of one of each per sample. Samples with w <= tau step w up from the tip
+  // (w = 0: sn 0, cn 1, dn 1, D 0), the others tau up from the root and are reflected, as in
+  // ShapeFromTip.
+  const double delta = sqrt_alpha / last;
+  const double k = solution.modulus_k, kc = solution.modulus_kc, k_sq = k * k;
+  const double d_complete = k_sq * Rd(0.0, kc * kc, 1.0) / 3.0;  // D(K)
+  const double big_k = tau0 + sqrt_alpha;
+  Stepped step;  // the step's functions, at delta <= K (beyond K/2 by reflection, n = 2 only)
+  if (delta <= 0.5 * big_k) {
+    step.j = JacobiFunctions(delta, chain);
+    step.big_d = EpsilonDefect(k, step.j);
+  } else {
+    Stepped other;
+    other.j = JacobiFunctions(big_k - delta, chain);
+    other.big_d = EpsilonDefect(k, other.j);
+    const Reflected r = Reflect(k, kc, other.j, other.big_d, d_complete);
+    step.j = r.at_w;
+    step.big_d = r.big_d;
+  }
+  // One step forward from `at`, or afresh at `argument` (<= K/2) when the walk since the last
+  // fresh evaluation has reached the anchor spacing (always, for steps longer than it).
+  double walked = 0.0;
+  const auto advance = [&](const Stepped& at, double argument) {
+    Stepped next = AddArgument(k_sq, at, step);
+    walked += delta;
+    if (walked >= kJacobiAnchor) {
+      next.j = JacobiFunctions(argument, chain);
+      walked = 0.0;
+    }
+    return next;
+  };
+  std::size_t first_tip_side = 0;
+  if (sqrt_alpha > tau0) {  // the root sample lies beyond K/2 from the tip: the root side
+    Stepped at_tau;
+    at_tau.j = JacobiFunctions(tau0, chain);  // tau0 < K/2 here, as w + tau = K
+    at_tau.big_d = EpsilonDefect(k, at_tau.j);
+    std::size_t& i = first_tip_side;
+    for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
+      if (i > 0) at_tau = advance(at_tau, tau0 + sqrt_alpha * s_of(i));
+      const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete);
+      store(i, FromJacobi(solution, sqrt_alpha, s_of(i), r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d));
+    }
+  }
+  walked = 0.0;
+  Stepped at_w;  // w = 0 at the tip: sn 0, cn 1, dn 1, D 0
+  for (std::size_t i = n; i-- > first_tip_side;) {
+    if (i + 1 < n) at_w = advance(at_w, sqrt_alpha * (1.0 - s_of(i)));
+    store(i,
+          FromJacobi(solution, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
+  }
+  // As in ElasticaCentreline: positions from the root sample, the closed forms' tiny difference
+  // from the tip figures spread linearly so that s = 0 and s = 1 are both exact.
+  const double root_along = xz_out[0].x(), root_across = xz_out[0].y();
+  const double root_x = root_along * load.cos_psi - root_across * load.sin_psi;
+  const double root_z = root_along * load.sin_psi + root_across * load.cos_psi;
+  const double error_x = tip.deflection - root_x;
+  const double error_z = (1.0 - tip.shortening) - root_z;
+  const double sin_tip = std::sin(tip.tip_angle_rad), cos_tip = std::cos(tip.tip_angle_rad);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double s = s_of(j);
+    const double along = root_along - xz_out[j].x();
+    const double across = root_across - xz_out[j].y();
+    xz_out[j] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s * error_x,
+                                along * load.sin_psi + across * load.cos_psi + s * error_z);
+    tangent_out[j] = j == 0 ? Eigen::Vector2d(0.0, 1.0)
+                            : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
   }
 }
 
