@@ -9,14 +9,15 @@ namespace tubeplan::core {
 namespace {
 
 // The elastica's tip, in the segment's clamp frame, for a load with lateral part fx >= 0 along
-// the bending direction and axial part fz.
-Eigen::Vector2d ElasticaTipXZ(double fx, double fz, double length_m, double EI) {
+// the bending direction and axial part fz; solved from `near`, a solution for a nearby load.
+Eigen::Vector2d ElasticaTipXZ(double fx, double fz, double length_m, double EI,
+                              const model::ElasticaSolution& near) {
   const double f = std::hypot(fx, fz);
   // The callers stay within the solver's range (ElasticaCovers allows half of it); the clamp
   // only guarantees that a tick can never throw.
   const double alpha = std::min(f * length_m * length_m / EI, model::kMaxElasticaAlpha);
   const double psi = f > 0.0 ? std::atan2(fz, fx) : 0.0;
-  const model::ElasticaSolution solution = model::SolveElastica(alpha, psi);
+  const model::ElasticaSolution solution = model::SolveElastica(alpha, psi, &near);
   return {length_m * solution.tip.deflection, length_m * (1.0 - solution.tip.shortening)};
 }
 
@@ -186,8 +187,10 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     const double f = std::hypot(fx, f_S.z());
     const double L = seg.length_m;
     if (L > 0.0) {
+      // The segment's last solution (last tick's, as a rule) is the solve's starting point.
+      const model::ElasticaSolution near = seg.solution;
       seg.solution = model::SolveElastica(std::min(f * L * L / EI_, model::kMaxElasticaAlpha),
-                                          f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0);
+                                          f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0, &near);
     } else {
       seg.solution = model::ElasticaSolution{};
     }
@@ -287,9 +290,11 @@ Eigen::Matrix3d BeamChain::ElasticaCompliance(const ElasticaSegment& segment,
   // plus the load itself: the elastica's ~1e-13 relative accuracy leaves ~1e-7 in the slope.
   const double scale = EI_ / (L * L);
   const double h = 1e-6 * (scale + std::hypot(fx, fz));
-  const Eigen::Vector2d base = ElasticaTipXZ(fx, fz, L, EI_);
-  const Eigen::Vector2d dx = (ElasticaTipXZ(fx + h, fz, L, EI_) - base) / h;
-  const Eigen::Vector2d dz = (ElasticaTipXZ(fx, fz + h, L, EI_) - base) / h;
+  // All three from the segment's own solution, a load at most h away.
+  const model::ElasticaSolution& near = segment.solution;
+  const Eigen::Vector2d base = ElasticaTipXZ(fx, fz, L, EI_, near);
+  const Eigen::Vector2d dx = (ElasticaTipXZ(fx + h, fz, L, EI_, near) - base) / h;
+  const Eigen::Vector2d dz = (ElasticaTipXZ(fx, fz + h, L, EI_, near) - base) / h;
   // Across the bending plane the response is the in-plane one turned about the axis: a small
   // turn phi of the load turns the deflection X by the same phi, so the compliance is X / fx.
   const double across = fx > 1e-9 * scale ? base.x() / fx : dx.x();

@@ -268,7 +268,9 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.elastica_shape = false;
   m.elastica_held_off = false;
   m.held_off_load_N = 0.0;
-  // The rod's starting guesses go too: a replay from here must not depend on what came before.
+  // The elastica's and the rod's starting guesses (their last solutions) go too: a replay from
+  // here must not depend on what came before.
+  m.segments = {};
   m.rod_segments = {};
   m.rod_segment_count = 0;
   m.rod_shape = false;

@@ -194,6 +194,69 @@ Trial BracketedNewton(Eval&& eval, double lo, double hi, double residual_lo, dou
   return trial;
 }
 
+// The residual and its slope in the two unknowns SolveAmplitude uses: p = log t while the tip
+// angle t is below half its range, q = -log y (y = gap - t, exact from k') above it.
+Trial EvalLowAngle(const Loading& load, double log_alpha, double p, double& residual,
+                   double& slope) {
+  const double t = std::exp(p);
+  const Trial trial = MakeTrial(load, t, load.gap - t);
+  residual = Residual(load, trial, log_alpha);
+  slope = t * ResidualSlope(load, trial);
+  return trial;
+}
+Trial EvalHighAngle(const Loading& load, double log_alpha, double q, double& residual,
+                    double& slope) {
+  const double y = std::exp(-q);
+  const Trial trial = MakeTrial(load, load.gap - y, y);
+  residual = Residual(load, trial, log_alpha);
+  slope = y * ResidualSlope(load, trial);
+  return trial;
+}
+
+// Newton from a nearby solution's tip angle (the last tick's, a finite difference's base):
+// the residual increases in t over (0, gap) and has one root there, so where Newton converges
+// it finds the root SolveAmplitude's bracketed search finds, to rounding, in two or three
+// evaluations instead of six to eight. It gives up (false) after kWarmIterations, on a
+// non-positive slope or on leaving (0, gap); the caller then searches from scratch.
+constexpr int kWarmIterations = 6;
+bool SolveAmplitudeFrom(const Loading& load, double alpha, double t_near, double y_near,
+                        RootResult& result) {
+  const double gap = load.gap;
+  const bool low = t_near < 0.5 * gap;
+  // (t rounds to gap where y is below its ulp: only y is checked on that side.)
+  if (low ? !(t_near > 0.0) : !(y_near > 0.0 && y_near < gap)) return false;
+  const double log_alpha = std::log(alpha);
+  double v = low ? std::log(t_near) : -std::log(y_near);
+  const double v_max = low ? std::log(gap) : 1e300;  // t < gap; y > 0 always
+  const double v_min = low ? -1e300 : -std::log(gap);
+  for (int i = 0; i < kWarmIterations; ++i) {
+    double residual = 0.0, slope = 0.0;
+    Trial trial = low ? EvalLowAngle(load, log_alpha, v, residual, slope)
+                      : EvalHighAngle(load, log_alpha, v, residual, slope);
+    ++result.iterations;
+    if (residual == 0.0) {
+      result.trial = trial;
+      return true;
+    }
+    if (!(slope > 0.0) || !std::isfinite(residual)) return false;
+    const double step = residual / slope;
+    const double next = v - step;
+    if (!(next > v_min && next < v_max)) return false;
+    // The same end as BracketedNewton's: after a step this small, one more evaluation.
+    if (std::abs(step) <= 1e-9 * std::max(1.0, std::abs(v))) {
+      if (next != v) {
+        trial = low ? EvalLowAngle(load, log_alpha, next, residual, slope)
+                    : EvalHighAngle(load, log_alpha, next, residual, slope);
+        ++result.iterations;
+      }
+      result.trial = trial;
+      return true;
+    }
+    v = next;
+  }
+  return false;
+}
+
 RootResult SolveAmplitude(const Loading& load, double alpha) {
   RootResult result;
   const double log_alpha = std::log(alpha);
@@ -208,11 +271,7 @@ RootResult SolveAmplitude(const Loading& load, double alpha) {
   if (middle_residual > 0.0) {
     // Tip angle below half its range: unknown p = log t, residual increasing in p.
     auto eval = [&](double p, double& residual, double& slope) {
-      const double t = std::exp(p);
-      const Trial trial = MakeTrial(load, t, gap - t);
-      residual = Residual(load, trial, log_alpha);
-      slope = t * ResidualSlope(load, trial);
-      return trial;
+      return EvalLowAngle(load, log_alpha, p, residual, slope);
     };
     const double hi = std::log(0.5 * gap);
     // Linear theory t = alpha cos(psi) / 2 is a good start; compression amplifies it (so it is
@@ -239,11 +298,7 @@ RootResult SolveAmplitude(const Loading& load, double alpha) {
   } else {
     // Tip nearly along the load: unknown v = -log y, in which the residual increases.
     auto eval = [&](double q, double& residual, double& slope) {
-      const double y = std::exp(-q);
-      const Trial trial = MakeTrial(load, gap - y, y);
-      residual = Residual(load, trial, log_alpha);
-      slope = y * ResidualSlope(load, trial);
-      return trial;
+      return EvalHighAngle(load, log_alpha, q, residual, slope);
     };
     const double lo = -std::log(0.5 * gap);  // residual < 0 here (the middle)
     // Large-alpha asymptotics k' ~ 4 exp(-sqrt(alpha) - atanh(s0)) give the start.
@@ -477,9 +532,32 @@ void SolveSeries(const Loading& load, ElasticaSolution& solution) {
   solution.u0 = std::atan2(load.s0, std::sqrt(std::max(d, 0.0)));
 }
 
-void SolveElliptic(const Loading& load, ElasticaSolution& solution) {
+void SolveElliptic(const Loading& load, ElasticaSolution& solution, const ElasticaSolution* near) {
   const double alpha = solution.alpha;
-  const RootResult root = SolveAmplitude(load, alpha);
+  RootResult root;
+  // A start from a nearby solution, unless it is a series answer or straight (no pendulum), or
+  // the load is pure compression (straight or buckled is decided near Euler's load by the
+  // search from scratch).
+  bool warm = false;
+  if (near && !near->series && near->tip.tip_angle_rad > 0.0 && load.phi0 > 0.0) {
+    // Its tip angle, and its distance y from the load's direction carried to this load's
+    // (k' = sin(y / 2) keeps y exact where t rounds to gap).
+    // Each scaled by how its first-order estimate changes between the two loads: t by linear
+    // theory's alpha cos(psi) / 2, y by the large-alpha asymptote 8 c0 / (1 + s0) e^-sqrt(alpha)
+    // (SolveAmplitude's starts), so that a change of the load's direction is followed as well.
+    const Loading near_load = MakeLoading(near->psi_rad);
+    const double t_near =
+        near->tip.tip_angle_rad * (alpha * load.cos_psi) / (near->alpha * near_load.cos_psi);
+    const double y_near = 2.0 * std::asin(std::min(near->modulus_kc, 1.0)) *
+                          (load.c0 / near_load.c0) * ((1.0 + near_load.s0) / (1.0 + load.s0)) *
+                          std::exp(std::sqrt(near->alpha) - std::sqrt(alpha));
+    warm = SolveAmplitudeFrom(load, alpha, t_near, y_near, root);
+  }
+  if (!warm) {
+    const int tried = root.iterations;
+    root = SolveAmplitude(load, alpha);
+    root.iterations += tried;
+  }
   solution.iterations = root.iterations;
   if (root.straight) return;
   const Trial& tr = root.trial;
@@ -626,6 +704,10 @@ constexpr double kJacobiAnchor = 0.5;
 }  // namespace
 
 ElasticaSolution SolveElastica(double alpha, double psi_rad) {
+  return SolveElastica(alpha, psi_rad, nullptr);
+}
+
+ElasticaSolution SolveElastica(double alpha, double psi_rad, const ElasticaSolution* near) {
   if (!std::isfinite(alpha)) ThrowBad("alpha", alpha, "not finite");
   if (!std::isfinite(psi_rad)) ThrowBad("psi_rad", psi_rad, "not finite");
   if (alpha < 0.0 || alpha > kMaxAlpha) ThrowBad("alpha", alpha, "outside [0, 1e4]");
@@ -643,7 +725,7 @@ ElasticaSolution SolveElastica(double alpha, double psi_rad) {
   if (alpha <= kSeriesMaxAlpha) {
     SolveSeries(load, solution);
   } else {
-    SolveElliptic(load, solution);
+    SolveElliptic(load, solution, near);
   }
   return solution;
 }

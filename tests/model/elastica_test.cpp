@@ -325,6 +325,56 @@ TEST_CASE("Evenly spaced elastica samples agree with the centreline evaluated po
                   std::invalid_argument);
 }
 
+TEST_CASE("An elastica solved from a nearby solution is the one solved from scratch",
+          "[elastica]") {
+  // The residual has one root in the tip angle, so Newton from a nearby solution must land on
+  // the root the bracketed search finds, to rounding: the tip figures agree to 1e-13 (the
+  // solver's own accuracy, physics.md), the shape's modulus k' to 1e-13 relative. Near loads
+  // (1 % and 0.01 rad away, as tick to tick or a finite difference) must take fewer iterations
+  // than the search from scratch; far ones (alpha 100 times off, psi across its range) may
+  // take more, never another answer.
+  const double alphas[] = {2e-3, 0.3, 2.0, 13.8, 40.0, 300.0, 1e3, 9e3};
+  const double psis[] = {-kPi / 2.0 + 1e-3, -1.3, -0.4, 0.0, 0.6, 1.4, kPi / 2.0 - 1e-3};
+  int near_iterations = 0, cold_iterations = 0;
+  for (const double alpha : alphas) {
+    for (const double psi : psis) {
+      const ElasticaSolution cold = SolveElastica(alpha, psi);
+      struct Start {
+        double alpha, psi;
+        bool near;
+      };
+      const Start starts[] = {{alpha * 1.001, psi, true},
+                              {alpha * 0.999, std::clamp(psi + 0.001, -kPi / 2.0, kPi / 2.0), true},
+                              {std::min(alpha * 100.0, 1e4), -psi, false},
+                              {alpha / 100.0, 0.0, false}};
+      for (const Start& start : starts) {
+        INFO("alpha = " << alpha << ", psi = " << psi << ", from alpha = " << start.alpha
+                        << ", psi = " << start.psi);
+        const ElasticaSolution from = SolveElastica(start.alpha, start.psi);
+        const ElasticaSolution warm = SolveElastica(alpha, psi, &from);
+        const auto close = [](double a, double b) {
+          return std::abs(a - b) <= 1e-13 * std::max(std::abs(b), 1e-300);
+        };
+        CHECK(close(warm.tip.tip_angle_rad, cold.tip.tip_angle_rad));
+        CHECK(close(warm.tip.deflection, cold.tip.deflection));
+        CHECK(close(warm.tip.shortening, cold.tip.shortening));
+        CHECK(close(warm.tip.root_curvature, cold.tip.root_curvature));
+        CHECK(close(warm.tip.energy, cold.tip.energy));
+        CHECK(close(warm.modulus_kc, cold.modulus_kc));
+        if (start.near && !cold.series) {
+          near_iterations += warm.iterations;
+          cold_iterations += cold.iterations;
+        }
+      }
+    }
+  }
+  INFO("iterations from near solutions " << near_iterations << ", from scratch "
+                                         << cold_iterations);
+  CHECK(2 * near_iterations < cold_iterations);  // measured: 313 against 784
+  CHECK(SolveElastica(2.0, 0.3, nullptr).tip.tip_angle_rad ==
+        SolveElastica(2.0, 0.3).tip.tip_angle_rad);
+}
+
 TEST_CASE("Elastica series and elliptic branches agree across the switch", "[elastica]") {
   // Locate the switch from the outside (the 'series' flag) instead of copying the constant.
   double lo = 1e-6;  // series here

@@ -50,6 +50,11 @@ inline constexpr double kMaxElasticaAlpha = 1e4;
 /// straight, and compression is straight up to and including alpha = std::numbers::pi^2 / 4 (the
 /// double nearest Euler's load), buckled towards +x above it.
 ElasticaSolution SolveElastica(double alpha, double psi_rad);
+/// The same, started from `near` (a solution for a nearby load, e.g. the last tick's; may be
+/// null): the same answer to rounding (~1e-15 relative) in fewer iterations where the load is
+/// close, and the search from scratch where Newton from there does not converge within a few
+/// steps. The answer then depends on `near` in its last bits only.
+ElasticaSolution SolveElastica(double alpha, double psi_rad, const ElasticaSolution* near);
 
 /// Centreline of the solved shape at the arc positions s (each in [0, 1]): out[i] = (x, z) / l and
 /// theta_out[i] = theta(s[i]). Sizes of s, xz_out and theta_out must match. No heap allocation.
