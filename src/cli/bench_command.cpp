@@ -169,6 +169,14 @@ struct CoreRun {
   long tick = 0;
 };
 
+// Which model drew the tube in the core's last tick.
+std::string ShapeModel(const core::Core& core) {
+  const std::uint32_t flags = core.last().flags;
+  if (flags & core::kRodShape) return "rod";
+  if (flags & core::kLinearFallback) return "linear (fallback)";
+  return core.scene().model.beam == model::BeamModel::kElastica ? "elastica" : "linear";
+}
+
 Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string what,
                       Eigen::Isometry3d at,
                       std::function<Eigen::Isometry3d(const Eigen::Isometry3d&, long)> motion,
@@ -202,6 +210,7 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
     return nlohmann::json{{"cf", run->core->FormationText()},
                           {"pcs", run->core->last().contact_count},
                           {"narrow_phase_calls", run->core->narrow_phase_calls()},
+                          {"shape", ShapeModel(*run->core)},
                           {"capsules", run->core->capsule_count()}};
   };
   return s;
@@ -241,6 +250,11 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
       CoreScenario(scene, "core.three_pcs",
                    "lying in the groove, turned to touch both walls: floor, left wall, right wall",
                    HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
+  // A line contact (the side lying along the floor, two load points on one cantilever): the
+  // elastica does not cover it and the rod shapes the tube.
+  out.push_back(CoreScenario(scene, "core.side_on_floor",
+                             "lying along the floor, pressed onto it (a line contact: the rod)",
+                             HandPose(0.0, -0.090, 0.0076, 0.0, 0.0), dither));
   // The leave-out effect: the same stuck tip without friction, and with the shape asked for.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
@@ -337,7 +351,7 @@ int RunBench(const BenchOptions& o, Streams io) {
       if (scenario.state) {
         const nlohmann::json state = scenario.state();
         io.out << "   " << state["cf"].get<std::string>() << " (" << state["narrow_phase_calls"]
-               << " narrow-phase queries)";
+               << " narrow-phase queries, " << state["shape"].get<std::string>() << ")";
       }
       io.out << "\n";
     }
