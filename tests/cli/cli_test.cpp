@@ -215,15 +215,19 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
       RunTool({"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(r.exit_code == 0);
   const auto doc = nlohmann::json::parse(r.out);
-  REQUIRE(doc["scenarios"].size() == 13);
+  REQUIRE(doc["scenarios"].size() == 14);
   std::map<std::string, int> pcs;
+  std::map<std::string, std::string> shape;
   for (const auto& s : doc["scenarios"]) {
     const double median = s["median_us"].get<double>();
     CHECK(std::isfinite(median));
     CHECK(median > 0.0);
     CHECK(s["p99_us"].get<double>() >= median);
     CHECK(s["max_us"].get<double>() >= s["p99_us"].get<double>());
-    if (s.contains("state")) pcs[s["name"].get<std::string>()] = s["state"]["pcs"].get<int>();
+    if (s.contains("state")) {
+      pcs[s["name"].get<std::string>()] = s["state"]["pcs"].get<int>();
+      shape[s["name"].get<std::string>()] = s["state"]["shape"].get<std::string>();
+    }
   }
   // The core scenarios measure the states their names say. (core.two_pcs is left out: on the
   // rubber scene its side contact along the wall does not hold still; the bench prints the
@@ -233,6 +237,21 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   CHECK(pcs["core.end_sliding"] == 1);
   CHECK(pcs["core.three_pcs"] == 3);
   CHECK(pcs["core.three_pcs.linear"] == 3);
+  // And the models their names say: the side along the floor is a line contact, the rod's.
+  CHECK(shape["core.end_stuck"] == "elastica");
+  CHECK(shape["core.side_on_floor"] == "rod");
+  CHECK(shape["core.end_stuck.linear"] == "linear");
+
+  // --only keeps the scenarios whose names start with it; a prefix no name has is an error.
+  const Outcome only = RunTool({"bench", "--samples", "10", "--json", "--only", "core.end_stuck",
+                                "--scene", SourcePath("scenes/groove.yaml")});
+  REQUIRE(only.exit_code == 0);
+  const auto only_doc = nlohmann::json::parse(only.out);
+  CHECK(only_doc["scenarios"].size() == 3);  // core.end_stuck, .mesh, .linear
+  const Outcome none =
+      RunTool({"bench", "--only", "core.nothing", "--scene", SourcePath("scenes/groove.yaml")});
+  CHECK(none.exit_code == 2);
+  CHECK_THAT(none.err, Catch::Contains("core.nothing") && Catch::Contains("core.free"));
 }
 
 TEST_CASE("usage: no subcommand and --version", "[cli]") {
