@@ -76,6 +76,10 @@ struct RodSegment {
   Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();  ///< clamp cross-section centre
   Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();  ///< clamp frame S (z along the tangent)
   double clamp_m = 0.0, end_m = 0.0;                   ///< arc positions of its clamp and end
+  /// From its last tangent compliance (Rod::Compliance): the end section's turn per N of each
+  /// load's force, frame S, for end_turn_count loads; the next solve's predictor.
+  std::array<Eigen::Matrix3d, kMaxLoads> end_turn_per_N{};
+  int end_turn_count = 0;
 };
 
 class BeamChain {
@@ -145,7 +149,7 @@ class BeamChain {
                     std::array<RodSegment, kMaxLoads>& segments) const;
   /// Tangent compliance of a solved segment's loads to each other, frame H, written to
   /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular.
-  bool RodCompliance(const RodSegment& segment,
+  bool RodCompliance(RodSegment& segment,
                      std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const;
   /// The centreline of a solved rod chain at s = k l / (nodes.size() - 1), frame H (straight
   /// beyond the last segment), and its tangent at the free end.

@@ -462,11 +462,12 @@ void Rod::Shape(std::span<const RodLoad> loads, const RodSolution& solution,
 }
 
 bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
-                     std::span<Eigen::Matrix3d> w) const {
+                     std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn) const {
   Order order{};
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
   assert(w.size() >= std::size_t(count * count));
+  assert(end_turn.empty() || end_turn.size() >= std::size_t(count));
   // The loads' arc positions in ascending order (the integration's samples) and their offsets.
   std::array<double, kMaxLoads> s_sorted{};
   std::array<Eigen::Vector3d, kMaxLoads> r_sorted;
@@ -494,6 +495,7 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
       const std::size_t d = std::size_t(3 + 3 * j + c);
       // The end's turn that keeps the root clamped as F_j moves.
       const Eigen::Vector3d u_F = -E_u_inv * tangent.residual[d];
+      if (!end_turn.empty()) end_turn[std::size_t(j)].col(c) = u_F;
       for (int ki = 0; ki < count; ++ki) {
         const std::size_t at = std::size_t(ki) * kMaxDirections;
         const int i = order[std::size_t(ki)];
@@ -504,6 +506,8 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
     }
   for (int k = 0; k < count * count; ++k)
     if (!w[std::size_t(k)].allFinite()) return false;
+  for (std::size_t j = 0; j < end_turn.size() && j < std::size_t(count); ++j)
+    if (!end_turn[j].allFinite()) return false;
   return true;
 }
 

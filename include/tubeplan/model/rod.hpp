@@ -95,8 +95,12 @@ class Rod {
   /// de/dF, all from one integration carrying the 3 + 3 count directions (exact derivatives of
   /// the discrete map).
   /// False if the shooting Jacobian is singular (at a bifurcation).
+  /// If `end_turn` is not empty (size >= loads.size()), end_turn[j] is also written: the turn of
+  /// the end section (clamp frame, rad per N of load j's force, a column per force axis) that
+  /// keeps the root clamped: with it a caller predicts the next solve's end from a change of
+  /// the forces (BeamChain::SolveRodChain).
   bool Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
-                  std::span<Eigen::Matrix3d> w) const;
+                  std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn = {}) const;
 
   double bending_stiffness_Nm2() const { return EI_; }
   double max_step_m() const { return max_step_m_; }
