@@ -177,7 +177,11 @@ TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (
     const RodSolution solution = rod.Solve(loads, Eigen::Matrix3d::Identity());
     REQUIRE(solution.converged);
     std::array<Eigen::Matrix3d, 9> w;
-    REQUIRE(rod.Compliance(loads, solution, w));
+    std::array<Eigen::Matrix3d, 3> end_turn;
+    REQUIRE(rod.Compliance(loads, solution, w, end_turn));
+    double largest_turn = 0.0;
+    for (const Eigen::Matrix3d& b : end_turn)
+      largest_turn = std::max(largest_turn, b.cwiseAbs().maxCoeff());
     const auto surface = [&](const std::vector<RodLoad>& ls, const RodSolution& sol, int i) {
       std::array<double, 1> s{ls[std::size_t(i)].s_m};
       std::array<Eigen::Vector3d, 1> p;
@@ -197,6 +201,10 @@ TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (
         const RodSolution sm = rod.Solve(minus, solution.end_R);
         REQUIRE(sp.converged);
         REQUIRE(sm.converged);
+        // The end section's turn per force (the solve's predictor), Q -> Exp(turn) Q.
+        const Eigen::AngleAxisd turned(sp.end_R * sm.end_R.transpose());
+        const Eigen::Vector3d turn = turned.angle() * turned.axis() / (2.0 * dF);
+        CHECK((end_turn[std::size_t(j)].col(c) - turn).norm() < 2e-5 * largest_turn);
         for (int i = 0; i < 3; ++i) {
           const auto [p0, R0] = surface(loads, solution, i);
           const auto [pp, Rp] = surface(plus, sp, i);
