@@ -774,12 +774,19 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
   bool solved = false, saturated = false, force_saturated = false;
   // Assembles and solves the tick's system for the current decisions; false if not finite.
+  //
+  // With the grip rigid (not torque-saturated) omega is the hand's turn e and the coupling's
+  // row gives p = (A + sum F) / Kc_eff: both are substituted, and only the forces are solved
+  // for (3 n unknowns instead of 3 n + 6: the factorisation, the largest cost of a pass, falls
+  // by half for two loads). A saturated grip keeps the full system: its omega row carries
+  // 1 / k_reg, which substituted would swamp the rest.
   const auto solve_system = [&]() {
     int n_active = 0;
     for (int i = 0; i < load_count; ++i)
       slot[std::size_t(i)] = m.loads[std::size_t(i)].active ? n_active++ : -1;
-    const int n = 3 * n_active + 6;
-    const int ip = n - 6, iw = n - 3;  // columns of p and omega
+    const bool reduced = !torque_saturated;
+    const int n = 3 * n_active + (reduced ? 0 : 6);
+    const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
     m.M.setZero(n, n);
     m.rhs.setZero(n);
     for (int i = 0; i < load_count; ++i) {
@@ -804,33 +811,50 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
       const int r = 3 * si;
       m.M.block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
+      // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
+      const Eigen::Matrix3d G_p = reduced ? Eigen::Matrix3d(G / Kc_eff) : Eigen::Matrix3d::Zero();
       for (int j = 0; j < load_count; ++j) {
         const int sj = slot[std::size_t(j)];
         if (sj < 0) continue;
         const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
-        m.M.block<3, 3>(r, 3 * sj) += G * Wij;
+        m.M.block<3, 3>(r, 3 * sj) += G * Wij + G_p;
         if (stuck) m.M.block<3, 3>(r, 3 * sj) -= Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
       }
       // The held end's turn omega moves the point by omega x r, r from the held end.
       const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
+      m.rhs.segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
+      if (reduced) {
+        m.rhs.segment<3>(r) += G * (Rx * e_hand) - G_p * A;
+        continue;
+      }
       m.M.block<3, 3>(r, ip) = G;
       m.M.block<3, 3>(r, iw) = -G * Rx;
-      m.rhs.segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
       m.M.block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
-      if (torque_saturated) m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
+      m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
+    }
+    if (reduced) {
+      if (n > 0) {
+        m.lu.compute(m.M);
+        m.z = m.lu.solve(m.rhs);
+      } else {
+        m.z.resize(0);
+      }
+      if (!m.z.allFinite()) return false;
+      Eigen::Vector3d sum_F = Eigen::Vector3d::Zero();
+      for (int k = 0; k < n_active; ++k) sum_F += m.z.segment<3>(3 * k);
+      p_W = (A + sum_F) / Kc_eff;
+      omega_W = e_hand;
+      return p_W.allFinite();
     }
     m.M.block<3, 3>(ip, ip) = Kc_eff * Eigen::Matrix3d::Identity();
     m.rhs.segment<3>(ip) = A;
-    if (torque_saturated) {
+    {
       // Torque balance: sum r x F + tau = 0 with the grip's tau = tau_sat + k_reg (e - omega);
       // the weak k_reg (1e-3 of the full torque per radian) keeps omega defined about axes the
       // contacts do not hold, and adds at most k_reg times the lag to the torque.
       const double k_reg = 1e-3 * max_torque;
       m.M.block<3, 3>(iw, iw) = -k_reg * Eigen::Matrix3d::Identity();
       m.rhs.segment<3>(iw) = -torque_sat_W - k_reg * e_hand;
-    } else {
-      m.M.block<3, 3>(iw, iw) = Eigen::Matrix3d::Identity();
-      m.rhs.segment<3>(iw) = e_hand;
     }
     m.lu.compute(m.M);
     m.z = m.lu.solve(m.rhs);
