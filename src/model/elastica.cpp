@@ -701,6 +701,38 @@ Stepped AddArgument(double k_sq, const Stepped& u, const Stepped& v) {
 // adds positive terms made of sn and needs no anchor.
 constexpr double kJacobiAnchor = 0.5;
 
+// tau0 = F(u0|k) with sin u0 = s0/k, cos u0 = sqrt(D)/k and Delta(u0) = c0: the root's argument.
+double RootArgument(const ElasticaSolution& solution, const Loading& load) {
+  const double sin_u0 = std::sin(solution.u0);
+  const double cos_u0 = std::cos(solution.u0);
+  return sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
+}
+
+// The series' centreline point at s.
+Eigen::Vector2d SeriesPoint(const SeriesShape& shape, double s) {
+  return {EvalPolynomial(shape.x, s), s - EvalPolynomial(shape.h, s)};
+}
+
+// Positions from the tip-relative figures: the closed forms give the whole tip position
+// relative to the root too; its tiny difference from the tip figures (rounding) is spread
+// linearly so that s = 0 and s = 1 are both exact.
+struct FromRoot {
+  FromRoot(const ElasticaSolution& solution, const Loading& load, double root_along,
+           double root_across)
+      : cos_psi(load.cos_psi), sin_psi(load.sin_psi), along0(root_along), across0(root_across) {
+    const ElasticaTip& tip = solution.tip;
+    error_x = tip.deflection - (along0 * cos_psi - across0 * sin_psi);
+    error_z = (1.0 - tip.shortening) - (along0 * sin_psi + across0 * cos_psi);
+  }
+  Eigen::Vector2d At(double s, double along_here, double across_here) const {
+    const double along = along0 - along_here;
+    const double across = across0 - across_here;
+    return {along * cos_psi - across * sin_psi + s * error_x,
+            along * sin_psi + across * cos_psi + s * error_z};
+  }
+  double cos_psi, sin_psi, along0, across0, error_x = 0.0, error_z = 0.0;
+};
+
 }  // namespace
 
 ElasticaSolution SolveElastica(double alpha, double psi_rad) {
@@ -754,31 +786,19 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
   if (solution.series) {
     const SeriesShape shape = BuildSeries(solution.alpha, load);
     for (std::size_t i = 0; i < s.size(); ++i) {
-      xz_out[i] =
-          Eigen::Vector2d(EvalPolynomial(shape.x, s[i]), s[i] - EvalPolynomial(shape.h, s[i]));
+      xz_out[i] = SeriesPoint(shape, s[i]);
       theta_out[i] = EvalPolynomial(shape.theta, s[i]);
     }
     return;
   }
   const double sqrt_alpha = std::sqrt(solution.alpha);
-  // tau0 = F(u0|k) with sin u0 = s0/k, cos u0 = sqrt(D)/k and Delta(u0) = c0.
-  const double sin_u0 = std::sin(solution.u0);
-  const double cos_u0 = std::cos(solution.u0);
-  const double tau0 = sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
-  // The closed forms give the whole tip position relative to the root too; its tiny difference
-  // from the tip figures (rounding) is spread linearly so that s = 0 and s = 1 are both exact.
+  const double tau0 = RootArgument(solution, load);
   const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
   const FromTip root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
-  const double root_x = root.along * load.cos_psi - root.across * load.sin_psi;
-  const double root_z = root.along * load.sin_psi + root.across * load.cos_psi;
-  const double error_x = tip.deflection - root_x;
-  const double error_z = (1.0 - tip.shortening) - root_z;
+  const FromRoot from_root(solution, load, root.along, root.across);
   for (std::size_t i = 0; i < s.size(); ++i) {
     const FromTip here = ShapeFromTip(solution, chain, sqrt_alpha, tau0, s[i]);
-    const double along = root.along - here.along;
-    const double across = root.across - here.across;
-    xz_out[i] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s[i] * error_x,
-                                along * load.sin_psi + across * load.cos_psi + s[i] * error_z);
+    xz_out[i] = from_root.At(s[i], here.along, here.across);
     theta_out[i] = (s[i] == 0.0) ? 0.0 : Theta(solution, here);
   }
 }
@@ -805,7 +825,7 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
     const SeriesShape shape = BuildSeries(solution.alpha, load);
     for (std::size_t j = 0; j < n; ++j) {
       const double s = s_of(j);
-      xz_out[j] = Eigen::Vector2d(EvalPolynomial(shape.x, s), s - EvalPolynomial(shape.h, s));
+      xz_out[j] = SeriesPoint(shape, s);
       const double theta = EvalPolynomial(shape.theta, s);
       tangent_out[j] = Eigen::Vector2d(std::sin(theta), std::cos(theta));
     }
@@ -814,9 +834,7 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
   // The samples' figures from the tip, (along, across) into xz_out and (gap_x, gap_y) into
   // tangent_out, then turned into positions and tangents below.
   const double sqrt_alpha = std::sqrt(solution.alpha);
-  const double sin_u0 = std::sin(solution.u0);
-  const double cos_u0 = std::cos(solution.u0);
-  const double tau0 = sin_u0 * Rf(cos_u0 * cos_u0, load.c0 * load.c0, 1.0);
+  const double tau0 = RootArgument(solution, load);
   const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
   const auto store = [&](std::size_t j, const FromTip& f) {
     xz_out[j] = Eigen::Vector2d(f.along, f.across);
@@ -875,20 +893,11 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
     store(i,
           FromJacobi(solution, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
   }
-  // As in ElasticaCentreline: positions from the root sample, the closed forms' tiny difference
-  // from the tip figures spread linearly so that s = 0 and s = 1 are both exact.
-  const double root_along = xz_out[0].x(), root_across = xz_out[0].y();
-  const double root_x = root_along * load.cos_psi - root_across * load.sin_psi;
-  const double root_z = root_along * load.sin_psi + root_across * load.cos_psi;
-  const double error_x = tip.deflection - root_x;
-  const double error_z = (1.0 - tip.shortening) - root_z;
+  // As in ElasticaCentreline: positions from the root sample.
+  const FromRoot from_root(solution, load, xz_out[0].x(), xz_out[0].y());
   const double sin_tip = std::sin(tip.tip_angle_rad), cos_tip = std::cos(tip.tip_angle_rad);
   for (std::size_t j = 0; j < n; ++j) {
-    const double s = s_of(j);
-    const double along = root_along - xz_out[j].x();
-    const double across = root_across - xz_out[j].y();
-    xz_out[j] = Eigen::Vector2d(along * load.cos_psi - across * load.sin_psi + s * error_x,
-                                along * load.sin_psi + across * load.cos_psi + s * error_z);
+    xz_out[j] = from_root.At(s_of(j), xz_out[j].x(), xz_out[j].y());
     tangent_out[j] = j == 0 ? Eigen::Vector2d(0.0, 1.0)
                             : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
   }
