@@ -205,20 +205,68 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
   return segment_count;
 }
 
-Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxLoads>& segments,
-                                         int segment_count, double s_m) const {
+namespace {
+
+// The segment of a solved chain whose arc holds s_m, or -1 beyond the last load (or with none).
+int ElasticaSegmentAt(const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count,
+                      double s_m) {
   for (int g = 0; g < segment_count; ++g) {
     const ElasticaSegment& seg = segments[std::size_t(g)];
     if (s_m > seg.clamp_m + seg.length_m && g + 1 < segment_count) continue;
-    if (s_m > seg.clamp_m + seg.length_m) break;  // beyond the last load: straight, below
+    return s_m > seg.clamp_m + seg.length_m ? -1 : g;
+  }
+  return -1;
+}
+
+// Points of one segment from its dimensionless centreline at (s_m - clamp) / length.
+void SegmentPoints(const ElasticaSegment& seg, std::span<const double> s_m,
+                   std::span<Eigen::Vector3d> out) {
+  constexpr std::size_t kChunk = 32;
+  for (std::size_t first = 0; first < s_m.size(); first += kChunk) {
+    const std::size_t n = std::min(kChunk, s_m.size() - first);
+    std::array<double, kChunk> s_unit{};
+    std::array<Eigen::Vector2d, kChunk> xz;
+    std::array<double, kChunk> theta{};
+    for (std::size_t i = 0; i < n; ++i)
+      s_unit[i] = std::clamp((s_m[first + i] - seg.clamp_m) / seg.length_m, 0.0, 1.0);
+    model::ElasticaCentreline(seg.solution, std::span<const double>(s_unit.data(), n),
+                              std::span<Eigen::Vector2d>(xz.data(), n),
+                              std::span<double>(theta.data(), n));
+    for (std::size_t i = 0; i < n; ++i)
+      out[first + i] =
+          seg.origin_H + seg.R_HS * (seg.length_m * (xz[i].x() * seg.bend_x_S +
+                                                     xz[i].y() * Eigen::Vector3d::UnitZ()));
+  }
+}
+
+}  // namespace
+
+void BeamChain::ElasticaPoints(const std::array<ElasticaSegment, kMaxLoads>& segments,
+                               int segment_count, std::span<const double> s_m,
+                               std::span<Eigen::Vector3d> out) const {
+  for (std::size_t i = 0; i < s_m.size();) {
+    const int g = ElasticaSegmentAt(segments, segment_count, s_m[i]);
+    std::size_t n = 1;
+    while (i + n < s_m.size() && ElasticaSegmentAt(segments, segment_count, s_m[i + n]) == g) ++n;
+    if (g < 0 || !(segments[std::size_t(g)].length_m > 0.0)) {
+      for (std::size_t k = i; k < i + n; ++k)
+        out[k] = ElasticaPoint(segments, segment_count, s_m[k]);
+    } else {
+      SegmentPoints(segments[std::size_t(g)], s_m.subspan(i, n), out.subspan(i, n));
+    }
+    i += n;
+  }
+}
+
+Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxLoads>& segments,
+                                         int segment_count, double s_m) const {
+  const int g = ElasticaSegmentAt(segments, segment_count, s_m);
+  if (g >= 0) {
+    const ElasticaSegment& seg = segments[std::size_t(g)];
     if (!(seg.length_m > 0.0)) return seg.origin_H;
-    const double s_unit = std::clamp((s_m - seg.clamp_m) / seg.length_m, 0.0, 1.0);
-    Eigen::Vector2d xz;
-    double theta = 0.0;
-    model::ElasticaCentreline(seg.solution, std::span<const double>(&s_unit, 1),
-                              std::span<Eigen::Vector2d>(&xz, 1), std::span<double>(&theta, 1));
-    return seg.origin_H +
-           seg.R_HS * (seg.length_m * (xz.x() * seg.bend_x_S + xz.y() * Eigen::Vector3d::UnitZ()));
+    Eigen::Vector3d point;
+    SegmentPoints(seg, std::span<const double>(&s_m, 1), std::span<Eigen::Vector3d>(&point, 1));
+    return point;
   }
   // Beyond the last segment (or no segment): straight along the last tip's tangent.
   if (segment_count == 0) return {0.0, 0.0, s_m};

@@ -1316,12 +1316,26 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
   const Impl& m = *impl_;
   const double l = scene_.tube.length_m;
   const std::size_t count = p_W_m.size();
+  const auto s_at = [&](std::size_t k) {
+    return count > 1 ? l * double(k) / double(count - 1) : l;
+  };
+  if (m.elastica_shape) {
+    // A segment's points in one call: its root figures are computed once (ElasticaPoints).
+    constexpr std::size_t kChunk = 64;
+    for (std::size_t first = 0; first < count; first += kChunk) {
+      const std::size_t n = std::min(kChunk, count - first);
+      std::array<double, kChunk> s_m{};
+      for (std::size_t k = 0; k < n; ++k) s_m[k] = s_at(first + k);
+      m.beam.ElasticaPoints(m.segments, m.segment_count, std::span<const double>(s_m.data(), n),
+                            p_W_m.subspan(first, n));
+      for (std::size_t k = first; k < first + n; ++k) p_W_m[k] = out_.X_WH * p_W_m[k];
+    }
+    return;
+  }
   for (std::size_t k = 0; k < count; ++k) {
-    const double s = count > 1 ? l * double(k) / double(count - 1) : l;
+    const double s = s_at(k);
     Eigen::Vector3d x_H(0.0, 0.0, s);
-    if (m.elastica_shape) {
-      x_H = m.beam.ElasticaPoint(m.segments, m.segment_count, s);
-    } else if (m.rod_shape) {
+    if (m.rod_shape) {
       // The rod's nodes, joined by chords: the capsule count keeps a chord within epsilon / 10
       // of the arc (ChainCapsuleCount), the accuracy the contacts already work to.
       const double u = std::clamp(s / l * capsule_count_, 0.0, double(capsule_count_));
