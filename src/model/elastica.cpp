@@ -540,11 +540,11 @@ void SolveElliptic(const Loading& load, ElasticaSolution& solution, const Elasti
   // search from scratch).
   bool warm = false;
   if (near && !near->series && near->tip.tip_angle_rad > 0.0 && load.phi0 > 0.0) {
-    // Its tip angle, and its distance y from the load's direction carried to this load's
-    // (k' = sin(y / 2) keeps y exact where t rounds to gap).
-    // Each scaled by how its first-order estimate changes between the two loads: t by linear
-    // theory's alpha cos(psi) / 2, y by the large-alpha asymptote 8 c0 / (1 + s0) e^-sqrt(alpha)
-    // (SolveAmplitude's starts), so that a change of the load's direction is followed as well.
+    // Its tip angle t, and its distance y from the load's direction (from k' = sin(y / 2), exact
+    // where t rounds to gap), each scaled by how its first-order estimate changes between the
+    // two loads: t by linear theory's alpha cos(psi) / 2, y by the large-alpha asymptote
+    // 8 c0 / (1 + s0) e^-sqrt(alpha) (SolveAmplitude's starts), so that a change of the load's
+    // direction is followed as well.
     const Loading near_load = MakeLoading(near->psi_rad);
     const double t_near =
         near->tip.tip_angle_rad * (alpha * load.cos_psi) / (near->alpha * near_load.cos_psi);
@@ -642,15 +642,16 @@ double EpsilonDefect(double k, const Jacobi& j) {
 // sn, cn, dn at w from those at tau = K - w: sn(K - tau) = cd(tau), cn(K - tau) = k' sd(tau),
 // dn(K - tau) = k' nd(tau); and D(K - tau) = D(K) - D(tau) - k^2 sn(tau) cd(tau) (the addition
 // theorem of E), D(K) = (k^2 / 3) R_D(0, k'^2, 1).
+Jacobi ReflectedJacobi(double kc, const Jacobi& at_tau) {
+  return {at_tau.cn / at_tau.dn, kc * at_tau.sn / at_tau.dn, kc / at_tau.dn};
+}
 struct Reflected {
   Jacobi at_w;
   double big_d = 0.0;
 };
 Reflected Reflect(double k, double kc, const Jacobi& at_tau, double d_tau, double d_complete) {
   Reflected r;
-  r.at_w.sn = at_tau.cn / at_tau.dn;
-  r.at_w.cn = kc * at_tau.sn / at_tau.dn;
-  r.at_w.dn = kc / at_tau.dn;
+  r.at_w = ReflectedJacobi(kc, at_tau);
   r.big_d = d_complete - d_tau - k * k * at_tau.sn * r.at_w.sn;
   return r;
 }
@@ -666,11 +667,7 @@ FromTip ShapeFromTip(const ElasticaSolution& solution, const LandenChain& chain,
   }
   // Reflection about K/2 keeps the Landen forms at arguments <= K/2. D(w) straight from R_D at
   // the reflected sn, cn, dn: accurate, and one R_D as the direct branch.
-  const Jacobi rootside = JacobiFunctions(tau, chain);
-  Jacobi j;
-  j.sn = rootside.cn / rootside.dn;
-  j.cn = solution.modulus_kc * rootside.sn / rootside.dn;
-  j.dn = solution.modulus_kc / rootside.dn;
+  const Jacobi j = ReflectedJacobi(solution.modulus_kc, JacobiFunctions(tau, chain));
   return FromJacobi(solution, sqrt_alpha, s, j.sn, j.cn, j.dn, EpsilonDefect(k, j));
 }
 
