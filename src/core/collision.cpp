@@ -70,6 +70,37 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     part.aligned = part.R_WP == Eigen::Matrix3d::Identity();
     parts_.push_back(part);
   }
+  kept_.resize(parts_.size() * std::size_t(kMaxCapsules));
+}
+
+void Collision::ForgetDistances() { std::fill(kept_.begin(), kept_.end(), KeptDistance{}); }
+
+bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
+                               const Eigen::Vector3d& b_W, double band_m) const {
+  // The distance from a capsule to a fixed box is 1-Lipschitz in the motion of its axis's ends:
+  // if each end moved by at most delta, every axis point a + t (b - a) moved by at most
+  // (1 - t) |da| + t |db| <= delta, and a point's distance to the box is 1-Lipschitz. So a pair
+  // kept at d_m is now at least d_m - delta away. The kept and the new distance are both
+  // computed, each off by the rounding of the part-frame transform and the closed form: a few
+  // units in the last place of the coordinates, ~1e-15 m in a scene a few metres across. The
+  // margin of 1 nm is six orders above that and far below any distance that matters (epsilon is
+  // a millimetre): a pair skipped here is beyond the band (and beyond 0 when the band is not, so
+  // the axis is outside the box) in the narrow phase too, which would discard it. A pair within
+  // 1 nm + delta of the band is evaluated. Squared: no root; their rounding is relative 1e-16.
+  // Nothing kept (-infinity) or a NaN anywhere compares false: evaluated.
+  const double slack_m = kept.d_m - (std::max(band_m, 0.0) + kCoherenceMargin_m);
+  const double slack_sq = slack_m * slack_m;
+  return slack_m > 0.0 && (a_W - kept.a_W_m).squaredNorm() <= slack_sq &&
+         (b_W - kept.b_W_m).squaredNorm() <= slack_sq;
+}
+
+void Collision::Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+                     double d_m) const {
+  // Only a finite distance: one from infinite coordinates would make every later motion look
+  // small against it.
+  kept.d_m = std::isfinite(d_m) ? d_m : -std::numeric_limits<double>::infinity();
+  kept.a_W_m = a_W;
+  kept.b_W_m = b_W;
 }
 
 double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -270,10 +301,13 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
   const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
   int count = 0;
   narrow_calls_ = 0;
+  coherent_skips_ = 0;
   const Eigen::Vector3d tip_W = nodes_W.back();
   const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
   const std::size_t node_count = nodes_W.size();
-  for (const Part& part : parts_) {
+  for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
+    const Part& part = parts_[part_i];
+    KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
     // The whole tube's bounding box first: most parts are nowhere near it.
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector3d hi = -lo;
@@ -295,14 +329,26 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
       if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
       if (count == static_cast<int>(out.size())) return count;
+      // Most pieces that pass the broad phase lie beside a part, farther than the band, and
+      // move micrometres a tick: the distance computed some ticks ago, less how far the piece
+      // has moved since, still says so (KeptBeyondBand), and the narrow phase below would
+      // discard the pair.
+      KeptDistance& kept_k = kept[k];
+      if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
+        ++coherent_skips_;
+        continue;
+      }
       if (is_end) {
         // The capsule on the end piece's axis contains the cylinder: if it is farther than the
-        // band, so is the cylinder, and FCL's GJK (microseconds) is not needed.
+        // band, so is the cylinder, and FCL's GJK (microseconds) is not needed. It is the
+        // distance kept for the end piece.
         double bound_m = 0.0;
         Eigen::Vector3d unused_p, unused_q, unused_n;
         if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_n) &&
-            bound_m >= band_m)
+            bound_m >= band_m) {
+          Keep(kept_k, a_W, b_W, bound_m);
           continue;
+        }
       }
 
       double d = 0.0;
@@ -316,6 +362,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       if (!is_end) {
         separated = CapsuleBoxDistance(part, a_P, b_P, d, p_P, q_P, n_P);
         signed_depth = separated && d <= 0.0;
+        if (separated && d >= band_m) {
+          Keep(kept_k, a_W, b_W, d);
+          continue;
+        }
       } else if (CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
         // The end piece nearest to a face (the usual case: the tip on the floor, the end against
         // a wall) in closed form; FCL's GJK only for an edge or a vertex nearest, or overlap.

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -86,8 +87,17 @@ class Collision {
   int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
             double band_m, std::span<RawContact> out) const;
 
-  /// GJK calls of the last Query (for the benchmarks' leave-out figures).
+  /// Narrow-phase evaluations (closed form or GJK) of the last Query, for the benchmarks'
+  /// figures; pairs settled by an earlier query's distance (below) are not among them.
   int last_narrow_phase_calls() const { return narrow_calls_; }
+  /// Pairs of the last Query that passed the broad phase and were settled as farther than the
+  /// band by a distance an earlier Query computed (temporal coherence, collision.cpp).
+  int last_coherent_skips() const { return coherent_skips_; }
+
+  /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
+  /// its narrow-phase count does: the core forgets them when it is reset or restored, so that
+  /// its figures depend on the ticks since then alone.
+  void ForgetDistances();
 
  private:
   struct Part {
@@ -127,6 +137,16 @@ class Collision {
   bool CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
                           double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
                           Eigen::Vector3d& normal_P) const;
+  struct KeptDistance;
+  // Whether the distance kept for a piece, now that its axis runs a_W-b_W, proves the pair
+  // farther than the band.
+  bool KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
+                      const Eigen::Vector3d& b_W, double band_m) const;
+  // Keeps the capsule distance d_m of the piece on a_W-b_W, found beyond the band. A pair in
+  // the band keeps what it had: any kept distance stays a bound wherever the piece goes, and a
+  // pair in the band costs nothing more than the check.
+  void Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
+            double d_m) const;
   // Returns the contact's part point in the part's frame.
   Eigen::Vector3d Overlapping(const Part& part, const Eigen::Vector3d& a_W,
                               const Eigen::Vector3d& b_W, RawContact& c) const;
@@ -146,7 +166,17 @@ class Collision {
   double eps_m_ = 0.0;           // the contact threshold epsilon
   double inner_radius_m_ = 0.0;  // r2: the end face is an annulus
   mutable int narrow_calls_ = 0;
+  mutable int coherent_skips_ = 0;
   mutable std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_P_{};  // scratch
+  // A lower bound on the distance from a piece's capsule (its axis a-b swept by r1; for the end
+  // piece the capsule that contains its cylinder) to a part, with the axis's ends when it was
+  // computed. Per part, kMaxCapsules pieces; sized at construction, so Query allocates nothing.
+  static constexpr double kCoherenceMargin_m = 1e-9;  // collision.cpp, KeptBeyondBand
+  struct KeptDistance {
+    Eigen::Vector3d a_W_m = Eigen::Vector3d::Zero(), b_W_m = Eigen::Vector3d::Zero();
+    double d_m = -std::numeric_limits<double>::infinity();  // none: never skips
+  };
+  mutable std::vector<KeptDistance> kept_;
 };
 
 }  // namespace tubeplan::core

@@ -152,7 +152,8 @@ struct Core::State {
 };
 
 // The set-up that ticks only read (Collision's GJK solver carries nothing between queries: its
-// cached guess is off), over the state.
+// cached guess is off; the distances Collision keeps from earlier queries save evaluations and
+// never change a result), over the state.
 struct Core::Impl : Core::State {
   Impl(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsules,
        std::vector<std::array<int, 64>> element_of)
@@ -202,6 +203,7 @@ bool Core::Restore(const Snapshot& snapshot) {
       snapshot.elements_ != elements_.size())
     return false;
   static_cast<State&>(*impl_) = *snapshot.state_;
+  impl_->collision.ForgetDistances();
   out_ = snapshot.out_;
   return true;
 }
@@ -275,6 +277,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.rod_segment_count = 0;
   m.rod_shape = false;
   m.rod_tangent_members = 0;
+  m.collision.ForgetDistances();
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
   out_.X_WH = X_WH;
