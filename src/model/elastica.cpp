@@ -337,8 +337,14 @@ struct LandenChain {
   static constexpr int kMaxLevels = 24;
   std::array<double, kMaxLevels> ks{};
   std::array<double, kMaxLevels> kcs{};
+  // Per level, the terms JacobiFunctions forms of the modulus alone: 1 + k_n, k_n^2 and k_n'^2,
+  // each the same rounding as formed there, so once per chain instead of once per argument.
+  std::array<double, kMaxLevels> one_plus_ks{};
+  std::array<double, kMaxLevels> ks_sq{};
+  std::array<double, kMaxLevels> kcs_sq{};
   int levels = 0;
   double k = 0.0, kc = 1.0;
+  double k_sq = 0.0, kc_sq = 1.0;
 };
 
 LandenChain MakeLandenChain(double k, double kc) {
@@ -358,24 +364,30 @@ LandenChain MakeLandenChain(double k, double kc) {
     ++n;
   }
   chain.levels = n;
+  for (std::size_t i = 1; i <= std::size_t(n); ++i) {
+    chain.one_plus_ks[i] = 1.0 + ks[i];
+    chain.ks_sq[i] = ks[i] * ks[i];
+    chain.kcs_sq[i] = kcs[i] * kcs[i];
+  }
+  chain.k_sq = k * k;
+  chain.kc_sq = kc * kc;
   return chain;
 }
 
 Jacobi JacobiFunctions(double z, const LandenChain& chain) {
   const auto& ks = chain.ks;
-  const auto& kcs = chain.kcs;
   const int n = chain.levels;
-  for (int level = 1; level <= n; ++level) z /= 1.0 + ks[std::size_t(level)];
+  for (int level = 1; level <= n; ++level) z /= chain.one_plus_ks[std::size_t(level)];
   double sn = std::sin(z);
   double cn = std::cos(z);
   for (int level = n; level >= 1; --level) {
     const std::size_t i = std::size_t(level);
-    const double dn = std::sqrt(kcs[i] * kcs[i] + ks[i] * ks[i] * cn * cn);
+    const double dn = std::sqrt(chain.kcs_sq[i] + chain.ks_sq[i] * cn * cn);
     const double den = 1.0 + ks[i] * sn * sn;
-    sn = (1.0 + ks[i]) * sn / den;
+    sn = chain.one_plus_ks[i] * sn / den;
     cn = cn * dn / den;
   }
-  return {sn, cn, std::sqrt(chain.kc * chain.kc + chain.k * chain.k * cn * cn)};
+  return {sn, cn, std::sqrt(chain.kc_sq + chain.k_sq * cn * cn)};
 }
 
 // ---- Tip displacement by quadrature (moderate alpha) ---------------------------------------
