@@ -60,6 +60,8 @@ std::string_view FlagName(std::uint32_t bit) {
       return "beyond_linear";
     case core::kRodShape:
       return "rod";
+    case core::kShapeOffContacts:
+      return "shape_off";
     default:
       return "unknown";
   }

@@ -1248,6 +1248,19 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   if (m.rod_shape) out.flags |= kRodShape;
   if (want_elastica && beam_count > 0 && !m.elastica_shape && !m.rod_shape)
     out.flags |= kLinearFallback;
+  // The elastica's shape is held to the tick's system above; the rod's and the fallback's are
+  // only checked. Past this tolerance the tick's compliance was not the shape's: measured, the
+  // first failing tick of the stability sweep's squeeze and slide cases (docs/accuracy.md).
+  if (want_elastica && !m.elastica_shape) {
+    const double tolerance_m = std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m);
+    for (int j = 0; j < beam_count; ++j) {
+      const double s_j = m.beam_loads[std::size_t(j)].s_m;
+      if (!((interpolate_node(s_j) - m.predicted_H[std::size_t(j)]).norm() <= tolerance_m)) {
+        out.flags |= kShapeOffContacts;
+        break;
+      }
+    }
+  }
   if (beam_count == 0) m.elastica_held_off = false;
   out.energy_J = energy_J;
   out.max_strain = strain;

@@ -69,10 +69,17 @@ enum StepFlag : std::uint32_t {
   /// a line contact, a push past buckling): the discrete rod (model/rod.hpp), which keeps the
   /// tube's length under any load, shaped the tube and gave the tick's compliance.
   kRodShape = 1u << 7,
+  /// The shape drawn under the tick's loads (the rod's, or the linear fallback's) puts a load
+  /// point farther from where the tick's system put it than the elastica's hold-off tolerance,
+  /// max(2 eps, r1 / 4): the tick's forces were solved with a compliance the shape does not
+  /// follow, and the next tick starts from a shape its contacts did not hold. Where the core's
+  /// known failures start (docs/accuracy.md): a replay through such ticks is not the tube's
+  /// motion.
+  kShapeOffContacts = 1u << 8,
 };
 /// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
-inline constexpr int kStepFlagCount = 8;
-static_assert(kRodShape == 1u << (kStepFlagCount - 1),
+inline constexpr int kStepFlagCount = 9;
+static_assert(kShapeOffContacts == 1u << (kStepFlagCount - 1),
               "kStepFlagCount must follow the last StepFlag bit");
 
 /// One principal contact in a tick, in the core's compact form.
