@@ -40,7 +40,8 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"friction_work_J", v.friction_work_J},
                              {"energy_entry_J", v.energy_entry_J},
                              {"energy_exit_J", v.energy_exit_J},
-                             {"beyond_linear_s", v.beyond_linear_s}});
+                             {"beyond_linear_s", v.beyond_linear_s},
+                             {"shape_off_s", v.shape_off_s}});
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -98,6 +99,10 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
       t << "      warning: for " << v.beyond_linear_s
         << " s the linear model drew the tube beyond its range (tip deflection above l/3): "
            "the verdict rests on a shape the tube cannot take\n";
+    if (v.shape_off_s > 0.0)
+      t << "      warning: for " << v.shape_off_s
+        << " s the tube's shape was off the points its contacts were solved at (flag shape_off): "
+           "the verdict rests on ticks the core did not resolve\n";
   }
   t.precision(precision);
 }

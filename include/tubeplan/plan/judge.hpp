@@ -30,6 +30,9 @@ struct TransitionVerdict {
   /// Time the linear model drew the tube beyond its range (core flag beyond_linear: tip
   /// deflection above l/3): the verdict then rests on a shape the tube cannot take.
   double beyond_linear_s = 0.0;
+  /// Time the shape under the tick's loads was off the points the tick's contacts were solved
+  /// at (core flag shape_off): the verdict then rests on ticks the core did not resolve.
+  double shape_off_s = 0.0;
 };
 
 struct Observation {
