@@ -41,6 +41,8 @@ int RunStability(const StabilityOptions& o, Streams io) {
                           {"peak_force_N", r.peak_force_N}};
       j["first_failing_tick"] =
           r.first_failing_tick >= 0 ? nlohmann::json(r.first_failing_tick) : nlohmann::json();
+      j["first_shape_off_tick"] =
+          r.first_shape_off_tick >= 0 ? nlohmann::json(r.first_shape_off_tick) : nlohmann::json();
       j["warning"] = r.warning.empty() ? nlohmann::json() : nlohmann::json(r.warning);
       cases.push_back(j);
     }

@@ -144,6 +144,7 @@ struct Run {
   int fail_finite = -1, fail_force = -1, fail_law = -1, fail_friction = -1, fail_passive = -1,
       fail_tunnel = -1, fail_fault = -1;
   int beyond_linear = -1;  // first tick the linear shape was beyond its range (not a check)
+  int shape_off = -1;      // first tick the shape was off its contacts' points (not a check)
   std::string why_force, why_law, why_friction, why_passive, why_tunnel;
   double work_J = 0.0, stored_J = 0.0, initial_J = 0.0;
 };
@@ -182,6 +183,7 @@ Run Drive(const StabilityCase& c, bool check) {
     }
     if (o.flags & core::kSolverFault) Note(run.fail_fault, run.why_force, tick, run.why_force);
     if ((o.flags & core::kBeyondLinearRange) && run.beyond_linear < 0) run.beyond_linear = tick;
+    if ((o.flags & core::kShapeOffContacts) && run.shape_off < 0) run.shape_off = tick;
     const Vector3d F = o.force_W_N, p = o.X_WH.translation();
     run.peak_force_N = std::max(run.peak_force_N, F.norm());
     run.max_strain = std::max(run.max_strain, o.max_strain);
@@ -430,6 +432,10 @@ StabilityResult RunStabilityCase(const StabilityCase& c) {
   // Where the failures usually start (docs/core.md): the linear shape drawn beyond its range.
   if (first.beyond_linear >= 0)
     r.detail += Fmt("; the linear shape beyond l/3 from tick %d", first.beyond_linear);
+  // And where the core's shape stopped following the contacts it solved (flag shape_off).
+  r.first_shape_off_tick = first.shape_off;
+  if (first.shape_off >= 0 && !r.pass)
+    r.detail += Fmt("; the shape off its contacts from tick %d", first.shape_off);
   return r;
 }
 

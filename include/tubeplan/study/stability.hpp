@@ -40,6 +40,9 @@ struct StabilityResult {
   std::string detail;           ///< what failed, first failing tick, or the figures of a pass
   std::string warning;          ///< outside validity, or a physical check failing there
   int first_failing_tick = -1;  ///< -1 when it passed
+  /// First tick the core flagged its shape off the points its contacts were solved at
+  /// (core::kShapeOffContacts), -1 if none: not a check, a pointer to where failures start.
+  int first_shape_off_tick = -1;
   int ticks = 0;
   double peak_force_N = 0.0;
 };
