@@ -390,12 +390,25 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
+  // How far a shape may draw a load point from where the tick's system put it: the contact
+  // band's width, at least a quarter radius (the elastica's hold-off, the shape_off flag, and
+  // the stuck stretch's correction all use it).
+  const double shape_tolerance_m = std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m);
   const auto interpolate_node = [&](double s_m) {
     const double u = std::clamp(s_m / l * N, 0.0, static_cast<double>(N));
     const int k = std::min(static_cast<int>(u), N - 1);
     const double t = u - k;
     return Eigen::Vector3d((1.0 - t) * m.nodes_H[std::size_t(k)] +
                            t * m.nodes_H[std::size_t(k) + 1]);
+  };
+  // Whether this tick's shape puts every load point where the tick's system put it.
+  const auto shape_follows_loads = [&](int count) {
+    for (int j = 0; j < count; ++j) {
+      const double s_j = m.beam_loads[std::size_t(j)].s_m;
+      if (!((interpolate_node(s_j) - m.predicted_H[std::size_t(j)]).norm() <= shape_tolerance_m))
+        return false;
+    }
+    return true;
   };
   int load_count = 0;
   const auto add_load = [&](int pc, int end, const RawContact& r) {
@@ -489,7 +502,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     // A tick whose system put the point farther from the shape than the contact band (the
     // elastica's hold-off tolerance, section 8; an undecided tick's last guards) predicted
     // nothing to correct: the difference is slip, not stretch.
-    if (!(unseen.norm() <= std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m))) return stretch;
+    if (!(unseen.norm() <= shape_tolerance_m)) return stretch;
     return Eigen::Vector3d(stretch - (unseen - n1 * n1.dot(unseen)));
   };
   std::array<bool, kMaxLoads> taken{};
@@ -1161,14 +1174,10 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     // state the contacts hold: it swings the tip away by centimetres, the contact opens, the
     // tube springs back straight through the wall and the cycle repeats. The linear model, which
     // carries an axial push as a strut, takes over (flagged) until the loads fall back.
-    const double tolerance_m = std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m);
-    for (int j = 0; j < beam_count && m.elastica_shape; ++j) {
-      const double s_j = m.beam_loads[std::size_t(j)].s_m;
-      if ((interpolate_node(s_j) - m.predicted_H[std::size_t(j)]).norm() > tolerance_m) {
-        m.elastica_shape = false;
-        m.elastica_held_off = true;
-        m.held_off_load_N = load_N;
-      }
+    if (!shape_follows_loads(beam_count)) {
+      m.elastica_shape = false;
+      m.elastica_held_off = true;
+      m.held_off_load_N = load_N;
     }
   }
   // Where the elastica does not cover the loading, or is held off, the rod shapes the tube.
@@ -1251,16 +1260,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // The elastica's shape is held to the tick's system above; the rod's and the fallback's are
   // only checked. Past this tolerance the tick's compliance was not the shape's: measured, the
   // first failing tick of the stability sweep's squeeze and slide cases (docs/accuracy.md).
-  if (want_elastica && !m.elastica_shape) {
-    const double tolerance_m = std::max(2.0 * eps, 0.25 * scene_.tube.outer_radius_m);
-    for (int j = 0; j < beam_count; ++j) {
-      const double s_j = m.beam_loads[std::size_t(j)].s_m;
-      if (!((interpolate_node(s_j) - m.predicted_H[std::size_t(j)]).norm() <= tolerance_m)) {
-        out.flags |= kShapeOffContacts;
-        break;
-      }
-    }
-  }
+  if (want_elastica && !m.elastica_shape && !shape_follows_loads(beam_count))
+    out.flags |= kShapeOffContacts;
   if (beam_count == 0) m.elastica_held_off = false;
   out.energy_J = energy_J;
   out.max_strain = strain;
