@@ -747,6 +747,9 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       Load& ld = m.loads[std::size_t(i)];
       ld.base_W = ld.x0_W - p_start_W;
       for (int j = 0; j < load_count; ++j) {
+        // A load that is not a member moves nothing: its column is zero in any frame (most of
+        // the loads of a tube lying in the groove, in the band of a wall it does not touch).
+        if (!member[std::size_t(j)]) continue;
         Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
         Wij = R_WH * Wij * R_WH.transpose();
         ld.base_W -= Wij * m.loads[std::size_t(j)].f_lin_W;
