@@ -194,8 +194,9 @@ Trial BracketedNewton(Eval&& eval, double lo, double hi, double residual_lo, dou
   return trial;
 }
 
-// The residual and its slope in the two unknowns SolveAmplitude uses: p = log t while the tip
-// angle t is below half its range, q = -log y (y = gap - t, exact from k') above it.
+// The trial, and with it the residual and its slope, in the two unknowns SolveAmplitude uses:
+// p = log t while the tip angle t is below half its range, q = -log y (y = gap - t, exact from
+// k') above it.
 Trial TrialLowAngle(const Loading& load, double p) {
   const double t = std::exp(p);
   return MakeTrial(load, t, load.gap - t);
@@ -249,8 +250,8 @@ bool SolveAmplitudeFrom(const Loading& load, double alpha, double t_near, double
     const double next = v - step;
     if (!(next > v_min && next < v_max)) return false;
     // The same end as BracketedNewton's: after a step this small, the trial at the step's end.
-    // Its residual and slope would not be used: only the trial is formed (a third of a warm
-    // solve's work, the slope's three R_D; the numbers are the same).
+    // Its residual and slope would not be used: only the trial is formed (the slope's three R_D
+    // and the residual's logarithms are saved; the numbers are the same).
     if (std::abs(step) <= 1e-9 * std::max(1.0, std::abs(v))) {
       if (next != v) {
         trial = low ? TrialLowAngle(load, next) : TrialHighAngle(load, next);
