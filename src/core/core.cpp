@@ -385,8 +385,28 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
     PcFound& pc = found[std::size_t(k)];
     if (r.distance_m < m.raw[std::size_t(pc.deepest)].distance_m) pc.deepest = i;
-    if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
-    if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
+  }
+  // The region a PC spans: its pieces within epsilon of its deepest, those that touch once the
+  // deepest is pressed to the contact law's end. The whole band spanned a tube crossing an
+  // edge at 2 m/s (a band of 3.75 mm: the pieces either side, 3.2 mm off, while the deepest was
+  // 1.25 mm off): its two load points went to those ends, too far off to close in the tick, and
+  // the tube went through the edge with no force (`stability --only "roll over an edge
+  // speed=2m/s"`, tick 2). A side lying along a face has its pieces at one distance: all in.
+  for (int k = 0; k < found_count; ++k) {
+    PcFound& pc = found[std::size_t(k)];
+    pc.first = pc.last = pc.deepest;  // (the piece that opened the PC may lie beyond epsilon)
+  }
+  for (int i = 0; i < raw_count; ++i) {
+    const RawContact& r = m.raw[std::size_t(i)];
+    for (int k = 0; k < found_count; ++k) {
+      PcFound& pc = found[std::size_t(k)];
+      if (pc.tube != r.tube || pc.part_element != r.part_element) continue;
+      if (r.distance_m > std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps))
+        break;
+      if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
+      if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
+      break;
+    }
   }
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
@@ -814,6 +834,17 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   const Eigen::Vector3d e_hand = error.angle() * error.axis();
   bool torque_saturated = false;
   Eigen::Vector3d torque_sat_W = Eigen::Vector3d::Zero();  // the grip's torque on the tube
+  // A saturated grip lets the contacts turn the held end, and the tick's system is linearised
+  // about the tick's start: a turn that moves the tip by more than epsilon can carry it past
+  // contacts the band never saw. The steel tube rolled off an edge turned by 2.2 rad in one tick
+  // and came out on the far side of the part (`stability --only "roll over an edge E=2e+11Pa"`).
+  // So the slipping grip turns at most epsilon / (l + r1) a tick (the tip's rim moves at most
+  // epsilon); the held end then follows the contacts over several ticks, the grip's torque above
+  // the device's limit meanwhile (flagged clamped; the device's own limiter bounds what it is
+  // sent). A rigid grip follows the hand, which is the operator's motion, and is not capped.
+  Eigen::Vector3d e_grip = e_hand;  // the held end's turn this tick while the grip holds
+  bool turn_limited = false;
+  const double max_turn_rad = eps / (l + scene_.tube.outer_radius_m);
   std::array<int, kMaxLoads> slot{};
   Eigen::Vector3d p_W = p_start_W;
   Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
@@ -869,7 +900,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
       m.rhs.segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
       if (reduced) {
-        m.rhs.segment<3>(r) += G * (Rx * e_hand) - G_p * A;
+        m.rhs.segment<3>(r) += G * (Rx * e_grip) - G_p * A;
         continue;
       }
       m.M.block<3, 3>(r, ip) = G;
@@ -888,7 +919,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       Eigen::Vector3d sum_F = Eigen::Vector3d::Zero();
       for (int k = 0; k < n_active; ++k) sum_F += m.z.segment<3>(3 * k);
       p_W = (A + sum_F) / Kc_eff;
-      omega_W = e_hand;
+      omega_W = e_grip;
       return p_W.allFinite();
     }
     m.M.block<3, 3>(ip, ip) = Kc_eff * Eigen::Matrix3d::Identity();
@@ -976,7 +1007,14 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       A = A_free;
       torque_saturated = false;
       saturated = force_saturated = false;
-    } else if (!torque_saturated) {
+      e_grip = e_hand;
+      turn_limited = false;
+    } else if (torque_saturated && omega_W.norm() > max_turn_rad) {
+      e_grip = omega_W * (max_turn_rad / omega_W.norm());
+      torque_saturated = false;
+      turn_limited = true;
+      changed = true;
+    } else if (!torque_saturated && !turn_limited) {
       Eigen::Vector3d moment_W = Eigen::Vector3d::Zero();
       for (int i = 0; i < load_count; ++i) {
         const int si = slot[std::size_t(i)];
@@ -1013,6 +1051,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // system is solved once more for them.
   if (!solved && finite) {
     solved = solve_system();
+    if (solved && torque_saturated && omega_W.norm() > max_turn_rad) {
+      e_grip = omega_W * (max_turn_rad / omega_W.norm());
+      torque_saturated = false;
+      solved = solve_system();
+    }
     // The device's force still bounds the coupling, whatever the contacts decided: saturate on
     // these decisions (a few passes: each moves the proxy, which changes the stretch).
     for (int pass = 0; solved && pass < 4; ++pass) {
