@@ -367,6 +367,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     }
   }
   std::array<PcFound, kMaxContacts> found{};
+  std::array<int, kMaxRawContacts> pc_of{};  // each raw contact's PC, -1 past kMaxContacts
   int found_count = 0;
   bool truncated = false;
   for (int i = 0; i < raw_count; ++i) {
@@ -375,9 +376,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
                                 found[std::size_t(k)].part_element == r.part_element))
       ++k;
+    pc_of[std::size_t(i)] = k;
     if (k == found_count) {
       if (found_count == kMaxContacts) {
         truncated = true;
+        pc_of[std::size_t(i)] = -1;
         continue;
       }
       found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i};
@@ -386,27 +389,26 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     PcFound& pc = found[std::size_t(k)];
     if (r.distance_m < m.raw[std::size_t(pc.deepest)].distance_m) pc.deepest = i;
   }
-  // The region a PC spans: its pieces within epsilon of its deepest, those that touch once the
-  // deepest is pressed to the contact law's end. The whole band spanned a tube crossing an
-  // edge at 2 m/s (a band of 3.75 mm: the pieces either side, 3.2 mm off, while the deepest was
-  // 1.25 mm off): its two load points went to those ends, too far off to close in the tick, and
-  // the tube went through the edge with no force (`stability --only "roll over an edge
-  // speed=2m/s"`, tick 2). A side lying along a face has its pieces at one distance: all in.
+  // The region a PC spans: its pieces within the static band 2 epsilon, or within epsilon of
+  // its deepest when that is itself only in the speculative sweep (at speed). The whole band
+  // spanned a tube crossing an edge at 2 m/s (a band of 3.75 mm: the pieces either side, 3.2 mm
+  // off, while the deepest was 1.25 mm off): its two load points went to those ends, too far off
+  // to close in the tick, and the tube went through the edge with no force (`stability --only
+  // "roll over an edge speed=2m/s"`, tick 2). It grows from the deepest piece: the piece that
+  // opened the PC may lie outside it.
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
-    pc.first = pc.last = pc.deepest;  // (the piece that opened the PC may lie beyond epsilon)
+    pc.first = pc.last = pc.deepest;
   }
   for (int i = 0; i < raw_count; ++i) {
+    const int k = pc_of[std::size_t(i)];
+    if (k < 0) continue;
     const RawContact& r = m.raw[std::size_t(i)];
-    for (int k = 0; k < found_count; ++k) {
-      PcFound& pc = found[std::size_t(k)];
-      if (pc.tube != r.tube || pc.part_element != r.part_element) continue;
-      if (r.distance_m > std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps))
-        break;
-      if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
-      if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
-      break;
-    }
+    PcFound& pc = found[std::size_t(k)];
+    if (r.distance_m > std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps))
+      continue;
+    if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
+    if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
   }
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
@@ -849,6 +851,13 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   Eigen::Vector3d p_W = p_start_W;
   Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
   bool solved = false, saturated = false, force_saturated = false;
+  // After a torque-saturated solve: if it turned too far, hold the grip at the capped turn.
+  const auto cap_turn = [&] {
+    if (!torque_saturated || !(omega_W.norm() > max_turn_rad)) return false;
+    e_grip = omega_W * (max_turn_rad / omega_W.norm());
+    torque_saturated = false;
+    return true;
+  };
   // Assembles and solves the tick's system for the current decisions; false if not finite.
   //
   // With the grip rigid (not torque-saturated) omega is the hand's turn e and the coupling's
@@ -1009,9 +1018,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       saturated = force_saturated = false;
       e_grip = e_hand;
       turn_limited = false;
-    } else if (torque_saturated && omega_W.norm() > max_turn_rad) {
-      e_grip = omega_W * (max_turn_rad / omega_W.norm());
-      torque_saturated = false;
+    } else if (cap_turn()) {
       turn_limited = true;
       changed = true;
     } else if (!torque_saturated && !turn_limited) {
@@ -1051,11 +1058,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // system is solved once more for them.
   if (!solved && finite) {
     solved = solve_system();
-    if (solved && torque_saturated && omega_W.norm() > max_turn_rad) {
-      e_grip = omega_W * (max_turn_rad / omega_W.norm());
-      torque_saturated = false;
-      solved = solve_system();
-    }
+    if (solved && cap_turn()) solved = solve_system();
     // The device's force still bounds the coupling, whatever the contacts decided: saturate on
     // these decisions (a few passes: each moves the proxy, which changes the stretch).
     for (int pass = 0; solved && pass < 4; ++pass) {
