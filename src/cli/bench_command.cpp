@@ -92,9 +92,8 @@ Figures Measure(const Scenario& scenario, int samples, double& sink) {
     const double value = work();
     const Clock::time_point stop = Clock::now();
     sink += value;
-    return std::pair{value,
-                     std::chrono::duration<double>(stop - start).count() /
-                         scenario.calls_per_sample};
+    return std::pair{
+        value, std::chrono::duration<double>(stop - start).count() / scenario.calls_per_sample};
   };
   for (int i = 0; i < samples; ++i) {
     const auto [value, first_s] = timed([&] { return scenario.run(i); });
@@ -362,7 +361,8 @@ int RunBench(const BenchOptions& o, Streams io) {
   if (!o.json) {
     io.out << std::left << std::setw(28) << "scenario" << std::right << std::setw(11) << "median"
            << std::setw(11) << "p99" << std::setw(11) << "p99.9" << std::setw(11) << "max"
-           << std::setw(11) << "own p99.9" << std::setw(11) << "own max" << "   target\n";
+           << std::setw(11) << "own p99.9" << std::setw(11) << "own max"
+           << "   target\n";
   }
   int mismatched = 0;
   for (const Scenario& scenario : scenarios) {
