@@ -364,12 +364,18 @@ namespace tubeplan::core {
 
 int BeamChain::SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
                              const std::array<int, kMaxLoads>& order,
-                             std::array<RodSegment, kMaxLoads>& segments) const {
+                             std::array<RodSegment, kMaxLoads>& segments,
+                             std::span<Eigen::Vector3d> nodes) const {
   const bool coupled = rule_ == scene::MultiContactRule::kCoupled;
   int segment_count = 0;
   Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();
   double clamp_m = 0.0;
+  // The nodes are shared out as RodNodes does: a segment's up to its end, the last one's all
+  // that are left (straight beyond its last load).
+  const std::size_t node_count = nodes.size();
+  std::array<double, kMaxCapsules + 1> node_s_S{};
+  std::size_t next_node = 0;
   for (int k = 0; k < count;) {
     // One segment: a group's loads (consecutive in `order`), or every load under the coupled rule.
     const int group = loads[std::size_t(order[std::size_t(k)])].group;
@@ -412,7 +418,25 @@ int BeamChain::SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int c
       if (same && angle > 0.0 && angle <= 0.25)
         start.end_R = Eigen::AngleAxisd(angle, turn / angle).toRotationMatrix() * start.end_R;
     }
-    seg.solution = rod_.Solve(seg_loads, start);
+    if (node_count == 0) {
+      seg.solution = rod_.Solve(seg_loads, start);
+    } else {
+      double end_S = 0.0;
+      for (const model::RodLoad& load : seg_loads) end_S = std::max(end_S, load.s_m);
+      const bool last = k == count;
+      const std::size_t first = next_node;
+      for (; next_node < node_count; ++next_node) {
+        const double s = length_m_ * double(next_node) / double(node_count - 1);
+        if (!last && s > clamp_m + end_S) break;
+        node_s_S[next_node - first] = std::max(s - clamp_m, 0.0);
+      }
+      const std::size_t n = next_node - first;
+      const std::span<Eigen::Vector3d> seg_nodes = nodes.subspan(first, n);
+      seg.solution =
+          rod_.Solve(seg_loads, start,
+                     model::RodSamples{std::span<const double>(node_s_S.data(), n), seg_nodes, {}});
+      for (Eigen::Vector3d& p : seg_nodes) p = origin_H + R_HS * p;
+    }
     if (!seg.solution.converged) return 0;
     seg.end_m = clamp_m + seg.solution.end_m;
     // Carry the clamp to the segment's end: there the next segment starts.

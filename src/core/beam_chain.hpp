@@ -148,16 +148,22 @@ class BeamChain {
   /// group (a segment per group, clamped where the previous ended); the coupled rule is one rod
   /// from the held end carrying every load. Each segment starts from the root moment its slot in
   /// `segments` holds (last tick's). Returns the number of segments, or 0 if one did not
-  /// converge (the caller falls back to the linear model).
+  /// converge (the caller falls back to the linear model). When `nodes` is not empty (at least
+  /// 2 and at most kMaxCapsules + 1 of them) it also writes the chain's centreline there, as
+  /// RodNodes would for the solved segments: each segment's solve draws its nodes on its way
+  /// (model::Rod::Solve with samples), so no integration is added for the shape.
   int SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int count,
                     const std::array<int, kMaxLoads>& order,
-                    std::array<RodSegment, kMaxLoads>& segments) const;
+                    std::array<RodSegment, kMaxLoads>& segments,
+                    std::span<Eigen::Vector3d> nodes = {}) const;
   /// Tangent compliance of a solved segment's loads to each other, frame H, written to
   /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular.
   bool RodCompliance(RodSegment& segment,
                      std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const;
   /// The centreline of a solved rod chain at s = k l / (nodes.size() - 1), frame H (straight
-  /// beyond the last segment), and its tangent at the free end.
+  /// beyond the last segment), and its tangent at the free end. The tick draws its nodes with
+  /// the solve (SolveRodChain given the nodes), which spares this integration; this one is
+  /// what tests/core/beam_chain_test.cpp holds that to.
   void RodNodes(const std::array<RodSegment, kMaxLoads>& segments, int segment_count,
                 std::span<Eigen::Vector3d> nodes) const;
   Eigen::Vector3d RodTipTangent(const std::array<RodSegment, kMaxLoads>& segments,

@@ -1232,12 +1232,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // Where the elastica does not cover the loading, or is held off, the rod shapes the tube.
   m.rod_shape = false;
   if (want_elastica && beam_count > 0 && !m.elastica_shape) {
-    m.rod_segment_count = m.beam.SolveRodChain(m.beam_loads, beam_count, m.order, m.rod_segments);
-    if (m.rod_segment_count > 0) {
-      m.rod_shape = true;
-      m.beam.RodNodes(m.rod_segments, m.rod_segment_count,
-                      std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
-    }
+    // The solve draws the nodes on its way (a converged chain's shape, as RodNodes would).
+    m.rod_segment_count =
+        m.beam.SolveRodChain(m.beam_loads, beam_count, m.order, m.rod_segments,
+                             std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
+    m.rod_shape = m.rod_segment_count > 0;
   }
   const double EI = m.beam.bending_stiffness_Nm2();
   const double r1 = scene_.tube.outer_radius_m;

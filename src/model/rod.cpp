@@ -307,9 +307,14 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
   return result;
 }
 
+void Rod::ShapeBuffers::Accept() const {
+  std::copy(trial.p_m.begin(), trial.p_m.end(), shape.p_m.begin());
+  std::copy(trial.R.begin(), trial.R.end(), shape.R.begin());
+}
+
 bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, double scale,
                  int max_iterations, Eigen::Matrix3d& Q, Eigen::Matrix3d& jacobian_inv,
-                 int& iterations, Result& result) const {
+                 int& iterations, Result& result, const ShapeBuffers& buffers) const {
   // Solved until the clamp's section is within 1e-10 rad of the clamp: the shape is then within
   // 1e-10 l of the discrete rod's exact equilibrium (15 pm for the rubber tube, 1.5e-7 N of
   // penalty at K = 1e4 N/m), six orders of magnitude below the discretisation's own error
@@ -317,7 +322,7 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
   // (it was ~5e-13, a few times the steps' rounding) cost a chord iteration more a solve: 16 %
   // of a tick with the side lying along the floor (bench core.side_on_floor).
   constexpr double kTolerance_rad = 1e-10;
-  result = Integrate(loads, order, scale, Q, {});
+  result = Integrate(loads, order, scale, Q, buffers.shape);
   // Chord iterations with the Jacobian of an earlier solve, while each at least halves the
   // residual (a rod loaded a little differently from last tick). Each accepted step corrects
   // the inverse Jacobian by Broyden's rank-one update (the secant through the two iterates), so
@@ -328,9 +333,10 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     Eigen::Vector3d step = -jacobian_inv * result.residual;
     if (!step.allFinite() || step.norm() > 0.5) break;
     const Eigen::Matrix3d trial = Rotation(step) * Q;
-    const Result r = Integrate(loads, order, scale, trial, {});
+    const Result r = Integrate(loads, order, scale, trial, buffers.trial);
     ++iterations;
     if (!(r.residual.norm() < 0.5 * result.residual.norm())) break;
+    buffers.Accept();
     // H += (s - H y) s^T H / (s^T H y), y the residual's change over the step s.
     const Eigen::Vector3d H_y = jacobian_inv * (r.residual - result.residual);
     const double s_H_y = step.dot(H_y);
@@ -358,7 +364,7 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     if (!(result.residual.norm() > kTolerance_rad)) return done();
     ++iterations;
     if (!have_jacobian) {
-      result = Integrate(loads, order, scale, Q, {}, &tangent);
+      result = Integrate(loads, order, scale, Q, buffers.shape, &tangent);
       jacobian();
     }
     const double det = J.determinant();
@@ -371,10 +377,11 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
     bool improved = false;
     for (double lambda = 1.0; lambda > 1.0 / 128.0; lambda *= 0.5) {
       const Eigen::Matrix3d trial = Rotation(lambda * step) * Q;
-      const Result r = Integrate(loads, order, scale, trial, {}, &tangent);
+      const Result r = Integrate(loads, order, scale, trial, buffers.trial, &tangent);
       if (r.residual.allFinite() && r.residual.norm() < result.residual.norm()) {
         Q = trial;
         result = r;
+        buffers.Accept();
         jacobian();
         have_jacobian = true;
         improved = true;
@@ -387,18 +394,36 @@ bool Rod::Newton(std::span<const RodLoad> loads, std::span<const int> order, dou
 }
 
 RodSolution Rod::Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const {
-  return SolveFrom(loads, end_R_guess, Eigen::Matrix3d::Zero());
+  return SolveFrom(loads, end_R_guess, Eigen::Matrix3d::Zero(), {});
 }
 
 RodSolution Rod::Solve(std::span<const RodLoad> loads, const RodSolution& previous) const {
-  return SolveFrom(loads, previous.end_R, previous.jacobian_inv);
+  return SolveFrom(loads, previous.end_R, previous.jacobian_inv, {});
+}
+
+RodSolution Rod::Solve(std::span<const RodLoad> loads, const RodSolution& previous,
+                       const RodSamples& shape) const {
+  return SolveFrom(loads, previous.end_R, previous.jacobian_inv, shape);
 }
 
 RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess,
-                           const Eigen::Matrix3d& jacobian_inv) const {
+                           const Eigen::Matrix3d& jacobian_inv, const RodSamples& shape) const {
   Order order{};
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
+  const std::size_t sample_count = shape.s_m.size();
+  if (sample_count > std::size_t(kMaxShapeSamples) || shape.p_m.size() != sample_count ||
+      !(shape.R.empty() || shape.R.size() == sample_count))
+    throw std::invalid_argument(
+        "Rod::Solve: the shape's samples exceed kMaxShapeSamples or "
+        "their spans differ in size");
+  // Where trial integrations draw the shape until one is accepted (not zeroed: written before
+  // read).
+  std::array<Eigen::Vector3d, kMaxShapeSamples> trial_p;
+  std::array<Eigen::Matrix3d, kMaxShapeSamples> trial_R;
+  const ShapeBuffers buffers{
+      shape, RodSamples{shape.s_m, std::span(trial_p.data(), sample_count),
+                        std::span(trial_R.data(), shape.R.empty() ? 0 : sample_count)}};
   RodSolution solution;
   Result result;
   Eigen::Matrix3d Q = Eigen::Matrix3d::Identity();
@@ -420,7 +445,7 @@ RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d
     // less than that, and the continuation below decides instead.
     const Eigen::Matrix3d guess = Eigen::Quaterniond(end_R_guess).normalized().toRotationMatrix();
     Q = guess;
-    converged = Newton(loads, sorted, 1.0, 8, Q, J_inv, solution.iterations, result) &&
+    converged = Newton(loads, sorted, 1.0, 8, Q, J_inv, solution.iterations, result, buffers) &&
                 Eigen::AngleAxisd(Q * guess.transpose()).angle() <= 0.5;
   }
   // Continuation from the unloaded rod: the load grown in steps, each solved from the last, at
@@ -433,13 +458,13 @@ RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d
     J_inv.setZero();
     converged = true;
     for (int k = 1; k <= steps && converged; ++k)
-      converged =
-          solution.iterations < kMaxIterations &&
-          Newton(loads, sorted, double(k) / steps, 20, Q, J_inv, solution.iterations, result);
+      converged = solution.iterations < kMaxIterations &&
+                  Newton(loads, sorted, double(k) / steps, 20, Q, J_inv, solution.iterations,
+                         result, buffers);
   }
   if (!converged && !Q.allFinite()) {
     Q.setIdentity();
-    result = Integrate(loads, sorted, 1.0, Q, {});
+    result = Integrate(loads, sorted, 1.0, Q, shape);
   }
   solution.end_R = Q;
   solution.jacobian_inv = converged ? J_inv : Eigen::Matrix3d::Zero();

@@ -85,3 +85,42 @@ TEST_CASE("Elastica points evaluated a segment at a time are the points one by o
   // And they are the shape: the tip where the second segment's elastica puts it, not straight.
   CHECK((points.back() - Eigen::Vector3d(0.0, 0.0, l)).norm() > 1e-3);
 }
+
+TEST_CASE("A rod chain solved with its nodes draws what RodNodes draws of it, bit for bit",
+          "[core][beam]") {
+  // SolveRodChain given the nodes has each segment's solve draw its share of them on its way
+  // (model::Rod::Solve with samples); RodNodes integrates each solved segment once more through
+  // the same arc positions. The same discrete rods, so the same bits: under the segmented rule
+  // (two segments, the second clamped where the first ends, nodes shared out between them and
+  // the straight run beyond the last load) and under the coupled rule (one rod, two loads).
+  for (const scene::MultiContactRule rule :
+       {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
+    scene::Scene s = RubberTube();
+    s.model.multi_contact = rule;
+    const core::BeamChain beam(s);
+    const double EI = beam.bending_stiffness_Nm2(), l = s.tube.length_m;
+    const double F = 6.0 * EI / (l * l);  // past the elastica's linear range: alpha 6
+    std::array<core::BeamLoad, core::kMaxLoads> loads{};
+    const Eigen::Vector3d r_H(0.0, s.tube.outer_radius_m, 0.0);
+    loads[0] = {0.45 * l, F * Eigen::Vector3d(0.7, -0.4, -0.2), r_H, 0.0, 0, 0};
+    loads[1] = {0.8 * l, F * Eigen::Vector3d(-0.3, -0.6, -0.4), r_H, 0.0, 0, 1};
+    std::array<bool, core::kMaxLoads> member{};
+    member[0] = member[1] = true;
+    std::array<int, core::kMaxLoads> order{};
+    int members = 0;
+    beam.Assign(loads, 2, member, order, members);
+    REQUIRE(members == 2);
+    std::array<core::RodSegment, core::kMaxLoads> segments{};
+    std::array<Eigen::Vector3d, 49> drawn;
+    const int count = beam.SolveRodChain(loads, 2, order, segments, drawn);
+    INFO((rule == scene::MultiContactRule::kCoupled ? "coupled" : "segmented"));
+    REQUIRE(count == (rule == scene::MultiContactRule::kCoupled ? 1 : 2));
+    std::array<Eigen::Vector3d, 49> nodes;
+    beam.RodNodes(segments, count, nodes);
+    int differing = 0;
+    for (std::size_t k = 0; k < nodes.size(); ++k)
+      if (drawn[k] != nodes[k]) ++differing;
+    CHECK(differing == 0);
+    CHECK((drawn.back() - Eigen::Vector3d(0.0, 0.0, l)).norm() > 1e-3);  // bent, not straight
+  }
+}

@@ -83,6 +83,14 @@ class Rod {
   RodSolution Solve(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess) const;
   /// The same from a previous solution: its end frame and its Jacobian as the starting point.
   RodSolution Solve(std::span<const RodLoad> loads, const RodSolution& previous) const;
+  /// The same, and the solution's shape at the samples (at most kMaxShapeSamples), as Shape
+  /// would give it, to the bit: every integration of the solve steps through the samples' arc
+  /// positions, so the one that converged has drawn the shape on its way, and the integration
+  /// Shape would add is spared. (The breakpoints change the discrete rod a little, within its
+  /// discretisation error: a solve with samples is not bit-equal to one without.) The samples
+  /// are written whatever the outcome: the last accepted iterate's.
+  RodSolution Solve(std::span<const RodLoad> loads, const RodSolution& previous,
+                    const RodSamples& shape) const;
 
   /// The shape of a solved rod at the samples' arc positions (within [0, end_m]).
   void Shape(std::span<const RodLoad> loads, const RodSolution& solution,
@@ -106,6 +114,7 @@ class Rod {
   double max_step_m() const { return max_step_m_; }
 
   static constexpr int kMaxLoads = 16;
+  static constexpr int kMaxShapeSamples = 129;
   /// Newton iterations one Solve may spend, continuation included (each one integration
   /// carrying its Jacobian, ~2.5 plain ones, and more if the step is damped).
   static constexpr int kMaxIterations = 320;
@@ -129,11 +138,17 @@ class Rod {
                    Tangent<kMaxDirections>* tangent) const;
   Result Integrate(std::span<const RodLoad> loads, std::span<const int> order, double scale,
                    const Eigen::Matrix3d& Q, const RodSamples& samples) const;
+  // The samples a solve draws the shape at (`shape`, possibly empty) and where its trial
+  // integrations draw theirs until one is accepted (`trial`: the same arc positions).
+  struct ShapeBuffers {
+    RodSamples shape, trial;
+    void Accept() const;  // the trial's samples become the shape's
+  };
   bool Newton(std::span<const RodLoad> loads, std::span<const int> order, double scale,
               int max_iterations, Eigen::Matrix3d& Q, Eigen::Matrix3d& jacobian_inv,
-              int& iterations, Result& result) const;
+              int& iterations, Result& result, const ShapeBuffers& buffers) const;
   RodSolution SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d& end_R_guess,
-                        const Eigen::Matrix3d& jacobian_inv) const;
+                        const Eigen::Matrix3d& jacobian_inv, const RodSamples& shape) const;
 
   double EI_ = 0.0;
   double max_step_m_ = 0.0;
