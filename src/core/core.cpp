@@ -131,11 +131,19 @@ struct Core::State {
   int rod_tangent_members = 0, rod_tangent_age = 0;
   double held_off_load_N = 0.0;
   std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
-  // The elastica's tangent compliance per segment and the loads it was computed for.
-  std::array<Eigen::Matrix3d, kMaxLoads> tangent{};
-  std::array<Eigen::Vector3d, kMaxLoads> tangent_force{};
-  std::array<double, kMaxLoads> tangent_length{};
-  int tangent_count = 0, tangent_age = 0;
+  // The elastica's tangent compliance per segment and the loads it was computed for, its age in
+  // ticks; the last two computed (`tangents[tangent_current]` the one used last). Two, because
+  // a tip in stick-slip at the tick rate alternates between two loadings (the stuck and the
+  // sliding force, 59 and 5 mN in `tubeplan bench`'s core.end_sliding): with one kept, each
+  // tick's tangent missed the other's loading and was computed again, on 60 % of the ticks.
+  struct ElasticaTangent {
+    std::array<Eigen::Matrix3d, kMaxLoads> J{};
+    std::array<Eigen::Vector3d, kMaxLoads> force{};
+    std::array<double, kMaxLoads> length{};
+    int count = 0, age = 0;
+  };
+  std::array<ElasticaTangent, 2> tangents{};
+  int tangent_current = 0;
 
   // Per-tick scratch (kept here so that Step allocates nothing).
   std::array<RawContact, kMaxRawContacts> raw{};
@@ -266,7 +274,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.R_held_prev_W = X_WH.linear();
   m.prev_count = 0;
   m.beam_count = m.segment_count = 0;
-  m.tangent_count = 0;
+  for (State::ElasticaTangent& t : m.tangents) t.count = 0;
   m.elastica_shape = false;
   m.elastica_held_off = false;
   m.held_off_load_N = 0.0;
@@ -721,7 +729,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
       // The tangent costs three elastica solves a segment. It only steers this tick's Newton
       // step (the solution is where the elastica's shape and the contacts agree, whatever the
       // tangent), so one computed for loads within 10 % and lengths within 1 % of these, in the
-      // last 50 ticks, is used again.
+      // last 50 ticks, is used again: the last one used, else the one before it.
       // (Eigen's vectors are not zeroed by {}: fill them.)
       std::array<Eigen::Vector3d, kMaxLoads> f_group;
       f_group.fill(Eigen::Vector3d::Zero());
@@ -732,26 +740,34 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         length_m[std::size_t(b.group)] = b.s_m - b.clamp_m;  // the group's last load: its end
       }
       const double scale_N = m.beam.bending_stiffness_Nm2() / (l * l);
-      bool reuse = m.tangent_count == groups && m.tangent_age < 50;
-      for (int g = 0; g < groups && reuse; ++g) {
-        const std::size_t gi = std::size_t(g);
-        reuse = (f_group[gi] - m.tangent_force[gi]).norm() <=
-                    0.1 * m.tangent_force[gi].norm() + 1e-3 * scale_N &&
-                std::abs(length_m[gi] - m.tangent_length[gi]) <= 0.01 * l;
-      }
-      if (!reuse) {
-        m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
-        for (int g = 0; g < groups; ++g) {
+      const auto fits = [&](const State::ElasticaTangent& t) {
+        bool ok = t.count == groups && t.age < 50;
+        for (int g = 0; g < groups && ok; ++g) {
           const std::size_t gi = std::size_t(g);
-          m.tangent[gi] = m.beam.ElasticaCompliance(m.segments[gi], f_group[gi]);
-          m.tangent_force[gi] = f_group[gi];
-          m.tangent_length[gi] = length_m[gi];
+          ok = (f_group[gi] - t.force[gi]).norm() <= 0.1 * t.force[gi].norm() + 1e-3 * scale_N &&
+               std::abs(length_m[gi] - t.length[gi]) <= 0.01 * l;
         }
-        m.tangent_count = groups;
-        m.tangent_age = 0;
+        return ok;
+      };
+      if (!fits(m.tangents[std::size_t(m.tangent_current)])) {
+        // The other one, or a new one in its place.
+        m.tangent_current = 1 - m.tangent_current;
+        State::ElasticaTangent& t = m.tangents[std::size_t(m.tangent_current)];
+        if (!fits(t)) {
+          m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
+          for (int g = 0; g < groups; ++g) {
+            const std::size_t gi = std::size_t(g);
+            t.J[gi] = m.beam.ElasticaCompliance(m.segments[gi], f_group[gi]);
+            t.force[gi] = f_group[gi];
+            t.length[gi] = length_m[gi];
+          }
+          t.count = groups;
+          t.age = 0;
+        }
       }
+      const State::ElasticaTangent& tangent = m.tangents[std::size_t(m.tangent_current)];
       for (int g = 0; g < groups; ++g) {
-        const Eigen::Matrix3d& J = m.tangent[std::size_t(g)];
+        const Eigen::Matrix3d& J = tangent.J[std::size_t(g)];
         for (int ki = 0; ki < members; ++ki) {
           const int i = m.order[std::size_t(ki)];
           if (m.beam_loads[std::size_t(i)].group != g) continue;
@@ -1199,7 +1215,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   }
   out.contact_count = kept;
 
-  ++m.tangent_age;
+  for (State::ElasticaTangent& t : m.tangents) ++t.age;
   ++m.rod_tangent_age;
 
   // 8. The shape under the solved loads: the next tick's capsules, energy, strain, markers.
