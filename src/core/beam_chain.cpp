@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <tubeplan/model/tube.hpp>
 
@@ -374,6 +375,8 @@ int BeamChain::SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int c
   // The nodes are shared out as RodNodes does: a segment's up to its end, the last one's all
   // that are left (straight beyond its last load).
   const std::size_t node_count = nodes.size();
+  if (node_count == 1 || node_count > std::size_t(kMaxCapsules) + 1)
+    throw std::invalid_argument("BeamChain::SolveRodChain: 2 to kMaxCapsules + 1 nodes expected");
   std::array<double, kMaxCapsules + 1> node_s_S{};
   std::size_t next_node = 0;
   for (int k = 0; k < count;) {

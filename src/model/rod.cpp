@@ -533,11 +533,17 @@ RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
   const std::size_t sample_count = shape.s_m.size();
-  if (sample_count > std::size_t(kMaxShapeSamples) || shape.p_m.size() != sample_count ||
-      !(shape.R.empty() || shape.R.size() == sample_count))
+  bool samples_ok = sample_count <= std::size_t(kMaxShapeSamples) &&
+                    shape.p_m.size() == sample_count &&
+                    (shape.R.empty() || shape.R.size() == sample_count);
+  // Ascending and finite from 0: Integrate records every such sample (Shape's contract), so the
+  // accepted trial's buffer is written through before it is copied.
+  for (std::size_t k = 0; k < sample_count && samples_ok; ++k)
+    samples_ok = shape.s_m[k] >= (k == 0 ? 0.0 : shape.s_m[k - 1]) && std::isfinite(shape.s_m[k]);
+  if (!samples_ok)
     throw std::invalid_argument(
-        "Rod::Solve: the shape's samples exceed kMaxShapeSamples or "
-        "their spans differ in size");
+        "Rod::Solve: the shape's samples must be at most kMaxShapeSamples arc positions, "
+        "ascending, finite and >= 0, with spans of their size");
   // Where trial integrations draw the shape until one is accepted (not zeroed: written before
   // read).
   std::array<Eigen::Vector3d, kMaxShapeSamples> trial_p;

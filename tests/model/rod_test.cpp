@@ -6,7 +6,9 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 #include <Eigen/Core>
@@ -388,8 +390,12 @@ TEST_CASE("Rod: a solve given samples draws the shape Shape draws at its solutio
       previous = rod.Solve(smaller, Eigen::Matrix3d::Identity());
       REQUIRE(previous.converged);
     }
+    // NaN first: a sample left unwritten fails the comparison (NaN equals nothing).
+    const double nan = std::numeric_limits<double>::quiet_NaN();
     std::array<Eigen::Vector3d, 49> drawn, shaped;
     std::array<Eigen::Matrix3d, 49> drawn_R, shaped_R;
+    for (auto* p : {&drawn, &shaped}) p->fill(Eigen::Vector3d::Constant(nan));
+    for (auto* R : {&drawn_R, &shaped_R}) R->fill(Eigen::Matrix3d::Constant(nan));
     const RodSolution solution = rod.Solve(c.loads, previous, RodSamples{s, drawn, drawn_R});
     REQUIRE(solution.converged);
     rod.Shape(c.loads, solution, RodSamples{s, shaped, shaped_R});
@@ -406,4 +412,19 @@ TEST_CASE("Rod: a solve given samples draws the shape Shape draws at its solutio
     REQUIRE(plain.converged);
     CHECK((plain.end_p_m - solution.end_p_m).norm() < 1e-4);
   }
+}
+
+TEST_CASE("Rod: a solve refuses samples it would not draw", "[rod]") {
+  // Integrate records only ascending samples from 0: anything else would leave the caller's
+  // entries unwritten (Shape leaves them as they were; a solve copied scratch over them).
+  const Rod rod(1.0, 1.0 / 48.0);
+  const std::vector<RodLoad> loads = {At(1.0, Eigen::Vector3d(2.0, 0.0, 0.0))};
+  std::array<Eigen::Vector3d, 3> p;
+  for (const std::array<double, 3> s :
+       {std::array<double, 3>{-0.1, 0.5, 1.0}, std::array<double, 3>{0.0, 0.6, 0.5},
+        std::array<double, 3>{0.0, std::nan(""), 1.0}}) {
+    CHECK_THROWS_AS(rod.Solve(loads, RodSolution{}, RodSamples{s, p, {}}), std::invalid_argument);
+  }
+  const std::array<double, 3> fine{0.0, 0.5, 1.0};
+  CHECK(rod.Solve(loads, RodSolution{}, RodSamples{fine, p, {}}).converged);
 }

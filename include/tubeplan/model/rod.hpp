@@ -88,7 +88,9 @@ class Rod {
   /// positions, so the one that converged has drawn the shape on its way, and the integration
   /// Shape would add is spared. (The breakpoints change the discrete rod a little, within its
   /// discretisation error: a solve with samples is not bit-equal to one without.) The samples
-  /// are written whatever the outcome: the last accepted iterate's.
+  /// must lie in [0, inf), ascending and finite (std::invalid_argument otherwise); they are the
+  /// solution's shape only when it `converged` (else some iterate's, possibly of a
+  /// continuation step).
   RodSolution Solve(std::span<const RodLoad> loads, const RodSolution& previous,
                     const RodSamples& shape) const;
 
