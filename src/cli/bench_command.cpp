@@ -14,10 +14,14 @@
 // tick of a few microseconds. Each core scenario therefore steps kReplicas cores in lockstep (the
 // same scene and hand poses, hence the same state to the bit, checked by their outputs) and
 // times each; a tick's own cost is the least of its kReplicas times. The wall-clock figures of
-// the first core are reported beside it, unchanged.
+// the first core are reported beside it. (Its tick now runs between two other cores' ticks, with
+// their state in the caches too: measured against a single core the medians moved by 2 % at
+// most, within this VM's drift.)
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <iomanip>
 #include <memory>
@@ -78,10 +82,14 @@ double Percentile(const std::vector<double>& sorted, double q) {
 Figures Measure(const Scenario& scenario, int samples, double& sink) {
   using Clock = std::chrono::steady_clock;
   Figures f;
+  // The same bits (a NaN equals itself, -0 differs from +0).
+  const auto same = [](double a, double b) {
+    return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+  };
   const auto call = [&](int i) {
     const double value = scenario.run(i);
     for (int r = 1; r < scenario.replicas; ++r)
-      if (scenario.replica(i, r) != value) ++f.replica_mismatches;
+      if (!same(scenario.replica(i, r), value)) ++f.replica_mismatches;
     return value;
   };
   for (int i = 0; i < std::max(10, samples / 10); ++i) sink += call(i);  // warm caches
@@ -100,7 +108,7 @@ Figures Measure(const Scenario& scenario, int samples, double& sink) {
     double least_s = first_s;
     for (int r = 1; r < scenario.replicas; ++r) {
       const auto [replica_value, replica_s] = timed([&] { return scenario.replica(i, r); });
-      if (replica_value != value) ++f.replica_mismatches;
+      if (!same(replica_value, value)) ++f.replica_mismatches;
       least_s = std::min(least_s, replica_s);
     }
     per_call_s[static_cast<std::size_t>(i)] = first_s;
@@ -402,6 +410,7 @@ int RunBench(const BenchOptions& o, Streams io) {
       }
       if (scenario.target_p999_s > 0.0) {
         entry["target_p999_us"] = scenario.target_p999_s * 1e6;
+        entry["target_p999_judged_on"] = "own.p999_us";
         entry["target_met"] = median_met && p999_met;
       }
       if (scenario.state) entry["state"] = scenario.state();
@@ -439,10 +448,11 @@ int RunBench(const BenchOptions& o, Streams io) {
                   .dump(2)
            << "\n";
   } else {
-    io.out << "(per call; " << o.samples << " samples each; own: the least of " << kReplicas
-           << " cores' times for the same tick, without the machine's interruptions; tube alpha "
-              "at 1 N = "
-           << model::LoadParameter(spec, 1.0) << ")\n";
+    io.out << "(per call; " << o.samples << " samples each; ";
+    if (!o.beam_only)
+      io.out << "own: the least of " << kReplicas
+             << " cores' times for the same tick, without the machine's interruptions; ";
+    io.out << "tube alpha at 1 N = " << model::LoadParameter(spec, 1.0) << ")\n";
   }
   // The sink is never NaN for valid input; printing it only when it is keeps the work observable.
   if (std::isnan(sink)) io.err << "tubeplan bench: a scenario produced NaN\n";

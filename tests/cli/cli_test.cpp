@@ -230,6 +230,7 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
       // statistic of the own figures is at most the same one of the first core's.
       REQUIRE(s.contains("own"));
       CHECK(s["replicas"].get<int>() == 3);
+      CHECK(s["target_p999_judged_on"] == "own.p999_us");
       CHECK(s["own"]["median_us"].get<double>() <= median);
       CHECK(s["own"]["p999_us"].get<double>() <= s["p999_us"].get<double>());
       CHECK(s["own"]["max_us"].get<double>() <= s["max_us"].get<double>());
