@@ -232,6 +232,9 @@ struct CoreRun {
   double us_per_tick = 0.0;
   int ticks = 0;
   std::uint32_t flags = 0;
+  // First tick (from 1) the core flagged its shape off its contacts' points, and a tube and a
+  // part overlapping: where a row's error stops being the model's and becomes a failure.
+  int first_shape_off_tick = -1, first_penetration_tick = -1;
 };
 
 Eigen::Isometry3d HandAt(const Vector2d& xz) {
@@ -257,6 +260,10 @@ CoreRun RunCore(const scene::Scene& s, const Scenario& sc) {
       spent += Clock::now() - t0;
       run.flags |= out.flags;
       ++run.ticks;
+      if ((out.flags & core::kShapeOffContacts) && run.first_shape_off_tick < 0)
+        run.first_shape_off_tick = run.ticks;
+      if ((out.flags & core::kPenetration) && run.first_penetration_tick < 0)
+        run.first_penetration_tick = run.ticks;
     }
     hand = target;
   };
@@ -500,6 +507,10 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
       if (run.flags & core::kLinearFallback) row.detail += "; linear fallback seen";
       if (run.flags & core::kSolverFault) row.detail += "; SOLVER FAULT seen";
       if (run.flags & core::kForceClamped) row.detail += "; force clamped";
+      if (run.first_shape_off_tick >= 0)
+        row.detail += Fmt("; SHAPE OFF ITS CONTACTS from tick %d", run.first_shape_off_tick);
+      if (run.first_penetration_tick >= 0)
+        row.detail += Fmt("; tube and part overlap from tick %d", run.first_penetration_tick);
       report.rows.push_back(row);
     }
   }
