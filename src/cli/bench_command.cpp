@@ -270,6 +270,8 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
     return nlohmann::json{{"cf", core.FormationText()},
                           {"pcs", core.last().contact_count},
                           {"narrow_phase_calls", core.narrow_phase_calls()},
+                          {"idle_parts_left_out", core.idle_parts_left_out()},
+                          {"idle_retries", core.idle_retries()},
                           {"shape", ShapeModel(core)},
                           {"capsules", core.capsule_count()}};
   };

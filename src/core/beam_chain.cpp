@@ -115,6 +115,23 @@ Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool
   return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
 }
 
+double BeamChain::DisplacementBound(const BeamLoad& j, const Eigen::Vector3d& df_H, bool moments,
+                                    double r_max_m, double s_max_m, const Eigen::Matrix3d& normal_H,
+                                    const Eigen::Matrix3d& turn_H) const {
+  // Compliance's terms one by one. The force's lateral part L F bends the centre by uF L F
+  // (its direction fixed, its size uF at most its value at s_max: |n . uF L F| <= uF |P L F| for
+  // unit n in P's range) and turns the section by theta = thF z x F, which moves the point at
+  // offset r_i by r_i x theta: |n . (r x theta)| = |r . (theta x n)| <= r_max |theta x n|, and
+  // |theta x n| is |theta| less its part along n when n is one direction. The offset moment
+  // r_j x F moves and turns it too (uM, thM) where the model carries it: bounded whole.
+  const Coefficients c = Coeffs(s_max_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  const Eigen::Vector3d lateral(df_H.x(), df_H.y(), 0.0);
+  const Eigen::Vector3d turn(-df_H.y(), df_H.x(), 0.0);  // z x F
+  double bound = c.uF * (normal_H * lateral).norm() + r_max_m * c.thF * (turn_H * turn).norm();
+  if (moments) bound += (c.uM + r_max_m * c.thM) * j.r_H_m.norm() * df_H.norm();
+  return bound;
+}
+
 Eigen::Vector3d BeamChain::CentreDisplacement(double s_m, const BeamLoad& j) const {
   const Coefficients c = Coeffs(s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
   const Eigen::Vector3d M = j.r_H_m.cross(j.f_H_N);

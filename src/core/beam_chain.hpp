@@ -102,6 +102,16 @@ class BeamChain {
   /// Without `moments` the offset moment r_j x F_j is left out (the elastica carries tip forces
   /// only, and the compliance must describe the shape the model will produce).
   Eigen::Matrix3d Compliance(const BeamLoad& i, const BeamLoad& j, bool moments = true) const;
+  /// An upper bound [m] of |Compliance(i, j, moments) df_H| over every point i of the tube (any
+  /// arc position, its offset from the centreline at most r_max_m): how far a change df_H [N]
+  /// of load j's force moves any surface point. Each coefficient grows with the point's arc
+  /// position, so a point at s_max_m bounds all those up to there. `normal_H` projects onto the
+  /// directions the bound is for (a part's possible normals: the bound of |n . displacement|
+  /// for unit n among them), `turn_H` is what a turn's cross product with such an n can keep
+  /// (the identity, or the projection across n when n is one direction).
+  double DisplacementBound(const BeamLoad& j, const Eigen::Vector3d& df_H, bool moments,
+                           double r_max_m, double s_max_m, const Eigen::Matrix3d& normal_H,
+                           const Eigen::Matrix3d& turn_H) const;
   /// Displacement of the centre at s_m [m] and rotation of its section [rad], frame H, under
   /// load j (force and the moment of its offset).
   Eigen::Vector3d CentreDisplacement(double s_m, const BeamLoad& j) const;

@@ -52,6 +52,11 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       tube_tolerance_m_(0.1 * scene.contact.threshold_m),
       eps_m_(scene.contact.threshold_m),
       inner_radius_m_(scene.tube.inner_radius_m) {
+  {
+    const double r1 = scene.tube.outer_radius_m, r2 = scene.tube.inner_radius_m;
+    const double tilt = 4.0 * eps_m_ * r1 / (r1 * r1 + r2 * r2);
+    facing_axis_sq_ = 1.0 - tilt * tilt;
+  }
   // FCL's default 1e-6 leaves micrometres of error in d, i.e. 1e-2 N at K = 1e4 N/m.
   solver_.gjk_tolerance = 1e-12;
   solver_.gjk_max_iterations = 128;
@@ -295,8 +300,103 @@ Eigen::Vector3d Collision::Overlapping(const Part& part, const Eigen::Vector3d& 
   return q_P;
 }
 
+bool Collision::LeaveOut(const Part& part, const KeptDistance* kept,
+                         std::span<const Eigen::Vector3d> nodes_W,
+                         const Eigen::Vector3d& end_start_W, const Eigen::Vector3d& end_start_P,
+                         double band_m, IdleParts& idle) const {
+  // The pieces the band would take are those the broad phase passes and no kept distance
+  // settles beyond the band (the loop in Query). Each has a kept distance, less how far it has
+  // moved since: a lower bound of its distance now (KeptBeyondBand). The part is left out when
+  // the least of them is above the floor; a piece with none, or an end that could face the
+  // part, keeps it in. Pieces are grouped by the axes their normals may have (IdleParts).
+  const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
+  const std::size_t node_count = nodes_W.size();
+  std::array<double, 8> lowest_m, moved_sq, s_max_m;
+  lowest_m.fill(std::numeric_limits<double>::infinity());
+  moved_sq.fill(0.0);
+  s_max_m.fill(-1.0);  // no piece
+  for (int k = 0; k < pieces; ++k) {
+    const bool is_end = k == pieces - 1;
+    const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
+    const Eigen::Vector3d& b_W = is_end ? nodes_W.back() : nodes_W[std::size_t(k) + 1];
+    const Eigen::Vector3d& a_P = is_end ? end_start_P : nodes_P_[std::size_t(k)];
+    const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
+    if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
+    const KeptDistance& kept_k = kept[k];
+    if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) continue;
+    // A capsule's nearest point to the box lies on the line from its axis's nearest point c to
+    // that point's clamp into the box: the normal has a component only along the axes on which
+    // c is out of the slab, so only where the axis reaches out. The end cylinder's rim reaches
+    // r1 beyond its axis. The face mask's tolerance is the margin for rounding.
+    const double reach_out_m = is_end ? radius_m_ : 0.0;
+    int outside = 0;
+    for (int i = 0; i < 3; ++i)
+      if (std::max(std::abs(a_P[i]), std::abs(b_P[i])) + reach_out_m >=
+          part.half_m[i] - 2.0 * part_tolerance_m_)
+        outside |= 1 << i;
+    if (is_end) {
+      // A face of the part the end nearly faces keeps it in, if the end cylinder reaches that
+      // face's plane (else no nearest point can lie on it).
+      const Eigen::Vector3d axis_P = (b_P - a_P).normalized();
+      for (int i = 0; i < 3; ++i)
+        if ((outside & (1 << i)) != 0 && !(axis_P[i] * axis_P[i] < facing_axis_sq_)) return false;
+    }
+    const std::size_t g = std::size_t(outside);
+    lowest_m[g] = std::min(lowest_m[g], kept_k.d_m);
+    moved_sq[g] = std::max(
+        {moved_sq[g], (a_W - kept_k.a_W_m).squaredNorm(), (b_W - kept_k.b_W_m).squaredNorm()});
+    // A load's arc position lies within its piece.
+    s_max_m[g] = is_end ? length_m_ : piece_m_ * (k + 1);
+  }
+  // The same margin as KeptBeyondBand's, for the same rounding. Nothing kept (-infinity) or a
+  // NaN compares false: kept in.
+  std::array<double, 8> gap_m{};
+  for (std::size_t g = 0; g < 8; ++g) {
+    if (s_max_m[g] < 0.0) continue;
+    gap_m[g] = lowest_m[g] - std::sqrt(moved_sq[g]) - kCoherenceMargin_m;
+    if (!(gap_m[g] > idle.floor_m)) return false;
+  }
+  ++idle.left_out;
+  for (int outside = 0; outside < 8; ++outside) {
+    const std::size_t g = std::size_t(outside);
+    if (s_max_m[g] < 0.0) continue;
+    IdleParts::Group group;
+    group.dims = (outside & 1) + ((outside >> 1) & 1) + ((outside >> 2) & 1);
+    const int axis = group.dims == 1 ? (outside == 1   ? 0
+                                        : outside == 2 ? 1
+                                                       : 2)
+                                     : (outside == 6   ? 0
+                                        : outside == 5 ? 1
+                                                       : 2);
+    if (group.dims == 0) group.dims = 3;  // no axis out: inside the box (overlap), any normal
+    group.axis_W = group.dims == 3 ? Eigen::Vector3d::UnitZ().eval()
+                                   : part.DirectionToWorld(Eigen::Vector3d::Unit(axis));
+    group.gap_m = gap_m[g];
+    group.s_max_m = s_max_m[g];
+    group.first_part = part.index;
+    int at = 0;
+    while (at < idle.group_count && !(idle.groups[std::size_t(at)].dims == group.dims &&
+                                      idle.groups[std::size_t(at)].axis_W == group.axis_W))
+      ++at;
+    if (at == IdleParts::kMaxGroups) {
+      // Full: the last group takes this one in, as a group of any normal.
+      at = IdleParts::kMaxGroups - 1;
+      idle.groups[std::size_t(at)].dims = 3;
+    }
+    if (at == idle.group_count) {
+      idle.groups[std::size_t(idle.group_count++)] = group;
+      continue;
+    }
+    IdleParts::Group& into = idle.groups[std::size_t(at)];
+    into.gap_m = std::min(into.gap_m, group.gap_m);
+    into.s_max_m = std::max(into.s_max_m, group.s_max_m);
+    into.first_part = std::min(into.first_part, group.first_part);
+  }
+  return true;
+}
+
 int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
-                     double band_m, std::span<RawContact> out) const {
+                     double band_m, std::span<RawContact> out, IdleParts* idle) const {
   // Capsules 0 .. pieces - 2, then the end cylinder as piece pieces - 1.
   const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
   int count = 0;
@@ -321,6 +421,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         ((hi.array() + grow) < -part.half_m.array()).any())
       continue;
     const Eigen::Vector3d end_start_P = part.ToPart(end_start_W);
+    if (idle != nullptr && part.index < idle->may_leave_out.size() &&
+        idle->may_leave_out[part.index] != 0 &&
+        LeaveOut(part, kept, nodes_W, end_start_W, end_start_P, band_m, *idle))
+      continue;
     for (int k = 0; k < pieces; ++k) {
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
@@ -344,10 +448,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // distance kept for the end piece.
         double bound_m = 0.0;
         Eigen::Vector3d unused_p, unused_q, unused_n;
-        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_n) &&
-            bound_m >= band_m) {
+        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_n)) {
           Keep(kept_k, a_W, b_W, bound_m);
-          continue;
+          if (bound_m >= band_m) continue;
         }
       }
 
@@ -362,10 +465,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       if (!is_end) {
         separated = CapsuleBoxDistance(part, a_P, b_P, d, p_P, q_P, n_P);
         signed_depth = separated && d <= 0.0;
-        if (separated && d >= band_m) {
-          Keep(kept_k, a_W, b_W, d);
-          continue;
-        }
+        if (separated) Keep(kept_k, a_W, b_W, d);
+        if (separated && d >= band_m) continue;
       } else if (CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
         // The end piece nearest to a face (the usual case: the tip on the floor, the end against
         // a wall) in closed form; FCL's GJK only for an edge or a vertex nearest, or overlap.

@@ -71,6 +71,35 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
                             const Eigen::Vector3d& half, double& depth, Eigen::Vector3d& p_cylinder,
                             Eigen::Vector3d& q_box, Eigen::Vector3d& normal);
 
+/// Parts a Query may leave out whole (the core's, docs/core.md "Idle parts"): a part with no load
+/// last tick whose every piece within the band is, by the distances kept from earlier queries,
+/// provably farther than `floor_m`. The core then checks each pass of its solve against `gap_m`
+/// and asks again with nothing left out where a left-out pair might have closed.
+struct IdleParts {
+  std::span<const std::uint8_t> may_leave_out;  ///< per scene part index; empty: none
+  double floor_m = 0.0;
+  // Out: what the left-out parts leave, in groups of pieces. A tube point within a part's slab
+  // along one of its axes has its nearest box point at the same coordinate there, so the pair's
+  // normal has no component along that axis: a group's normal lies in the span of the part's
+  // axes along which one of its pieces reaches out of the slab (`dims` of them: along `axis_W`
+  // when 1, across it when 2, anywhere when 3). Its pieces are at least `gap_m` away and no
+  // farther along the tube than `s_max_m`; only motion along such a normal, and bending no
+  // larger than the bending there, can close one.
+  struct Group {
+    Eigen::Vector3d axis_W = Eigen::Vector3d::UnitZ();
+    int dims = 3;
+    double gap_m = 0.0;
+    double s_max_m = 0.0;
+    /// The first of its parts in the query's order (scene index): their loads would have come
+    /// after those of every part before it.
+    std::uint32_t first_part = 0;
+  };
+  static constexpr int kMaxGroups = 8;
+  std::array<Group, kMaxGroups> groups{};
+  int group_count = 0;
+  int left_out = 0;  ///< parts left out
+};
+
 class Collision {
  public:
   /// `element_of[part][mask]` is the element index of a face mask of a part.
@@ -84,8 +113,16 @@ class Collision {
   /// and returns how many; no allocation. Pairs closer than `band_m` are returned (the core asks
   /// for more than epsilon so that a contact about to close this tick is in its system, and one
   /// releasing leaves smoothly).
+  ///
+  /// `idle` (optional) names parts that may be left out; see IdleParts. An end piece within the
+  /// band of a part it could face (its axis within the tilt at which an end face presses at a
+  /// centre of pressure, collision.cpp) keeps that part in: such a contact carries its centre
+  /// of pressure from tick to tick.
   int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
-            double band_m, std::span<RawContact> out) const;
+            double band_m, std::span<RawContact> out, IdleParts* idle = nullptr) const;
+  /// The end cylinder's length (at least r1): a point of the end piece is within it plus r1 of
+  /// the tip.
+  double end_length_m() const { return end_m_; }
 
   /// Narrow-phase evaluations (closed form or GJK) of the last Query, for the benchmarks'
   /// figures; pairs settled by an earlier query's distance (below) are not among them.
@@ -138,13 +175,17 @@ class Collision {
                           double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
                           Eigen::Vector3d& normal_P) const;
   struct KeptDistance;
+  // Whether the idle part can be left out of this query (IdleParts); then it lowers idle.gap_m
+  // to the part's bound and counts it. Reads the part-frame nodes Query has just made.
+  bool LeaveOut(const Part& part, const KeptDistance* kept,
+                std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& end_start_W,
+                const Eigen::Vector3d& end_start_P, double band_m, IdleParts& idle) const;
   // Whether the distance kept for a piece, now that its axis runs a_W-b_W, proves the pair
   // farther than the band.
   bool KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
                       const Eigen::Vector3d& b_W, double band_m) const;
-  // Keeps the capsule distance d_m of the piece on a_W-b_W, found beyond the band. A pair in
-  // the band keeps what it had: any kept distance stays a bound wherever the piece goes, and a
-  // pair in the band costs nothing more than the check.
+  // Keeps the capsule distance d_m of the piece on a_W-b_W (beyond the band, or in it: an idle
+  // part is left out by the kept distances of its pieces in the band).
   void Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
             double d_m) const;
   // Returns the contact's part point in the part's frame.
@@ -165,6 +206,10 @@ class Collision {
   double tube_tolerance_m_ = 0.0;
   double eps_m_ = 0.0;           // the contact threshold epsilon
   double inner_radius_m_ = 0.0;  // r2: the end face is an annulus
+  // An end face presses at a centre of pressure only while tilted less than
+  // 4 eps r1 / (r1^2 + r2^2) from a face (collision.cpp): 1 - that squared, the least square of
+  // the end's axis component along a face normal at which it can (above 1: never).
+  double facing_axis_sq_ = 0.0;
   mutable int narrow_calls_ = 0;
   mutable int coherent_skips_ = 0;
   mutable std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_P_{};  // scratch

@@ -169,10 +169,60 @@ struct Core::State {
 struct Core::Impl : Core::State {
   Impl(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsules,
        std::vector<std::array<int, 64>> element_of)
-      : collision(scene, parts, capsules, std::move(element_of)), beam(scene) {}
+      : collision(scene, parts, capsules, std::move(element_of)),
+        beam(scene),
+        may_leave_out(scene.parts.size(), 0) {}
 
   Collision collision;
   BeamChain beam;
+  // Idle parts (Step): whether to leave them out, the per-part permission handed to the query,
+  // and what the last tick did. Counts, not state: a snapshot does not carry them.
+  bool leave_out_idle = true;
+  std::vector<std::uint8_t> may_leave_out;
+  int idle_left_out = 0;
+  long idle_retries = 0;
+  // The beam's tangents and starting guesses as the tick found them, copied before a tick with
+  // parts left out first changes them: a tick solved again starts from them, as it would have
+  // (a tangent computed for the first try would otherwise stay in the cache in place of an
+  // older one, and a later tick that fits the older one would compute a new one: the same
+  // physics, other last bits). Most ticks change none of them (the tangents are reused).
+  struct BeamCache {
+    std::array<ElasticaTangent, 2> tangents{};
+    int tangent_current = 0;
+    std::array<ElasticaSegment, kMaxLoads> segments{};
+    std::array<RodSegment, kMaxLoads> rod_segments{};
+    std::array<Eigen::Matrix3d, kMaxLoads * kMaxLoads> rod_tangent{};
+    std::array<Eigen::Vector3d, kMaxLoads> rod_tangent_force{};
+    std::array<double, kMaxLoads> rod_tangent_s{};
+    std::array<int, kMaxLoads> rod_tangent_segment{};
+    int rod_tangent_members = 0, rod_tangent_age = 0;
+  } beam_cache;
+  bool beam_cache_saved = false;
+  void SaveBeamCache() {
+    beam_cache_saved = true;
+    beam_cache.tangents = tangents;
+    beam_cache.tangent_current = tangent_current;
+    beam_cache.segments = segments;
+    beam_cache.rod_segments = rod_segments;
+    beam_cache.rod_tangent = rod_tangent;
+    beam_cache.rod_tangent_force = rod_tangent_force;
+    beam_cache.rod_tangent_s = rod_tangent_s;
+    beam_cache.rod_tangent_segment = rod_tangent_segment;
+    beam_cache.rod_tangent_members = rod_tangent_members;
+    beam_cache.rod_tangent_age = rod_tangent_age;
+  }
+  void RestoreBeamCache() {
+    tangents = beam_cache.tangents;
+    tangent_current = beam_cache.tangent_current;
+    segments = beam_cache.segments;
+    rod_segments = beam_cache.rod_segments;
+    rod_tangent = beam_cache.rod_tangent;
+    rod_tangent_force = beam_cache.rod_tangent_force;
+    rod_tangent_s = beam_cache.rod_tangent_s;
+    rod_tangent_segment = beam_cache.rod_tangent_segment;
+    rod_tangent_members = beam_cache.rod_tangent_members;
+    rod_tangent_age = beam_cache.rod_tangent_age;
+  }
 };
 
 Core::Snapshot::Snapshot() = default;
@@ -309,6 +359,19 @@ struct PcFound {
 
 const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   Impl& m = *impl_;
+  // Idle parts left out, unless a pass of the solve may have moved the tube into reach of one:
+  // then the tick again with every part (docs/core.md, "Idle parts").
+  m.beam_cache_saved = false;
+  if (!Tick(t_s, X_W_hand, m.leave_out_idle)) {
+    ++m.idle_retries;
+    if (m.beam_cache_saved) m.RestoreBeamCache();
+    Tick(t_s, X_W_hand, false);
+  }
+  return out_;
+}
+
+bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_idle) {
+  Impl& m = *impl_;
   using Load = Impl::Load;
   const double T = scene_.model.time_step_s;
   const double K = scene_.contact.stiffness_N_per_m;
@@ -328,7 +391,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     out.flags |= kSolverFault;
     out.force_W_N.setZero();
     out.torque_W_Nm.setZero();
-    return out;
+    return true;
   }
 
   // 1. The tube where it is: last tick's held-end pose and shape.
@@ -354,9 +417,30 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
                                  .norm() /
                              (coupling_stiffness_ + coupling_damping_ / T) +
                          turn_bound_rad * (l + scene_.tube.outer_radius_m);
+  //
+  // A part that carried no load last tick and whose pieces in the band are all, by distances
+  // kept from earlier ticks, farther than epsilon plus the sweep is left out (the groove's walls
+  // beside a tube centred in it: half the tick, docs/core.md). Its loads would be open loads,
+  // which change nothing unless a pass of the solve closes one; each pass checks below that its
+  // motion could not have.
+  IdleParts idle;
+  if (leave_out_idle) {
+    std::fill(m.may_leave_out.begin(), m.may_leave_out.end(), std::uint8_t{1});
+    for (int q = 0; q < m.prev_count; ++q) {
+      // A load that carried force is in this tick's system; an end face's centre of pressure is
+      // carried to the next tick even while open.
+      const Load& before = m.prev[std::size_t(q)];
+      if (before.part_element >= 0 &&
+          (before.active || before.pressure_centre || !before.force_W.isZero(0.0)))
+        m.may_leave_out[elements_[std::size_t(before.part_element)].part_index] = 0;
+    }
+    idle.may_leave_out = m.may_leave_out;
+    idle.floor_m = eps + sweep_m;
+  }
   const int raw_count = m.collision.Query(
       std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
-      2.0 * eps + sweep_m, std::span<RawContact>(m.raw.data(), m.raw.size()));
+      2.0 * eps + sweep_m, std::span<RawContact>(m.raw.data(), m.raw.size()), &idle);
+  m.idle_left_out = idle.left_out;
 
   // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
   // one's PC (an edge of the face a side lies on, the rim of an end face lying flat).
@@ -672,6 +756,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
                     0.1 * m.rod_tangent_force[kk].norm() + 1e-3 * scale_N;
       }
       bool ok = true;
+      if (!reuse && idle.left_out > 0 && !m.beam_cache_saved) m.SaveBeamCache();
       if (!reuse) {
         // Last tick's shape was the rod's, solved at last tick's forces, which are this tick's
         // f_lin: if its loads are these members, at arc positions within 1 % of l, on the same
@@ -757,6 +842,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         return ok;
       };
       if (!fits(m.tangents[std::size_t(m.tangent_current)])) {
+        if (idle.left_out > 0 && !m.beam_cache_saved) m.SaveBeamCache();
         // The other one, or a new one in its place.
         m.tangent_current = 1 - m.tangent_current;
         State::ElasticaTangent& t = m.tangents[std::size_t(m.tangent_current)];
@@ -971,14 +1057,87 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     omega_W = m.z.segment<3>(iw);
     return true;
   };
+  // Whether this pass's motion keeps every left-out part's pieces beyond epsilon: then none of
+  // their open loads would have closed in it (the open-load test below), and the tick is the
+  // one it would have been with them in. A load point x moves by
+  //     x - x0 = (p - p0) + omega x (x0 - p0) + sum_j W_ij (F_j - F_lin_j),
+  // bounded with |x0 - p0| at most the farthest node plus the end piece and r1, and W_ij, for
+  // a load that is not a member (an open one of an idle part: the linear compliance whatever
+  // the model), by the tube's end (DisplacementBound). The offset of a load point from the
+  // centreline at its arc position is r1 on a capsule; on the end cylinder, whose axis leaves
+  // the centreline's chords within the end piece, at most r1 + 2 (end piece).
+  double reach_m = 0.0, offset_m = 0.0;
+  if (idle.group_count > 0) {
+    double farthest_sq = 0.0;
+    for (int k = 0; k <= N; ++k)
+      farthest_sq = std::max(farthest_sq, m.nodes_H[std::size_t(k)].squaredNorm());
+    const double end_m = m.collision.end_length_m();
+    reach_m = std::sqrt(farthest_sq) + end_m + scene_.tube.outer_radius_m;
+    offset_m = scene_.tube.outer_radius_m + 2.0 * end_m;
+  }
+  // How far this pass's motion may move a left-out group's pieces along their normals, per
+  // group (IdleParts::Group); computed from the pass's solve, judged after its decisions.
+  std::array<Eigen::Vector3d, kMaxLoads> df_H;
+  std::array<double, IdleParts::kMaxGroups> idle_moved_m{};
+  const auto bound_idle_motion = [&] {
+    if (idle.group_count == 0) return;
+    for (int j = 0; j < load_count; ++j) {
+      const int sj = slot[std::size_t(j)];
+      const Eigen::Vector3d F =
+          sj >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * sj)) : Eigen::Vector3d::Zero();
+      df_H[std::size_t(j)] = R_WH.transpose() * (F - m.loads[std::size_t(j)].f_lin_W);
+    }
+    const Eigen::Vector3d dp_W = p_W - p_start_W;
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+    for (int g = 0; g < idle.group_count; ++g) {
+      // The group's normals n (unit): P projects onto their span; |n . dp| <= |P dp|, and
+      // |n . (omega x r)| = |r . (n x omega)| <= |r| |Q omega|, Q taking out omega's part along
+      // n when n is one direction.
+      const IdleParts::Group& group = idle.groups[std::size_t(g)];
+      const Eigen::Matrix3d aa = group.axis_W * group.axis_W.transpose();
+      const Eigen::Matrix3d P_W = group.dims == 1   ? aa
+                                  : group.dims == 2 ? Eigen::Matrix3d(I - aa)
+                                                    : I;
+      const Eigen::Matrix3d Q_W = group.dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+      const Eigen::Matrix3d P_H = R_WH.transpose() * P_W * R_WH;
+      const Eigen::Matrix3d Q_H = R_WH.transpose() * Q_W * R_WH;
+      double moved_m = (P_W * dp_W).norm() + (Q_W * omega_W).norm() * reach_m;
+      for (int j = 0; j < load_count; ++j)
+        if (!df_H[std::size_t(j)].isZero(0.0))
+          moved_m += m.beam.DisplacementBound(m.beam_loads[std::size_t(j)], df_H[std::size_t(j)],
+                                              !use_elastica, offset_m, group.s_max_m, P_H, Q_H);
+      idle_moved_m[std::size_t(g)] = moved_m;
+    }
+  };
+  // Whether the pass's decisions would have been the same with the left-out parts in: their
+  // loads would have come after the loads of the parts before them in the query and before the
+  // rest (and the ghosts), and the decisions stop at the first load that changes. So a group is
+  // judged when that load is of a later part, or none changed; it passes while its pieces stay
+  // farther than epsilon.
+  const auto idle_parts_stay_open = [&](int changed_load) {
+    const std::uint32_t changed_part =
+        changed_load < 0 || m.loads[std::size_t(changed_load)].ghost ||
+                m.loads[std::size_t(changed_load)].part_element < 0
+            ? std::numeric_limits<std::uint32_t>::max()
+            : elements_[std::size_t(m.loads[std::size_t(changed_load)].part_element)].part_index;
+    for (int g = 0; g < idle.group_count; ++g) {
+      const IdleParts::Group& group = idle.groups[std::size_t(g)];
+      if (group.first_part < changed_part &&
+          !(idle_moved_m[std::size_t(g)] < group.gap_m - eps))  // NaN too
+        return false;
+    }
+    return true;
+  };
   bool finite = true;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     finite = solve_system();
     if (!finite) break;
+    bound_idle_motion();
 
     // Decisions: release a load that pulls, slide one beyond its friction limit, saturate the
     // coupling at the device's force. Each changes the system: solve again.
     bool changed = false;
+    int changed_load = -1;  // the first load whose decision changed
     for (int i = 0; i < load_count && !changed; ++i) {
       const int si = slot[std::size_t(i)];
       Load& ld = m.loads[std::size_t(i)];
@@ -993,6 +1152,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         if (ld.distance_m + ld.normal_W.dot(x - ld.x0_W) < eps) {
           ld.active = true;
           changed = true;
+          changed_load = i;
           if (!member[std::size_t(i)]) {
             build_compliance();  // it cuts the tube now
             build_stick_compliance();
@@ -1006,6 +1166,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
         ld.active = false;
         ld.released = true;  // once released in a tick it stays open: no cycling
         changed = true;
+        changed_load = i;
         break;
       }
       if (!ld.friction) continue;
@@ -1025,15 +1186,18 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
           LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
         }
         changed = true;
+        changed_load = i;
       } else {
         // Newton on the kinetic law: relinearise f_k where the normal force now is.
         const double fk = FrictionLimit(*ld.friction, ld.friction->kinetic_coefficient, normal_N);
         if (std::abs(fk - (ld.slide_a + ld.slide_b * normal_N)) > 1e-9 * (1.0 + fk)) {
           LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
           changed = true;
+          changed_load = i;
         }
       }
     }
+    if (!idle_parts_stay_open(changed_load)) return false;
     if (changed) {
       // The contact set changed: saturation is decided again on the new solution.
       A = A_free;
@@ -1102,7 +1266,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
     out.contact_count = 0;
     m.p_hand_prev_W = p_hand_W;
     m.prev_count = 0;  // start the next tick afresh rather than repeat this one
-    return out;
+    return true;
   }
 
   // The held end's new orientation: last tick's turned by omega.
@@ -1387,7 +1551,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   if (!all_finite) {
     Reset(X_W_hand);
     out.flags |= kSolverFault;
-    return out;
+    return true;
   }
   m.p_hand_prev_W = p_hand_W;
   m.p_held_prev_W = p_W;
@@ -1397,7 +1561,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   for (int i = 0; i < load_count; ++i)
     if (!m.loads[std::size_t(i)].ghost)
       m.prev[std::size_t(m.prev_count++)] = m.loads[std::size_t(i)];
-  return out;
+  return true;
 }
 
 void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
@@ -1447,6 +1611,9 @@ states::ContactFormation Core::Formation() const {
 }
 
 int Core::narrow_phase_calls() const { return impl_->collision.last_narrow_phase_calls(); }
+int Core::idle_parts_left_out() const { return impl_->idle_left_out; }
+long Core::idle_retries() const { return impl_->idle_retries; }
+void Core::set_leave_out_idle_parts(bool on) { impl_->leave_out_idle = on; }
 
 std::string Core::FormationText() const { return states::ToString(Formation()); }
 

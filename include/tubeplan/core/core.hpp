@@ -203,12 +203,22 @@ class Core {
   /// Narrow-phase queries in the last tick: the main cost of a tick, for the benchmarks. Pairs
   /// settled by a distance kept from an earlier tick (collision.cpp) are not counted.
   int narrow_phase_calls() const;
+  /// Idle parts the last tick left out (docs/core.md, "Idle parts"), and the ticks since
+  /// construction that had to be solved again with every part in.
+  int idle_parts_left_out() const;
+  long idle_retries() const;
+  /// Leaving idle parts out never changes a tick's result; off, every part in the band is
+  /// queried every tick (the tests compare the two; the bench shows the difference).
+  void set_leave_out_idle_parts(bool on);
   double coupling_stiffness_N_per_m() const { return coupling_stiffness_; }
   double coupling_damping_Ns_per_m() const { return coupling_damping_; }
 
   struct Impl;  // State, and the collision and beam set-up (src/core)
 
  private:
+  // Step's tick; false, with nothing carried to the next tick, when a left-out idle part might
+  // have been reached (then Step runs it again with leave_out_idle false).
+  bool Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_idle);
   scene::Scene scene_;
   std::vector<scene::PartElement> elements_;
   std::vector<std::uint32_t> reachable_parts_;
