@@ -2,6 +2,7 @@
 #include "core/beam_chain.hpp"  // private to the core (src/)
 
 #include <cmath>
+#include <random>
 
 #include <catch2/catch.hpp>
 
@@ -123,4 +124,55 @@ TEST_CASE("A rod chain solved with its nodes draws what RodNodes draws of it, bi
     CHECK(differing == 0);
     CHECK((drawn.back() - Eigen::Vector3d(0.0, 0.0, l)).norm() > 1e-3);  // bent, not straight
   }
+}
+
+TEST_CASE("DisplacementBound bounds the compliance of every point up to s_max, along any normal",
+          "[core][beam]") {
+  // The core leaves an idle part out while this bound of how far a load point could move stays
+  // below the part's gap (core.cpp); an open load's row is Compliance(i, j), so the bound must
+  // hold for every point i it could be: any arc position up to s_max, any offset up to r_max,
+  // and every unit normal n in the span it is given (one axis, the plane across one, or all).
+  const scene::Scene s = RubberTube();
+  const core::BeamChain chain(s);
+  const double l = s.tube.length_m, r_max = 0.03;
+  std::mt19937_64 rng(20261125);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
+  const auto random_unit = [&] {
+    Eigen::Vector3d v(unit(rng), unit(rng), unit(rng));
+    return Eigen::Vector3d(v.norm() > 1e-3 ? v.normalized() : Eigen::Vector3d::UnitX());
+  };
+  double tightest = 0.0;  // the largest |n . W df| / bound seen
+  for (int trial = 0; trial < 20000; ++trial) {
+    core::BeamLoad j;
+    j.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);  // a later segment's clamp
+    j.s_m = j.clamp_m + (l - j.clamp_m) * fraction(rng);
+    j.r_H_m = 0.008 * random_unit();
+    const Eigen::Vector3d df_H = 0.1 * unit(rng) * random_unit();
+    const bool moments = trial % 2 == 0;
+    const double s_max = l * fraction(rng);
+    const Eigen::Vector3d axis = random_unit();
+    const int dims = 1 + trial % 3;
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), aa = axis * axis.transpose();
+    const Eigen::Matrix3d P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
+    const Eigen::Matrix3d Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+    const double bound = chain.DisplacementBound(j, df_H, moments, r_max, s_max, P, Q);
+    // Points i: at s_max with the offset r_max along the axis (where the section's turn moves
+    // the point along the bend) or anywhere, and random points before s_max. The largest
+    // |n . v| over unit n in P's range is |P v|.
+    for (int k = 0; k < 8; ++k) {
+      core::BeamLoad i;
+      i.s_m = k < 3 ? s_max : s_max * fraction(rng);
+      i.r_H_m = k == 0   ? Eigen::Vector3d(0.0, 0.0, r_max)
+                : k == 1 ? Eigen::Vector3d(0.0, 0.0, -r_max)
+                         : fraction(rng) * r_max * random_unit();
+      const double moved = (P * (chain.Compliance(i, j, moments) * df_H)).norm();
+      INFO("trial " << trial << " dims " << dims << " k " << k);
+      // Rounding: the bound is a sum of a few products of the same magnitudes.
+      CHECK(moved <= bound * (1.0 + 1e-12) + 1e-18);
+      if (bound > 0.0) tightest = std::max(tightest, moved / bound);
+    }
+  }
+  // And it is not loose: some points reach it to within 2 % (a lateral force's bend and turn
+  // at s_max, with the offset along the axis, add up along the force).
+  CHECK(tightest > 0.98);
 }

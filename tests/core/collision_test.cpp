@@ -201,7 +201,8 @@ struct TubePose {
 
 }  // namespace
 
-TEST_CASE("Distances kept from earlier queries change no contact", "[core][collision]") {
+TEST_CASE("Distances kept from earlier queries change no contact, and leave out only idle parts",
+          "[core][collision]") {
   // Query skips a pair that an earlier query found farther than the band by more than the piece
   // has moved since. Whatever the history (drifts of a nanometre to a tenth of a millimetre a
   // query, jumps across the scene, jumps back to an earlier pose, the band changing), its
@@ -228,6 +229,14 @@ TEST_CASE("Distances kept from earlier queries change no contact", "[core][colli
   const int capsules = 24;
   const double piece_m = s.tube.length_m / capsules;
   const core::Collision kept(s, parts, capsules, element_of);
+  // A third with the same history that may leave every part out (the core's IdleParts, at a
+  // floor of epsilon): each contact of a part it left out must lie in one of its groups, at
+  // least the group's gap away, no farther along the tube than its s_max, with a normal in its
+  // span; and no end face at a centre of pressure is left out.
+  const core::Collision idle(s, parts, capsules, element_of);
+  const std::vector<std::uint8_t> may_leave_out(s.parts.size(), 1);
+  std::array<core::RawContact, core::kMaxRawContacts> got_idle{};
+  int left_out = 0, covered = 0;
 
   std::mt19937_64 rng(20261124);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -298,6 +307,35 @@ TEST_CASE("Distances kept from earlier queries change no contact", "[core][colli
       REQUIRE(SameBits(got[std::size_t(i)], want[std::size_t(i)]));
       if (band_m - want[std::size_t(i)].distance_m < 1e-6) ++at_band_edge;
     }
+    core::IdleParts groups;
+    groups.may_leave_out = may_leave_out;
+    groups.floor_m = s.contact.threshold_m;
+    const int n_idle = idle.Query(nodes_W, tip_tangent_W, band_m, got_idle, &groups);
+    left_out += groups.left_out;
+    int j = 0;  // the idle query's contacts are the full one's, less whole parts
+    for (int i = 0; i < m; ++i) {
+      const core::RawContact& c = want[std::size_t(i)];
+      if (j < n_idle && SameBits(got_idle[std::size_t(j)], c)) {
+        ++j;
+        continue;
+      }
+      INFO("left out: contact " << i << " of part " << c.part << " at s " << c.s_m << " d "
+                                << c.distance_m << " n " << c.normal_W.transpose());
+      CHECK_FALSE(c.pressure_centre);
+      bool in_a_group = false;
+      for (int g = 0; g < groups.group_count && !in_a_group; ++g) {
+        const core::IdleParts::Group& group = groups.groups[std::size_t(g)];
+        // Rounding: the normal's components off its span are those of a unit vector computed
+        // from points a few units in the last place apart.
+        const double off_span = group.dims == 1   ? c.normal_W.cross(group.axis_W).norm()
+                                : group.dims == 2 ? std::abs(c.normal_W.dot(group.axis_W))
+                                                  : 0.0;
+        in_a_group = c.distance_m >= group.gap_m && c.s_m <= group.s_max_m && off_span < 1e-9;
+      }
+      CHECK(in_a_group);
+      ++covered;
+    }
+    CHECK(j == n_idle);
     // Only the evaluations differ, never more than a fresh query's.
     CHECK(kept.last_narrow_phase_calls() <= fresh.last_narrow_phase_calls());
     CHECK(fresh.last_coherent_skips() == 0);
@@ -310,4 +348,8 @@ TEST_CASE("Distances kept from earlier queries change no contact", "[core][colli
                   << at_band_edge);
   CHECK(skipped > 20000);
   CHECK(at_band_edge > 2000);
+  // Parts were left out, and some of them had contacts in the band, which the checks above saw.
+  INFO("parts left out " << left_out << ", their contacts " << covered);
+  CHECK(left_out > 1000);
+  CHECK(covered > 1000);
 }
