@@ -76,9 +76,14 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     parts_.push_back(part);
   }
   kept_.resize(parts_.size() * std::size_t(kMaxCapsules));
+  summaries_.resize(parts_.size());
+  anchors_.resize(parts_.size() * std::size_t(kMaxCapsules + 2));
 }
 
-void Collision::ForgetDistances() { std::fill(kept_.begin(), kept_.end(), KeptDistance{}); }
+void Collision::ForgetDistances() {
+  std::fill(kept_.begin(), kept_.end(), KeptDistance{});
+  std::fill(summaries_.begin(), summaries_.end(), IdleSummary{});
+}
 
 bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
                                const Eigen::Vector3d& b_W, double band_m) const {
@@ -93,10 +98,15 @@ bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& 
   // the axis is outside the box) in the narrow phase too, which would discard it. A pair within
   // 1 nm + delta of the band is evaluated. Squared: no root; their rounding is relative 1e-16.
   // Nothing kept (-infinity) or a NaN anywhere compares false: evaluated.
+  return KeptBeyondBand(kept, (a_W - kept.a_W_m).squaredNorm(), (b_W - kept.b_W_m).squaredNorm(),
+                        band_m);
+}
+
+bool Collision::KeptBeyondBand(const KeptDistance& kept, double moved_a_sq, double moved_b_sq,
+                               double band_m) const {
   const double slack_m = kept.d_m - (std::max(band_m, 0.0) + kCoherenceMargin_m);
   const double slack_sq = slack_m * slack_m;
-  return slack_m > 0.0 && (a_W - kept.a_W_m).squaredNorm() <= slack_sq &&
-         (b_W - kept.b_W_m).squaredNorm() <= slack_sq;
+  return slack_m > 0.0 && moved_a_sq <= slack_sq && moved_b_sq <= slack_sq;
 }
 
 void Collision::Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
@@ -300,63 +310,138 @@ Eigen::Vector3d Collision::Overlapping(const Part& part, const Eigen::Vector3d& 
   return q_P;
 }
 
-bool Collision::LeaveOut(const Part& part, const KeptDistance* kept,
+namespace {
+// Adds a part's group to the query's, merging it with one of the same span (the least gap, the
+// farthest s_max, the first part).
+void AddGroup(IdleParts& idle, const IdleParts::Group& group) {
+  int at = 0;
+  while (at < idle.group_count && !(idle.groups[std::size_t(at)].dims == group.dims &&
+                                    idle.groups[std::size_t(at)].axis_W == group.axis_W))
+    ++at;
+  if (at == IdleParts::kMaxGroups) {
+    // Full: the last group takes this one in, as a group of any normal.
+    at = IdleParts::kMaxGroups - 1;
+    idle.groups[std::size_t(at)].dims = 3;
+  }
+  if (at == idle.group_count) {
+    idle.groups[std::size_t(idle.group_count++)] = group;
+    return;
+  }
+  IdleParts::Group& into = idle.groups[std::size_t(at)];
+  into.gap_m = std::min(into.gap_m, group.gap_m);
+  into.s_max_m = std::max(into.s_max_m, group.s_max_m);
+  into.first_part = std::min(into.first_part, group.first_part);
+}
+}  // namespace
+
+bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
                          std::span<const Eigen::Vector3d> nodes_W,
                          const Eigen::Vector3d& end_start_W, const Eigen::Vector3d& end_start_P,
                          double band_m, IdleParts& idle) const {
+  const Part& part = parts_[part_i];
+  IdleSummary& summary = summaries_[part_i];
+  Eigen::Vector3d* const anchor = &anchors_[part_i * std::size_t(kMaxCapsules + 2)];
+  const std::size_t node_count = nodes_W.size();
+  // Last tick's evaluation, while it still holds: every point of the tube has moved at most
+  // delta since it (a piece's axis ends did, so all of it), so each group's pieces are at least
+  // its gap less delta away; no piece has crossed a slab it was inside by more than delta, nor
+  // turned the end onto a face it was `slack` from facing; and a piece beyond the band it was
+  // evaluated at is beyond this tick's band if that is delta narrower.
+  if (summary.valid) {
+    double delta_sq = (end_start_W - anchor[node_count]).squaredNorm();
+    for (std::size_t i = 0; i < node_count; ++i)
+      delta_sq = std::max(delta_sq, (nodes_W[i] - anchor[i]).squaredNorm());
+    const double delta_m = std::sqrt(delta_sq);
+    bool holds = band_m + delta_m <= summary.band_m && delta_m < summary.slack_m;
+    for (int g = 0; g < summary.group_count && holds; ++g)
+      holds = summary.groups[std::size_t(g)].gap_m - delta_m > idle.floor_m;
+    if (holds) {
+      ++idle.left_out;
+      for (int g = 0; g < summary.group_count; ++g) {
+        IdleParts::Group group = summary.groups[std::size_t(g)];
+        group.gap_m -= delta_m;
+        AddGroup(idle, group);
+      }
+      return true;
+    }
+  }
+  summary.valid = false;
   // The pieces the band would take are those the broad phase passes and no kept distance
-  // settles beyond the band (the loop in Query). Each has a kept distance, less how far it has
+  // settles beyond the band (the loop in Query), here a band a tenth of epsilon wider so that
+  // the evaluation holds for ticks after it. Each has a kept distance, less how far it has
   // moved since: a lower bound of its distance now (KeptBeyondBand). The part is left out when
   // the least of them is above the floor; a piece with none, or an end that could face the
   // part, keeps it in. Pieces are grouped by the axes their normals may have (IdleParts).
-  const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
-  const std::size_t node_count = nodes_W.size();
-  std::array<double, 8> lowest_m, moved_sq, s_max_m;
+  const double wide_band_m = band_m + 0.1 * eps_m_;
+  const int pieces = static_cast<int>(node_count) - end_pieces_;
+  std::array<double, 8> lowest_m, s_max_m;
   lowest_m.fill(std::numeric_limits<double>::infinity());
-  moved_sq.fill(0.0);
   s_max_m.fill(-1.0);  // no piece
+  double slack_m = std::numeric_limits<double>::infinity();
   for (int k = 0; k < pieces; ++k) {
     const bool is_end = k == pieces - 1;
     const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
     const Eigen::Vector3d& b_W = is_end ? nodes_W.back() : nodes_W[std::size_t(k) + 1];
     const Eigen::Vector3d& a_P = is_end ? end_start_P : nodes_P_[std::size_t(k)];
     const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
-    if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
+    // The broad phase's own bound: how far the piece's axis box, grown by r1, is from the part's
+    // along one of its axes (the broad phase passes a piece where this is within the band). A
+    // piece the wider band takes that the query's band never did has no kept distance; this
+    // bounds it. Only there: taken within the band too, it left parts out in ticks whose full
+    // query truncated its contacts, and the graph's exploration went elsewhere (249 CFs against
+    // 251), the case docs/core.md names.
+    double apart_m = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i)
+      apart_m = std::max({apart_m, std::min(a_P[i], b_P[i]) - part.half_m[i],
+                          -part.half_m[i] - std::max(a_P[i], b_P[i])});
+    apart_m -= radius_m_;
+    if (apart_m > wide_band_m) continue;
     const KeptDistance& kept_k = kept[k];
-    if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) continue;
+    const double moved_a_sq = (a_W - kept_k.a_W_m).squaredNorm();
+    const double moved_b_sq = (b_W - kept_k.b_W_m).squaredNorm();
+    if (KeptBeyondBand(kept_k, moved_a_sq, moved_b_sq, wide_band_m)) continue;
     // A capsule's nearest point to the box lies on the line from its axis's nearest point c to
     // that point's clamp into the box: the normal has a component only along the axes on which
     // c is out of the slab, so only where the axis reaches out. The end cylinder's rim reaches
     // r1 beyond its axis. The face mask's tolerance is the margin for rounding.
     const double reach_out_m = is_end ? radius_m_ : 0.0;
     int outside = 0;
-    for (int i = 0; i < 3; ++i)
-      if (std::max(std::abs(a_P[i]), std::abs(b_P[i])) + reach_out_m >=
-          part.half_m[i] - 2.0 * part_tolerance_m_)
+    for (int i = 0; i < 3; ++i) {
+      const double inside_by_m = part.half_m[i] - 2.0 * part_tolerance_m_ -
+                                 (std::max(std::abs(a_P[i]), std::abs(b_P[i])) + reach_out_m);
+      if (inside_by_m <= 0.0)
         outside |= 1 << i;
+      else
+        slack_m = std::min(slack_m, inside_by_m);
+    }
     if (is_end) {
       // A face of the part the end nearly faces keeps it in, if the end cylinder reaches that
-      // face's plane (else no nearest point can lie on it).
-      const Eigen::Vector3d axis_P = (b_P - a_P).normalized();
-      for (int i = 0; i < 3; ++i)
-        if ((outside & (1 << i)) != 0 && !(axis_P[i] * axis_P[i] < facing_axis_sq_)) return false;
+      // face's plane (else no nearest point can lie on it). The end's axis u turns by at most
+      // 4 delta / |b - a| when its ends move by delta.
+      const Eigen::Vector3d axis_P = b_P - a_P;
+      const double length_m = axis_P.norm();
+      for (int i = 0; i < 3; ++i) {
+        if ((outside & (1 << i)) == 0) continue;
+        const double u = std::abs(axis_P[i]) / length_m;
+        if (!(u * u < facing_axis_sq_)) return false;
+        slack_m = std::min(slack_m, (std::sqrt(facing_axis_sq_) - u) * length_m / 4.0);
+      }
     }
+    // The same margin as KeptBeyondBand's, for the same rounding. Nothing kept (-infinity) or a
+    // NaN leaves the broad phase's bound.
+    const double kept_m =
+        kept_k.d_m - std::sqrt(std::max(moved_a_sq, moved_b_sq)) - kCoherenceMargin_m;
     const std::size_t g = std::size_t(outside);
-    lowest_m[g] = std::min(lowest_m[g], kept_k.d_m);
-    moved_sq[g] = std::max(
-        {moved_sq[g], (a_W - kept_k.a_W_m).squaredNorm(), (b_W - kept_k.b_W_m).squaredNorm()});
+    lowest_m[g] = std::min(lowest_m[g], apart_m > band_m ? std::max(kept_m, apart_m) : kept_m);
     // A load's arc position lies within its piece.
     s_max_m[g] = is_end ? length_m_ : piece_m_ * (k + 1);
   }
-  // The same margin as KeptBeyondBand's, for the same rounding. Nothing kept (-infinity) or a
-  // NaN compares false: kept in.
-  std::array<double, 8> gap_m{};
-  for (std::size_t g = 0; g < 8; ++g) {
-    if (s_max_m[g] < 0.0) continue;
-    gap_m[g] = lowest_m[g] - std::sqrt(moved_sq[g]) - kCoherenceMargin_m;
-    if (!(gap_m[g] > idle.floor_m)) return false;
-  }
+  // A NaN compares false: kept in.
+  for (std::size_t g = 0; g < 8; ++g)
+    if (s_max_m[g] >= 0.0 && !(lowest_m[g] > idle.floor_m)) return false;
+  const std::array<double, 8>& gap_m = lowest_m;
   ++idle.left_out;
+  summary.group_count = 0;
   for (int outside = 0; outside < 8; ++outside) {
     const std::size_t g = std::size_t(outside);
     if (s_max_m[g] < 0.0) continue;
@@ -374,24 +459,14 @@ bool Collision::LeaveOut(const Part& part, const KeptDistance* kept,
     group.gap_m = gap_m[g];
     group.s_max_m = s_max_m[g];
     group.first_part = part.index;
-    int at = 0;
-    while (at < idle.group_count && !(idle.groups[std::size_t(at)].dims == group.dims &&
-                                      idle.groups[std::size_t(at)].axis_W == group.axis_W))
-      ++at;
-    if (at == IdleParts::kMaxGroups) {
-      // Full: the last group takes this one in, as a group of any normal.
-      at = IdleParts::kMaxGroups - 1;
-      idle.groups[std::size_t(at)].dims = 3;
-    }
-    if (at == idle.group_count) {
-      idle.groups[std::size_t(idle.group_count++)] = group;
-      continue;
-    }
-    IdleParts::Group& into = idle.groups[std::size_t(at)];
-    into.gap_m = std::min(into.gap_m, group.gap_m);
-    into.s_max_m = std::max(into.s_max_m, group.s_max_m);
-    into.first_part = std::min(into.first_part, group.first_part);
+    AddGroup(idle, group);
+    summary.groups[std::size_t(summary.group_count++)] = group;
   }
+  summary.valid = true;
+  summary.band_m = wide_band_m;
+  summary.slack_m = slack_m;
+  for (std::size_t i = 0; i < node_count; ++i) anchor[i] = nodes_W[i];
+  anchor[node_count] = end_start_W;
   return true;
 }
 
@@ -422,9 +497,11 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       continue;
     const Eigen::Vector3d end_start_P = part.ToPart(end_start_W);
     if (idle != nullptr && part.index < idle->may_leave_out.size() &&
-        idle->may_leave_out[part.index] != 0 &&
-        LeaveOut(part, kept, nodes_W, end_start_W, end_start_P, band_m, *idle))
-      continue;
+        idle->may_leave_out[part.index] != 0) {
+      if (LeaveOut(part_i, kept, nodes_W, end_start_W, end_start_P, band_m, *idle)) continue;
+    } else {
+      summaries_[part_i].valid = false;
+    }
     for (int k = 0; k < pieces; ++k) {
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];

@@ -175,15 +175,18 @@ class Collision {
                           double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
                           Eigen::Vector3d& normal_P) const;
   struct KeptDistance;
-  // Whether the idle part can be left out of this query (IdleParts); then it lowers idle.gap_m
-  // to the part's bound and counts it. Reads the part-frame nodes Query has just made.
-  bool LeaveOut(const Part& part, const KeptDistance* kept,
+  // Whether the idle part parts_[part_i] can be left out of this query (IdleParts); then it adds
+  // its groups to idle's and counts it. Reads the part-frame nodes Query has just made.
+  bool LeaveOut(std::size_t part_i, const KeptDistance* kept,
                 std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& end_start_W,
                 const Eigen::Vector3d& end_start_P, double band_m, IdleParts& idle) const;
   // Whether the distance kept for a piece, now that its axis runs a_W-b_W, proves the pair
   // farther than the band.
   bool KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
                       const Eigen::Vector3d& b_W, double band_m) const;
+  // The same with the squared motions of the axis's ends since the distance was kept.
+  bool KeptBeyondBand(const KeptDistance& kept, double moved_a_sq, double moved_b_sq,
+                      double band_m) const;
   // Keeps the capsule distance d_m of the piece on a_W-b_W (beyond the band, or in it: an idle
   // part is left out by the kept distances of its pieces in the band).
   void Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
@@ -222,6 +225,19 @@ class Collision {
     double d_m = -std::numeric_limits<double>::infinity();  // none: never skips
   };
   mutable std::vector<KeptDistance> kept_;
+  // A part's last evaluation as idle (LeaveOut), per part, and where the tube's nodes and its end
+  // piece's start were then ((kMaxCapsules + 2) points a part): it holds for later queries while
+  // the tube has moved less than its slack (a piece crossing no slab, the end turning onto no
+  // face), the band has not widened past the one it was taken at, and every gap less the motion
+  // stays above the floor. Forgotten with the distances, and when the part is queried.
+  struct IdleSummary {
+    bool valid = false;
+    double band_m = 0.0, slack_m = 0.0;
+    std::array<IdleParts::Group, IdleParts::kMaxGroups> groups{};
+    int group_count = 0;
+  };
+  mutable std::vector<IdleSummary> summaries_;
+  mutable std::vector<Eigen::Vector3d> anchors_;
 };
 
 }  // namespace tubeplan::core

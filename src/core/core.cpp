@@ -694,6 +694,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     ghost.ghost = true;
   }
   if (truncated) out.flags |= kContactsTruncated;
+  // Truncated, the set kept depends on what came before it: take the tick with every part.
+  if (truncated && idle.left_out > 0) return false;
 
   // 5. The beam's compliance between the load points, about last tick's forces.
   for (int i = 0; i < load_count; ++i) {
