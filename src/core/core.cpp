@@ -200,28 +200,22 @@ struct Core::Impl : Core::State {
   bool beam_cache_saved = false;
   void SaveBeamCache() {
     beam_cache_saved = true;
-    beam_cache.tangents = tangents;
-    beam_cache.tangent_current = tangent_current;
-    beam_cache.segments = segments;
-    beam_cache.rod_segments = rod_segments;
-    beam_cache.rod_tangent = rod_tangent;
-    beam_cache.rod_tangent_force = rod_tangent_force;
-    beam_cache.rod_tangent_s = rod_tangent_s;
-    beam_cache.rod_tangent_segment = rod_tangent_segment;
-    beam_cache.rod_tangent_members = rod_tangent_members;
-    beam_cache.rod_tangent_age = rod_tangent_age;
+    CopyBeamCache(beam_cache, static_cast<const State&>(*this));
   }
-  void RestoreBeamCache() {
-    tangents = beam_cache.tangents;
-    tangent_current = beam_cache.tangent_current;
-    segments = beam_cache.segments;
-    rod_segments = beam_cache.rod_segments;
-    rod_tangent = beam_cache.rod_tangent;
-    rod_tangent_force = beam_cache.rod_tangent_force;
-    rod_tangent_s = beam_cache.rod_tangent_s;
-    rod_tangent_segment = beam_cache.rod_tangent_segment;
-    rod_tangent_members = beam_cache.rod_tangent_members;
-    rod_tangent_age = beam_cache.rod_tangent_age;
+  void RestoreBeamCache() { CopyBeamCache(static_cast<State&>(*this), beam_cache); }
+  // The one list of what the beam's cache is, either way.
+  template <typename To, typename From>
+  static void CopyBeamCache(To& to, const From& from) {
+    to.tangents = from.tangents;
+    to.tangent_current = from.tangent_current;
+    to.segments = from.segments;
+    to.rod_segments = from.rod_segments;
+    to.rod_tangent = from.rod_tangent;
+    to.rod_tangent_force = from.rod_tangent_force;
+    to.rod_tangent_s = from.rod_tangent_s;
+    to.rod_tangent_segment = from.rod_tangent_segment;
+    to.rod_tangent_members = from.rod_tangent_members;
+    to.rod_tangent_age = from.rod_tangent_age;
   }
 };
 
