@@ -347,12 +347,19 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
   // its gap less delta away; no piece has crossed a slab it was inside by more than delta, nor
   // turned the end onto a face it was `slack` from facing; and a piece beyond the band it was
   // evaluated at is beyond this tick's band if that is delta narrower.
+  // A slab is crossed by motion along its own axis only: that is bounded axis by axis (a tube
+  // sliding along a wall keeps its height, however far it slides).
   if (summary.valid) {
-    double delta_sq = (end_start_W - anchor[node_count]).squaredNorm();
+    // The largest motion along each world axis; every node's motion is within its norm.
+    Eigen::Vector3d along_W = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < node_count; ++i)
-      delta_sq = std::max(delta_sq, (nodes_W[i] - anchor[i]).squaredNorm());
-    const double delta_m = std::sqrt(delta_sq);
-    bool holds = band_m + delta_m <= summary.band_m && delta_m < summary.slack_m;
+      along_W = along_W.cwiseMax((nodes_W[i] - anchor[i]).cwiseAbs());
+    along_W = along_W.cwiseMax((end_start_W - anchor[node_count]).cwiseAbs());
+    const double delta_m = along_W.norm();
+    // A part turned to the world: its own axes see at most delta.
+    const Eigen::Vector3d along_P = part.aligned ? along_W : Eigen::Vector3d::Constant(delta_m);
+    bool holds = band_m + delta_m <= summary.band_m && delta_m < summary.slack_m &&
+                 (along_P.array() < summary.slab_slack_m.array()).all();
     for (int g = 0; g < summary.group_count && holds; ++g)
       holds = summary.groups[std::size_t(g)].gap_m - delta_m > idle.floor_m;
     if (holds) {
@@ -367,17 +374,18 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
   }
   summary.valid = false;
   // The pieces the band would take are those the broad phase passes and no kept distance
-  // settles beyond the band (the loop in Query), here a band a tenth of epsilon wider so that
+  // settles beyond the band (the loop in Query), here a band half an epsilon wider so that
   // the evaluation holds for ticks after it. Each has a kept distance, less how far it has
   // moved since: a lower bound of its distance now (KeptBeyondBand). The part is left out when
   // the least of them is above the floor; a piece with none, or an end that could face the
   // part, keeps it in. Pieces are grouped by the axes their normals may have (IdleParts).
-  const double wide_band_m = band_m + 0.1 * eps_m_;
+  const double wide_band_m = band_m + 0.5 * eps_m_;
   const int pieces = static_cast<int>(node_count) - end_pieces_;
   std::array<double, 8> lowest_m, s_max_m;
   lowest_m.fill(std::numeric_limits<double>::infinity());
   s_max_m.fill(-1.0);  // no piece
   double slack_m = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d slab_slack_m = Eigen::Vector3d::Constant(slack_m);
   for (int k = 0; k < pieces; ++k) {
     const bool is_end = k == pieces - 1;
     const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
@@ -409,10 +417,12 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
     for (int i = 0; i < 3; ++i) {
       const double inside_by_m = part.half_m[i] - 2.0 * part_tolerance_m_ -
                                  (std::max(std::abs(a_P[i]), std::abs(b_P[i])) + reach_out_m);
-      if (inside_by_m <= 0.0)
+      // Within a tenth of epsilon of the slab's side counts as out: the tube's jitter would cross
+      // it tick after tick and void the evaluation (a piece at a wall's top, the tip sliding).
+      if (inside_by_m <= 0.1 * eps_m_)
         outside |= 1 << i;
       else
-        slack_m = std::min(slack_m, inside_by_m);
+        slab_slack_m[i] = std::min(slab_slack_m[i], inside_by_m);
     }
     if (is_end) {
       // A face of the part the end nearly faces keeps it in, if the end cylinder reaches that
@@ -465,6 +475,7 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
   summary.valid = true;
   summary.band_m = wide_band_m;
   summary.slack_m = slack_m;
+  summary.slab_slack_m = slab_slack_m;
   for (std::size_t i = 0; i < node_count; ++i) anchor[i] = nodes_W[i];
   anchor[node_count] = end_start_W;
   return true;

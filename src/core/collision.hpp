@@ -227,12 +227,15 @@ class Collision {
   mutable std::vector<KeptDistance> kept_;
   // A part's last evaluation as idle (LeaveOut), per part, and where the tube's nodes and its end
   // piece's start were then ((kMaxCapsules + 2) points a part): it holds for later queries while
-  // the tube has moved less than its slack (a piece crossing no slab, the end turning onto no
-  // face), the band has not widened past the one it was taken at, and every gap less the motion
-  // stays above the floor. Forgotten with the distances, and when the part is queried.
+  // the tube has moved less than its slacks (along each axis, a piece crossing no slab; the end
+  // turning onto no face), the band has not widened past the one it was taken at, and every gap
+  // less the motion stays above the floor. Forgotten with the distances, and when the part is
+  // queried.
   struct IdleSummary {
     bool valid = false;
-    double band_m = 0.0, slack_m = 0.0;
+    double band_m = 0.0;
+    double slack_m = 0.0;  // how far the end may move before it could face a face
+    Eigen::Vector3d slab_slack_m = Eigen::Vector3d::Zero();  // per axis: before a slab is crossed
     std::array<IdleParts::Group, IdleParts::kMaxGroups> groups{};
     int group_count = 0;
   };
