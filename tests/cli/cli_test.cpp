@@ -215,7 +215,7 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
       RunTool({"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(r.exit_code == 0);
   const auto doc = nlohmann::json::parse(r.out);
-  REQUIRE(doc["scenarios"].size() == 14);
+  REQUIRE(doc["scenarios"].size() == 15);
   std::map<std::string, int> pcs;
   std::map<std::string, std::string> shape;
   for (const auto& s : doc["scenarios"]) {
@@ -251,13 +251,22 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   CHECK(shape["core.end_stuck"] == "elastica");
   CHECK(shape["core.side_on_floor"] == "rod");
   CHECK(shape["core.end_stuck.linear"] == "linear");
+  // The stuck tip centred in the groove leaves the two walls out; the scenario that keeps them
+  // in does not, and measures the same state.
+  std::map<std::string, int> left_out;
+  for (const auto& s : doc["scenarios"])
+    if (s["state"].contains("idle_parts_left_out"))
+      left_out[s["name"].get<std::string>()] = s["state"]["idle_parts_left_out"].get<int>();
+  CHECK(left_out["core.end_stuck"] == 2);
+  CHECK(left_out["core.end_stuck.all_parts"] == 0);
+  CHECK(pcs["core.end_stuck.all_parts"] == 1);
 
   // --only keeps the scenarios whose names start with it; a prefix no name has is an error.
   const Outcome only = RunTool({"bench", "--samples", "10", "--json", "--only", "core.end_stuck",
                                 "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(only.exit_code == 0);
   const auto only_doc = nlohmann::json::parse(only.out);
-  CHECK(only_doc["scenarios"].size() == 3);  // core.end_stuck, .mesh, .linear
+  CHECK(only_doc["scenarios"].size() == 4);  // core.end_stuck, .mesh, .all_parts, .linear
   const Outcome none =
       RunTool({"bench", "--only", "core.nothing", "--scene", SourcePath("scenes/groove.yaml")});
   CHECK(none.exit_code == 2);
