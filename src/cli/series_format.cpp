@@ -62,6 +62,8 @@ std::string_view FlagName(std::uint32_t bit) {
       return "rod";
     case core::kShapeOffContacts:
       return "shape_off";
+    case core::kHeldBack:
+      return "held";
     default:
       return "unknown";
   }

@@ -43,6 +43,9 @@ int RunStability(const StabilityOptions& o, Streams io) {
           r.first_failing_tick >= 0 ? nlohmann::json(r.first_failing_tick) : nlohmann::json();
       j["first_shape_off_tick"] =
           r.first_shape_off_tick >= 0 ? nlohmann::json(r.first_shape_off_tick) : nlohmann::json();
+      j["held_ticks"] = r.held_ticks;
+      j["first_held_tick"] =
+          r.first_held_tick >= 0 ? nlohmann::json(r.first_held_tick) : nlohmann::json();
       j["warning"] = r.warning.empty() ? nlohmann::json() : nlohmann::json(r.warning);
       cases.push_back(j);
     }
@@ -66,10 +69,15 @@ int RunStability(const StabilityOptions& o, Streams io) {
       for (const std::string& m : motions) {
         const auto it = cell.find({p, m});
         std::string text = "-";
-        if (it != cell.end())
-          text = it->second->pass ? (it->second->warning.empty() ? "pass" : "pass (outside)")
-                                  : "FAIL @" + std::to_string(it->second->first_failing_tick) +
-                                        (it->second->warning.empty() ? "" : " (outside)");
+        if (it != cell.end()) {
+          const study::StabilityResult& r = *it->second;
+          // "held": the core held the tube back from going through a part in some ticks.
+          const std::string notes = std::string(r.warning.empty() ? "" : "outside") +
+                                    (r.warning.empty() || r.held_ticks == 0 ? "" : ", ") +
+                                    (r.held_ticks > 0 ? "held" : "");
+          text = (r.pass ? "pass" : "FAIL @" + std::to_string(r.first_failing_tick)) +
+                 (notes.empty() ? "" : " (" + notes + ")");
+        }
         io.out << std::setw(23) << text;
       }
       io.out << "\n";

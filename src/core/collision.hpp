@@ -131,6 +131,14 @@ class Collision {
   /// band by a distance an earlier Query computed (temporal coherence, collision.cpp).
   int last_coherent_skips() const { return coherent_skips_; }
 
+  /// Whether a node of the centreline `nodes_H` (held-end frame H), placed by (R_WH, p_WH), lies
+  /// deeper than `depth_m` inside a part: past every face plane by more than that. The core keeps
+  /// the tube from going there (docs/core.md, "Through a part"). A part thinner than 2 depth_m
+  /// has no such inside. The nodes' bounding box is tried against each part first, so a tube
+  /// nowhere near that deep costs a box test a part.
+  bool AxisDeeperThan(std::span<const Eigen::Vector3d> nodes_H, const Eigen::Matrix3d& R_WH,
+                      const Eigen::Vector3d& p_WH, double depth_m) const;
+
   /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
   /// its narrow-phase count does: the core forgets them when it is reset or restored, so that
   /// its figures depend on the ticks since then alone.

@@ -135,6 +135,9 @@ struct Core::State {
   int rod_tangent_members = 0, rod_tangent_age = 0;
   double held_off_load_N = 0.0;
   std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
+  // The shape already had a centreline point more than r1 / 2 inside a part (a scene or a reset
+  // that starts there): there is no state out of the part to hold the tube in, so none is held.
+  bool axis_inside = false;
   // The elastica's tangent compliance per segment and the loads it was computed for, its age in
   // ticks; the last two computed (`tangents[tangent_current]` the one used last). Two, because
   // a tip in stick-slip at the tick rate alternates between two loadings (the stuck and the
@@ -198,6 +201,68 @@ struct Core::Impl : Core::State {
     int rod_tangent_members = 0, rod_tangent_age = 0;
   } beam_cache;
   bool beam_cache_saved = false;
+  // What a tick changes of the last tick's shape and output, copied before it first changes
+  // them, once a Step: a tick whose shape would go through a part is not taken, and the tube
+  // stays as this says (docs/core.md, "Through a part"). The loads, the segments and the rod's
+  // are copied as far as they are used (a few hundred bytes; the rod's only when it shaped).
+  struct ShapeSave {
+    std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_H{};
+    Eigen::Vector3d tip_tangent_H = Eigen::Vector3d::UnitZ();
+    std::array<BeamLoad, kMaxLoads> beam_loads{};
+    std::array<int, kMaxLoads> order{};
+    std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};
+    std::array<ElasticaSegment, kMaxLoads> segments{};
+    std::array<RodSegment, kMaxLoads> rod_segments{};
+    int beam_count = 0, segment_count = 0, rod_segment_count = 0;
+    bool elastica_shape = false, elastica_held_off = false, rod_shape = false;
+    double held_off_load_N = 0.0;
+    // The output's shape figures and PCs (its pose and wrench are not written before step 9).
+    std::array<ContactState, kMaxContacts> contacts{};
+    int contact_count = 0;
+    double energy_J = 0.0, max_strain = 0.0, tip_deflection_m = 0.0;
+  } shape_save;
+  bool shape_saved = false;
+  bool hold_out_of_parts = true;
+  void SaveShape(std::size_t node_count, const StepOutput& out) {
+    if (shape_saved) return;
+    shape_saved = true;
+    CopyShape(shape_save, static_cast<const State&>(*this), node_count);
+    CopyShapeFigures(shape_save, out);
+  }
+  void RestoreShape(std::size_t node_count, StepOutput& out) {
+    CopyShape(static_cast<State&>(*this), shape_save, node_count);
+    CopyShapeFigures(out, shape_save);
+  }
+  // The one list of what a tick's shape is, either way (the arrays as far as they are used).
+  template <typename To, typename From>
+  static void CopyShape(To& to, const From& from, std::size_t node_count) {
+    std::copy_n(from.nodes_H.begin(), node_count, to.nodes_H.begin());
+    to.tip_tangent_H = from.tip_tangent_H;
+    const std::size_t load_n = std::size_t(from.beam_count);
+    std::copy_n(from.beam_loads.begin(), load_n, to.beam_loads.begin());
+    std::copy_n(from.order.begin(), load_n, to.order.begin());
+    std::copy_n(from.predicted_H.begin(), load_n, to.predicted_H.begin());
+    if (from.elastica_shape)
+      std::copy_n(from.segments.begin(), std::size_t(from.segment_count), to.segments.begin());
+    if (from.rod_shape)
+      std::copy_n(from.rod_segments.begin(), std::size_t(from.rod_segment_count),
+                  to.rod_segments.begin());
+    to.beam_count = from.beam_count;
+    to.segment_count = from.segment_count;
+    to.rod_segment_count = from.rod_segment_count;
+    to.elastica_shape = from.elastica_shape;
+    to.elastica_held_off = from.elastica_held_off;
+    to.rod_shape = from.rod_shape;
+    to.held_off_load_N = from.held_off_load_N;
+  }
+  template <typename To, typename From>
+  static void CopyShapeFigures(To& to, const From& from) {
+    std::copy_n(from.contacts.begin(), std::size_t(from.contact_count), to.contacts.begin());
+    to.contact_count = from.contact_count;
+    to.energy_J = from.energy_J;
+    to.max_strain = from.max_strain;
+    to.tip_deflection_m = from.tip_deflection_m;
+  }
   void SaveBeamCache() {
     beam_cache_saved = true;
     CopyBeamCache(beam_cache, static_cast<const State&>(*this));
@@ -335,6 +400,9 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.rod_shape = false;
   m.rod_tangent_members = 0;
   m.collision.ForgetDistances();
+  m.axis_inside = m.collision.AxisDeeperThan(
+      std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(capsule_count_) + 1),
+      X_WH.linear(), X_WH.translation(), 0.5 * scene_.tube.outer_radius_m);
   out_ = StepOutput{};
   out_.X_W_hand = X_WH;
   out_.X_WH = X_WH;
@@ -356,6 +424,7 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   // Idle parts left out, unless a pass of the solve may have moved the tube into reach of one:
   // then the tick again with every part (docs/core.md, "Idle parts").
   m.beam_cache_saved = false;
+  m.shape_saved = false;
   if (!Tick(t_s, X_W_hand, m.leave_out_idle)) {
     ++m.idle_retries;
     if (m.beam_cache_saved) m.RestoreBeamCache();
@@ -692,6 +761,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   if (truncated && idle.left_out > 0) return false;
 
   // 5. The beam's compliance between the load points, about last tick's forces.
+  m.SaveShape(std::size_t(N) + 1, out);
   for (int i = 0; i < load_count; ++i) {
     Load& ld = m.loads[std::size_t(i)];
     if (!ld.ghost) {
@@ -1535,6 +1605,34 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       pc.marker = states::Marker::kBent;
   }
 
+  // Through a part: the tick's shape puts a centreline point more than r1 / 2 inside a part
+  // (there the tube is going through it: the penalty pressed its surface in by 1.5 r1), from a
+  // shape that did not. The proxy is placed where the contacts allow (issue 3): the tube is not
+  // moved there. It stays as it was, the held end too, and the operator feels the coupling's
+  // spring and damper stretched from the held end to the hand, up to the device's force: a wall.
+  // The tick's loads were solved with a compliance its shape did not follow (the segmented
+  // rule's cut bending the tube with one of two pinching loads, a piece with no load in the tick
+  // bent into a part: docs/accuracy.md); the next ticks try again from the state kept.
+  const bool inside = m.hold_out_of_parts &&
+                      m.collision.AxisDeeperThan(
+                          std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1),
+                          R_WH_new, p_W, 0.5 * scene_.tube.outer_radius_m);
+  if (inside && !m.axis_inside && p_W.allFinite() && R_WH_new.allFinite()) {
+    m.RestoreShape(std::size_t(N) + 1, out);
+    Eigen::Vector3d hold_W =
+        -(coupling_stiffness_ * (p_hand_W - m.p_held_prev_W) + coupling_damping_ * v_hand_W);
+    out.flags = kHeldBack | (out.flags & (kPenetration | kContactsTruncated));
+    if (hold_W.norm() > max_force) {
+      hold_W *= max_force / hold_W.norm();
+      out.flags |= kForceClamped;
+    }
+    if (out.torque_W_Nm.norm() > scene_.device.max_torque_Nm) out.flags |= kForceClamped;
+    out.force_W_N = hold_W;  // the torque and the held end's pose stay last tick's
+    m.p_hand_prev_W = p_hand_W;
+    return true;
+  }
+  m.axis_inside = inside;
+
   // 9. The operator's wrench, and the state for the next tick.
   out.X_WH = Eigen::Isometry3d::Identity();
   out.X_WH.linear() = R_WH_new;
@@ -1610,6 +1708,7 @@ int Core::narrow_phase_calls() const { return impl_->collision.last_narrow_phase
 int Core::idle_parts_left_out() const { return impl_->idle_left_out; }
 long Core::idle_retries() const { return impl_->idle_retries; }
 void Core::set_leave_out_idle_parts(bool on) { impl_->leave_out_idle = on; }
+void Core::set_hold_out_of_parts(bool on) { impl_->hold_out_of_parts = on; }
 
 std::string Core::FormationText() const { return states::ToString(Formation()); }
 

@@ -143,8 +143,9 @@ struct Run {
   // First failing tick of each check (-1: never) and what it saw there.
   int fail_finite = -1, fail_force = -1, fail_law = -1, fail_friction = -1, fail_passive = -1,
       fail_tunnel = -1, fail_fault = -1;
-  int beyond_linear = -1;  // first tick the linear shape was beyond its range (not a check)
-  int shape_off = -1;      // first tick the shape was off its contacts' points (not a check)
+  int beyond_linear = -1;         // first tick the linear shape was beyond its range (not a check)
+  int shape_off = -1;             // first tick the shape was off its contacts' points (not a check)
+  int held = 0, first_held = -1;  // ticks held back from going through a part (not a check)
   std::string why_force, why_law, why_friction, why_passive, why_tunnel;
   double work_J = 0.0, stored_J = 0.0, initial_J = 0.0;
 };
@@ -184,6 +185,10 @@ Run Drive(const StabilityCase& c, bool check) {
     if (o.flags & core::kSolverFault) Note(run.fail_fault, run.why_force, tick, run.why_force);
     if ((o.flags & core::kBeyondLinearRange) && run.beyond_linear < 0) run.beyond_linear = tick;
     if ((o.flags & core::kShapeOffContacts) && run.shape_off < 0) run.shape_off = tick;
+    if (o.flags & core::kHeldBack) {
+      ++run.held;
+      if (run.first_held < 0) run.first_held = tick;
+    }
     const Vector3d F = o.force_W_N, p = o.X_WH.translation();
     run.peak_force_N = std::max(run.peak_force_N, F.norm());
     run.max_strain = std::max(run.max_strain, o.max_strain);
@@ -436,6 +441,13 @@ StabilityResult RunStabilityCase(const StabilityCase& c) {
   r.first_shape_off_tick = first.shape_off;
   if (first.shape_off >= 0 && !r.pass)
     r.detail += Fmt("; the shape off its contacts from tick %d", first.shape_off);
+  // And where it held the tube back from going through a part: the tube then did not follow the
+  // hand (the operator felt the coupling's spring), which the checks above cannot see.
+  r.held_ticks = first.held;
+  r.first_held_tick = first.first_held;
+  if (first.held > 0)
+    r.detail += Fmt("; held back from going through a part in %d of %d ticks, from tick %d",
+                    first.held, first.ticks, first.first_held);
   return r;
 }
 

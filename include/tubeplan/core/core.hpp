@@ -76,10 +76,15 @@ enum StepFlag : std::uint32_t {
   /// known failures start (docs/accuracy.md): a replay through such ticks is not the tube's
   /// motion.
   kShapeOffContacts = 1u << 8,
+  /// The tick's solution would have put a point of the tube's centreline more than r1 / 2 inside
+  /// a part (the tube going through it), from a state where none was: the tube and the held end
+  /// were kept where they were, and the operator feels the coupling's spring and damper
+  /// stretched to the hand (docs/core.md, "Through a part").
+  kHeldBack = 1u << 9,
 };
 /// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
-inline constexpr int kStepFlagCount = 9;
-static_assert(kShapeOffContacts == 1u << (kStepFlagCount - 1),
+inline constexpr int kStepFlagCount = 10;
+static_assert(kHeldBack == 1u << (kStepFlagCount - 1),
               "kStepFlagCount must follow the last StepFlag bit");
 
 /// One principal contact in a tick, in the core's compact form.
@@ -210,6 +215,9 @@ class Core {
   /// Leaving idle parts out never changes a tick's result; off, every part in the band is
   /// queried every tick (the tests compare the two; the bench shows the difference).
   void set_leave_out_idle_parts(bool on);
+  /// On (the default), a tick whose solution would carry the centreline into a part is not taken
+  /// (kHeldBack); off, it is (the tests show what the guard prevents).
+  void set_hold_out_of_parts(bool on);
   double coupling_stiffness_N_per_m() const { return coupling_stiffness_; }
   double coupling_damping_Ns_per_m() const { return coupling_damping_; }
 

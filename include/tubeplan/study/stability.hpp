@@ -43,6 +43,10 @@ struct StabilityResult {
   /// First tick the core flagged its shape off the points its contacts were solved at
   /// (core::kShapeOffContacts), -1 if none: not a check, a pointer to where failures start.
   int first_shape_off_tick = -1;
+  /// Ticks the core held the tube back from going through a part (core::kHeldBack), and the
+  /// first (-1 if none): a case that passes by being held is shown as such.
+  int held_ticks = 0;
+  int first_held_tick = -1;
   int ticks = 0;
   double peak_force_N = 0.0;
 };
