@@ -243,7 +243,8 @@ int RunGraph(const GraphOptions& o, Streams io) {
     << g.motions.size() << " motions (";
   bool first = true;
   for (const auto& [kind, n] : kinds) t << (first ? "" : ", ") << n << " " << kind, first = false;
-  t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined; " << g.seconds
+  t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined, " << g.held_back
+    << " motions ended where the tube was held back from going through a part; " << g.seconds
     << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
   t << "saturation (motions: nodes/arcs):";
   const std::size_t every = std::max<std::size_t>(1, g.saturation.size() / 12);

@@ -97,9 +97,9 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   }
   j["motions"] = motions;
   j["stats"] = {{"motions", g.motions.size()},  {"ticks", g.ticks},
-                {"refinements", g.refinements}, {"probed", g.probed},
-                {"saturated", g.saturated},     {"seconds", g.seconds},
-                {"jobs", explore.jobs}};
+                {"refinements", g.refinements}, {"held_back", g.held_back},
+                {"probed", g.probed},           {"saturated", g.saturated},
+                {"seconds", g.seconds},         {"jobs", explore.jobs}};
   return j;
 }
 

@@ -96,6 +96,7 @@ struct MotionResult {
   std::vector<Change> changes;
   long ticks = 0;
   int refinements = 0;
+  bool held_back = false;  // cut where the core held the tube back from going through a part
   // Per stay: the run's point at or before its witness, from which its CF's probe can start,
   // kept for the first stay of each CF (refined or not) that could become that probe's start
   // (Merger::MayEnter); null for the others.
@@ -237,6 +238,15 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
 
   for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
+    if (out.flags & core::kHeldBack) {
+      // The core held the tube back: this tick would have carried it through a part (docs/
+      // core.md, "Through a part"). The tube cannot follow the hand further, and what a motion
+      // reaches after that it reaches only by snapping after the hand once the hold lets go, so
+      // the motion ends here (the held tick, which kept the last state, is not recorded).
+      result.held_back = true;
+      ++k;
+      break;
+    }
     samples.push_back(SampleOf(out));
     samples.back().move = runner.move();
     samples.back().move_tick = runner.move_tick();
@@ -613,6 +623,7 @@ class Merger {
     }
     graph_.ticks += r.ticks;
     graph_.refinements += r.refinements;
+    graph_.held_back += r.held_back ? 1 : 0;
     graph_.saturation.push_back({static_cast<int>(graph_.saturation.size()) + 1,
                                  static_cast<int>(graph_.nodes.size()),
                                  static_cast<int>(graph_.arcs.size())});

@@ -460,7 +460,10 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
     std::string counted, current;
     int held = 0;
     for (int k = 1; !runner.Done(); ++k) {
-      core.Step(k * s.model.time_step_s, runner.Next(core.last()));
+      // Held back from going through a part, the tube no longer follows the motion: it ends
+      // here, as the exploration's do (docs/graph.md).
+      if (core.Step(k * s.model.time_step_s, runner.Next(core.last())).flags & core::kHeldBack)
+        break;
       const std::string cf = core.FormationText();
       held = cf == current ? held + 1 : 1;
       current = cf;
@@ -509,7 +512,9 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
   // edges, its marker flipping (Fs n/u left.top_inner), and wedges against floor and wall, which
   // the probes from one stay per node do not reach. Issue 4 stays open for them. The floor, 90 %,
   // keeps a margin of about three CFs and four transitions, so that exploration that misses
-  // common states fails here.
+  // common states fails here. Since motions end where the core holds the tube back from going
+  // through a part (stop 30), fewer states are reached (47/48 and 90/98 measured): the margin is
+  // four CFs and one transition.
   CHECK(node_coverage >= 0.90);
   CHECK(arc_coverage >= 0.90);
 }
