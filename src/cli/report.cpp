@@ -41,7 +41,8 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"energy_entry_J", v.energy_entry_J},
                              {"energy_exit_J", v.energy_exit_J},
                              {"beyond_linear_s", v.beyond_linear_s},
-                             {"shape_off_s", v.shape_off_s}});
+                             {"shape_off_s", v.shape_off_s},
+                             {"held_s", v.held_s}});
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -103,6 +104,10 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
       t << "      warning: for " << v.shape_off_s
         << " s the tube's shape was off the points its contacts were solved at (flag shape_off): "
            "the verdict rests on ticks the core did not resolve\n";
+    if (v.held_s > 0.0)
+      t << "      warning: for " << v.held_s
+        << " s the core held the tube back from going through a part (flag held): the tube did "
+           "not follow the plan's hand there\n";
   }
   t.precision(precision);
 }

@@ -33,6 +33,9 @@ struct TransitionVerdict {
   /// Time the shape under the tick's loads was off the points the tick's contacts were solved
   /// at (core flag shape_off): the verdict then rests on ticks the core did not resolve.
   double shape_off_s = 0.0;
+  /// Time the core held the tube back from going through a part (core flag held): there the
+  /// tube did not follow the hand, and the operator felt the coupling's spring.
+  double held_s = 0.0;
 };
 
 struct Observation {
