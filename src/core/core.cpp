@@ -188,7 +188,11 @@ struct Core::Impl : Core::State {
   // parts left out first changes them: a tick solved again starts from them, as it would have
   // (a tangent computed for the first try would otherwise stay in the cache in place of an
   // older one, and a later tick that fits the older one would compute a new one: the same
-  // physics, other last bits). Most ticks change none of them (the tangents are reused).
+  // physics, other last bits). Most ticks change none of them (the tangents are reused). Each of
+  // its three parts is copied only when the tick is about to change it: the choice of tangent
+  // (an int; a tip in stick-slip flips it every other tick), the elastica's tangents and starting
+  // guesses (~4 kB), the rod's (~17 kB). Copying all of it on every flip cost 1.7 k instructions a
+  // tick sliding.
   struct BeamCache {
     std::array<ElasticaTangent, 2> tangents{};
     int tangent_current = 0;
@@ -200,7 +204,7 @@ struct Core::Impl : Core::State {
     std::array<int, kMaxLoads> rod_tangent_segment{};
     int rod_tangent_members = 0, rod_tangent_age = 0;
   } beam_cache;
-  bool beam_cache_saved = false;
+  bool tangent_choice_saved = false, elastica_cache_saved = false, rod_cache_saved = false;
   // What a tick changes of the last tick's shape and output, copied before it first changes
   // them, once a Step: a tick whose shape would go through a part is not taken, and the tube
   // stays as this says (docs/core.md, "Through a part"). The loads, the segments and the rod's
@@ -263,17 +267,36 @@ struct Core::Impl : Core::State {
     to.max_strain = from.max_strain;
     to.tip_deflection_m = from.tip_deflection_m;
   }
-  void SaveBeamCache() {
-    beam_cache_saved = true;
-    CopyBeamCache(beam_cache, static_cast<const State&>(*this));
+  void SaveTangentChoice() {
+    if (tangent_choice_saved) return;
+    tangent_choice_saved = true;
+    beam_cache.tangent_current = tangent_current;
   }
-  void RestoreBeamCache() { CopyBeamCache(static_cast<State&>(*this), beam_cache); }
-  // The one list of what the beam's cache is, either way.
+  void SaveElasticaCache() {
+    if (elastica_cache_saved) return;
+    elastica_cache_saved = true;
+    CopyElasticaCache(beam_cache, static_cast<const State&>(*this));
+  }
+  void SaveRodCache() {
+    if (rod_cache_saved) return;
+    rod_cache_saved = true;
+    CopyRodCache(beam_cache, static_cast<const State&>(*this));
+  }
+  // Puts back what was saved, and forgets it.
+  void RestoreBeamCache() {
+    if (tangent_choice_saved) tangent_current = beam_cache.tangent_current;
+    if (elastica_cache_saved) CopyElasticaCache(static_cast<State&>(*this), beam_cache);
+    if (rod_cache_saved) CopyRodCache(static_cast<State&>(*this), beam_cache);
+    tangent_choice_saved = elastica_cache_saved = rod_cache_saved = false;
+  }
+  // The one list of what each part of the beam's cache is, either way.
   template <typename To, typename From>
-  static void CopyBeamCache(To& to, const From& from) {
+  static void CopyElasticaCache(To& to, const From& from) {
     to.tangents = from.tangents;
-    to.tangent_current = from.tangent_current;
     to.segments = from.segments;
+  }
+  template <typename To, typename From>
+  static void CopyRodCache(To& to, const From& from) {
     to.rod_segments = from.rod_segments;
     to.rod_tangent = from.rod_tangent;
     to.rod_tangent_force = from.rod_tangent_force;
@@ -423,11 +446,11 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
   Impl& m = *impl_;
   // Idle parts left out, unless a pass of the solve may have moved the tube into reach of one:
   // then the tick again with every part (docs/core.md, "Idle parts").
-  m.beam_cache_saved = false;
+  m.tangent_choice_saved = m.elastica_cache_saved = m.rod_cache_saved = false;
   m.shape_saved = false;
   if (!Tick(t_s, X_W_hand, m.leave_out_idle)) {
     ++m.idle_retries;
-    if (m.beam_cache_saved) m.RestoreBeamCache();
+    m.RestoreBeamCache();
     Tick(t_s, X_W_hand, false);
   }
   return out_;
@@ -822,7 +845,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
                     0.1 * m.rod_tangent_force[kk].norm() + 1e-3 * scale_N;
       }
       bool ok = true;
-      if (!reuse && idle.left_out > 0 && !m.beam_cache_saved) m.SaveBeamCache();
+      if (!reuse && idle.left_out > 0) m.SaveRodCache();
       if (!reuse) {
         // Last tick's shape was the rod's, solved at last tick's forces, which are this tick's
         // f_lin: if its loads are these members, at arc positions within 1 % of l, on the same
@@ -908,11 +931,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         return ok;
       };
       if (!fits(m.tangents[std::size_t(m.tangent_current)])) {
-        if (idle.left_out > 0 && !m.beam_cache_saved) m.SaveBeamCache();
+        if (idle.left_out > 0) m.SaveTangentChoice();
         // The other one, or a new one in its place.
         m.tangent_current = 1 - m.tangent_current;
         State::ElasticaTangent& t = m.tangents[std::size_t(m.tangent_current)];
         if (!fits(t)) {
+          if (idle.left_out > 0) m.SaveElasticaCache();
           m.beam.SolveElasticaChain(m.beam_loads, members, m.order, m.segments);
           for (int g = 0; g < groups; ++g) {
             const std::size_t gi = std::size_t(g);
