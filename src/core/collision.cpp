@@ -483,20 +483,27 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
 
 bool Collision::AxisDeeperThan(std::span<const Eigen::Vector3d> nodes_H,
                                const Eigen::Matrix3d& R_WH, const Eigen::Vector3d& p_WH,
-                               double depth_m) const {
+                               double depth_m, double spacing_m) const {
   // The nodes' bounding box in frame H, then per part the box that contains it in the part's
-  // frame; only a part that box reaches deep enough into is tried node by node.
+  // frame; only a part that box reaches deep enough into is tried node by node. With nodes at
+  // most spacing_m apart, every node lies within two spacings of one of every fourth node (and
+  // the last): their box grown by that contains them all.
   // (x and y as one SSE pair, z alone: a third of the instructions of Eigen's 3-vector min/max.)
   constexpr double kInf = std::numeric_limits<double>::infinity();
   Eigen::Vector2d lo_xy(kInf, kInf), hi_xy(-kInf, -kInf);
   double lo_z = kInf, hi_z = -kInf;
-  for (const Eigen::Vector3d& x : nodes_H) {
+  const std::size_t stride = spacing_m > 0.0 ? 4 : 1;
+  const auto take = [&](const Eigen::Vector3d& x) {
     lo_xy = lo_xy.cwiseMin(x.head<2>());
     hi_xy = hi_xy.cwiseMax(x.head<2>());
     lo_z = x.z() < lo_z ? x.z() : lo_z;
     hi_z = x.z() > hi_z ? x.z() : hi_z;
-  }
-  const Eigen::Vector3d lo(lo_xy.x(), lo_xy.y(), lo_z), hi(hi_xy.x(), hi_xy.y(), hi_z);
+  };
+  for (std::size_t k = 0; k < nodes_H.size(); k += stride) take(nodes_H[k]);
+  if (!nodes_H.empty()) take(nodes_H.back());
+  const double grow_m = stride > 1 ? 2.0 * spacing_m : 0.0;
+  const Eigen::Vector3d lo(lo_xy.x() - grow_m, lo_xy.y() - grow_m, lo_z - grow_m);
+  const Eigen::Vector3d hi(hi_xy.x() + grow_m, hi_xy.y() + grow_m, hi_z + grow_m);
   const Eigen::Vector3d centre_H = 0.5 * (lo + hi), half_H = 0.5 * (hi - lo);
   for (const Part& part : parts_) {
     // A node deeper than depth_m has |q| < half - depth_m along every axis of the part.

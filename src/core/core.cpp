@@ -1637,10 +1637,15 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // The tick's loads were solved with a compliance its shape did not follow (the segmented
   // rule's cut bending the tube with one of two pinching loads, a piece with no load in the tick
   // bent into a part: docs/accuracy.md); the next ticks try again from the state kept.
+  // The elastica's and the rod's shapes keep the tube's length: their nodes are at most l / N
+  // apart (chords of arcs that long; 10 % more allows for the elastica's Hermite interpolation
+  // between exact samples, whose error is far below that), which lets the check bound them by
+  // every fourth. The linear model's nodes need not be: all are taken.
+  const double spacing_m = (m.elastica_shape || m.rod_shape) ? 1.1 * l / N : 0.0;
   const bool inside = m.hold_out_of_parts &&
                       m.collision.AxisDeeperThan(
                           std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1),
-                          R_WH_new, p_W, 0.5 * scene_.tube.outer_radius_m);
+                          R_WH_new, p_W, 0.5 * scene_.tube.outer_radius_m, spacing_m);
   if (inside && !m.axis_inside && p_W.allFinite() && R_WH_new.allFinite()) {
     m.RestoreShape(std::size_t(N) + 1, out);
     Eigen::Vector3d hold_W =

@@ -1,10 +1,12 @@
 // The core's closed-form distances against FCL's GJK, an independent method.
 #include "core/collision.hpp"  // private to the core (src/)
 
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <span>
 #include <vector>
 
 #include <catch2/catch.hpp>
@@ -352,4 +354,85 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   INFO("parts left out " << left_out << ", their contacts " << covered);
   CHECK(left_out > 1000);
   CHECK(covered > 1000);
+}
+
+TEST_CASE("A centreline deeper than r1/2 in a part is found, by every fourth node too",
+          "[core][collision]") {
+  // Random curves of nodes at most h apart (a random walk of the tangent, each step h times a
+  // random factor in [0.5, 1]: a shape that keeps its length), placed by random poses in and
+  // around the groove's parts. The answer is judged independently, node by node against each
+  // part's box, with or without the promise of the spacing (which bounds the nodes by every
+  // fourth). Near misses are common: poses are drawn so that the deepest node lies within a few
+  // millimetres of the threshold.
+  io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene.has_value());
+  const scene::Scene& s = *loaded.scene;
+  std::vector<std::uint32_t> parts;
+  for (std::uint32_t p = 0; p < s.parts.size(); ++p) parts.push_back(p);
+  std::vector<std::array<int, 64>> element_of(s.parts.size());
+  const int capsules = 48;
+  const core::Collision collision(s, parts, capsules, element_of);
+  const double l = s.tube.length_m, h = l / capsules, depth = 0.5 * s.tube.outer_radius_m;
+  std::mt19937_64 rng(20261125);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int inside = 0, outside = 0, near = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    // Every other curve short (2 to 9 nodes) and sharply bent: there the deepest node can lie
+    // between the fourth nodes with all of those outside, which only the growth of their box
+    // covers.
+    const int count = trial % 2 == 0 ? capsules : 1 + int(std::floor(4.5 * (1.0 + u(rng))));
+    std::array<Eigen::Vector3d, core::kMaxCapsules + 1> storage;
+    const std::span<Eigen::Vector3d> nodes(storage.data(), std::size_t(count) + 1);
+    Eigen::Vector3d tangent = Eigen::Vector3d::UnitZ();
+    nodes[0].setZero();
+    const double wiggle = (count == capsules ? 0.3 : 1.0) * (1.0 + u(rng));  // radians a step
+    for (int k = 1; k <= count; ++k) {
+      tangent = (tangent + wiggle * Eigen::Vector3d(u(rng), u(rng), u(rng))).normalized();
+      nodes[std::size_t(k)] = nodes[std::size_t(k) - 1] + h * (0.75 + 0.25 * u(rng)) * tangent;
+    }
+    const Eigen::Matrix3d R_WH =
+        Eigen::Quaterniond(Eigen::Vector4d(u(rng), u(rng), u(rng), u(rng)).normalized())
+            .toRotationMatrix();
+    // The held end anywhere over the groove's 60 mm by 200 mm, from 10 mm under the floor's top
+    // to 40 mm above it.
+    const Eigen::Vector3d p_WH(0.04 * u(rng), 0.1 * u(rng), 0.015 + 0.025 * u(rng));
+    double deepest = -1.0;
+    for (const scene::BoxPart& part : s.parts) {
+      const Eigen::Isometry3d X_PW = part.X_WP.inverse();
+      for (const Eigen::Vector3d& x : nodes)
+        deepest = std::max(deepest,
+                           (0.5 * part.size_m - (X_PW * (R_WH * x + p_WH)).cwiseAbs()).minCoeff());
+    }
+    const bool expected = deepest > depth;
+    (expected ? inside : outside) += 1;
+    near += std::abs(deepest - depth) < 2e-3 ? 1 : 0;
+    INFO("trial " << trial << ": deepest node " << deepest * 1e3 << " mm");
+    CHECK(collision.AxisDeeperThan(nodes, R_WH, p_WH, depth) == expected);
+    CHECK(collision.AxisDeeperThan(nodes, R_WH, p_WH, depth, h) == expected);
+  }
+  // Random curves seldom put their deepest node exactly where only the growth, or only the last
+  // node, reaches: two made so, over the floor (its top at z = 0, deeper than r1/2 = 4 mm is
+  // z < -4 mm). A fold straight down and back, nodes 0 and 4 two spacings above its tip: the box
+  // of those two grown by two spacings just reaches the tip (by one, it would not). And a curve
+  // of 8 nodes whose last three go down from node 4: node 7, three spacings under it, is reached
+  // only because the last node is always taken.
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  std::array<Eigen::Vector3d, 5> fold = {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(0, 0, -h),
+                                         Eigen::Vector3d(0, 0, -2 * h), Eigen::Vector3d(0, 0, -h),
+                                         Eigen::Vector3d(0, 0, 0)};
+  const Eigen::Vector3d fold_at(0.0, 0.0, -4.5e-3 + 2 * h);  // its tip 0.5 mm past r1/2
+  CHECK(collision.AxisDeeperThan(fold, I, fold_at, depth));
+  CHECK(collision.AxisDeeperThan(fold, I, fold_at, depth, h));
+  CHECK_FALSE(collision.AxisDeeperThan(fold, I, fold_at + Eigen::Vector3d(0, 0, 1e-3), depth, h));
+  std::array<Eigen::Vector3d, 8> hook;
+  for (int k = 0; k < 8; ++k)
+    hook[std::size_t(k)] = Eigen::Vector3d(h * std::min(k, 4), 0.0, -h * std::max(0, k - 4));
+  const Eigen::Vector3d hook_at(0.0, 0.0, -4.5e-3 + 3 * h);
+  CHECK(collision.AxisDeeperThan(hook, I, hook_at, depth));
+  CHECK(collision.AxisDeeperThan(hook, I, hook_at, depth, h));
+  INFO(inside << " inside, " << outside << " outside, " << near << " within 2 mm of r1/2");
+  CHECK(inside > 200);
+  CHECK(outside > 200);
+  CHECK(near > 50);
 }
