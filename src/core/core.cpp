@@ -164,6 +164,8 @@ struct Core::State {
   SystemMatrix M;
   SystemVector rhs, z;
   Eigen::PartialPivLU<SystemMatrix> lu;
+  Eigen::PartialPivLU<Eigen::Matrix3d> lu3;
+  Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu6;
 };
 
 // The set-up that ticks only read (Collision's GJK solver carries nothing between queries: its
@@ -1117,7 +1119,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
     }
     if (reduced) {
-      if (n > 0) {
+      // One load or two (most ticks): the fixed-size factorisation, the same partial pivoting in
+      // the same order (the same bits) without the dynamic one's blocking and bookkeeping, which
+      // cost a 3 x 3 system ~700 instructions.
+      if (n == 3) {
+        m.lu3.compute(m.M.topLeftCorner<3, 3>());
+        m.z = m.lu3.solve(m.rhs.head<3>());
+      } else if (n == 6) {
+        m.lu6.compute(m.M.topLeftCorner<6, 6>());
+        m.z = m.lu6.solve(m.rhs.head<6>());
+      } else if (n > 0) {
         m.lu.compute(m.M);
         m.z = m.lu.solve(m.rhs);
       } else {
