@@ -334,13 +334,12 @@ void AddGroup(IdleParts& idle, const IdleParts::Group& group) {
 }
 }  // namespace
 
-bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
-                         std::span<const Eigen::Vector3d> nodes_W,
-                         const Eigen::Vector3d& end_start_W, const Eigen::Vector3d& end_start_P,
-                         double band_m, IdleParts& idle) const {
+bool Collision::StillLeftOut(std::size_t part_i, std::span<const Eigen::Vector3d> nodes_W,
+                             const Eigen::Vector3d& end_start_W, double band_m,
+                             IdleParts& idle) const {
   const Part& part = parts_[part_i];
-  IdleSummary& summary = summaries_[part_i];
-  Eigen::Vector3d* const anchor = &anchors_[part_i * std::size_t(kMaxCapsules + 2)];
+  const IdleSummary& summary = summaries_[part_i];
+  const Eigen::Vector3d* const anchor = &anchors_[part_i * std::size_t(kMaxCapsules + 2)];
   const std::size_t node_count = nodes_W.size();
   // Last tick's evaluation, while it still holds: every point of the tube has moved at most
   // delta since it (a piece's axis ends did, so all of it), so each group's pieces are at least
@@ -372,6 +371,17 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
       return true;
     }
   }
+  return false;
+}
+
+bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
+                         std::span<const Eigen::Vector3d> nodes_W,
+                         const Eigen::Vector3d& end_start_W, const Eigen::Vector3d& end_start_P,
+                         double band_m, IdleParts& idle) const {
+  const Part& part = parts_[part_i];
+  IdleSummary& summary = summaries_[part_i];
+  Eigen::Vector3d* const anchor = &anchors_[part_i * std::size_t(kMaxCapsules + 2)];
+  const std::size_t node_count = nodes_W.size();
   summary.valid = false;
   // The pieces the band would take are those the broad phase passes and no kept distance
   // settles beyond the band (the loop in Query), here a band half an epsilon wider so that
@@ -534,28 +544,54 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
   const Eigen::Vector3d tip_W = nodes_W.back();
   const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
   const std::size_t node_count = nodes_W.size();
+  // The whole tube's bounding box first: most parts are nowhere near it. In the world frame once,
+  // for the parts aligned with it (their frame is a shift of the world's, and rounding is
+  // monotonic, so the shifted box is the box of the shifted nodes, bit for bit).
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d lo_W = Eigen::Vector3d::Constant(kInf), hi_W = -lo_W;
+  for (std::size_t i = 0; i < node_count; ++i) {
+    lo_W = lo_W.cwiseMin(nodes_W[i]);
+    hi_W = hi_W.cwiseMax(nodes_W[i]);
+  }
   for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
-    // The whole tube's bounding box first: most parts are nowhere near it.
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = -lo;
-    for (std::size_t i = 0; i < node_count; ++i) {
-      nodes_P_[i] = part.ToPart(nodes_W[i]);
-      lo = lo.cwiseMin(nodes_P_[i]);
-      hi = hi.cwiseMax(nodes_P_[i]);
+    // The nodes in the part's frame, made only for a part the tube may reach and that is not
+    // still left out (most of the groove's ticks leave out both walls).
+    bool in_part_frame = false;
+    const auto to_part_frame = [&] {
+      if (in_part_frame) return;
+      for (std::size_t i = 0; i < node_count; ++i) nodes_P_[i] = part.ToPart(nodes_W[i]);
+      in_part_frame = true;
+    };
+    Eigen::Vector3d lo, hi;
+    if (part.aligned) {
+      lo = lo_W + part.p_PW;
+      hi = hi_W + part.p_PW;
+    } else {
+      to_part_frame();
+      lo = Eigen::Vector3d::Constant(kInf);
+      hi = -lo;
+      for (std::size_t i = 0; i < node_count; ++i) {
+        lo = lo.cwiseMin(nodes_P_[i]);
+        hi = hi.cwiseMax(nodes_P_[i]);
+      }
     }
     const double grow = radius_m_ + band_m;
     if (((lo.array() - grow) > part.half_m.array()).any() ||
         ((hi.array() + grow) < -part.half_m.array()).any())
       continue;
+    const bool may_leave_out = idle != nullptr && part.index < idle->may_leave_out.size() &&
+                               idle->may_leave_out[part.index] != 0;
+    if (may_leave_out && StillLeftOut(part_i, nodes_W, end_start_W, band_m, *idle)) continue;
     const Eigen::Vector3d end_start_P = part.ToPart(end_start_W);
-    if (idle != nullptr && part.index < idle->may_leave_out.size() &&
-        idle->may_leave_out[part.index] != 0) {
+    if (may_leave_out) {
+      to_part_frame();
       if (LeaveOut(part_i, kept, nodes_W, end_start_W, end_start_P, band_m, *idle)) continue;
     } else {
       summaries_[part_i].valid = false;
     }
+    to_part_frame();
     for (int k = 0; k < pieces; ++k) {
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];

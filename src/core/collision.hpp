@@ -185,8 +185,14 @@ class Collision {
                           double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
                           Eigen::Vector3d& normal_P) const;
   struct KeptDistance;
-  // Whether the idle part parts_[part_i] can be left out of this query (IdleParts); then it adds
-  // its groups to idle's and counts it. Reads the part-frame nodes Query has just made.
+  // Whether the idle part parts_[part_i], left out by its last evaluation (valid summary), still
+  // is: every node has moved too little since for it to matter (world frame only). Then it adds
+  // its groups to idle's and counts it.
+  bool StillLeftOut(std::size_t part_i, std::span<const Eigen::Vector3d> nodes_W,
+                    const Eigen::Vector3d& end_start_W, double band_m, IdleParts& idle) const;
+  // Evaluates the idle part parts_[part_i] afresh: whether it can be left out of this query
+  // (IdleParts); then it adds its groups to idle's and counts it. Reads the part-frame nodes Query
+  // has just made.
   bool LeaveOut(std::size_t part_i, const KeptDistance* kept,
                 std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& end_start_W,
                 const Eigen::Vector3d& end_start_P, double band_m, IdleParts& idle) const;
