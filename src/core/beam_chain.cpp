@@ -132,6 +132,33 @@ double BeamChain::DisplacementBound(const BeamLoad& j, const Eigen::Vector3d& df
   return bound;
 }
 
+double BeamChain::DisplacementChangeBound(const BeamLoad& now, const BeamLoad& then,
+                                          const Eigen::Vector3d& f_H, bool moments, double r_max_m,
+                                          double s_max_m, const Eigen::Matrix3d& normal_H,
+                                          const Eigen::Matrix3d& turn_H) const {
+  if (now.clamp_m != then.clamp_m)
+    return DisplacementBound(now, f_H, moments, r_max_m, s_max_m, normal_H, turn_H) +
+           DisplacementBound(then, f_H, moments, r_max_m, s_max_m, normal_H, turn_H);
+  // Each coefficient (Coeffs) is non-decreasing in the load's arc position b at every point a,
+  // and for b1 > b2 the difference c(a; b1) - c(a; b2) is non-negative and non-decreasing in a:
+  // its value at s_max bounds it at every point up to there. The terms as in DisplacementBound;
+  // the offset moment M = r x f changes with r too: u_now M_now - u_then M_then is
+  // u_now (M_now - M_then) + (u_now - u_then) M_then.
+  const double a = s_max_m - now.clamp_m;
+  const Coefficients cn = Coeffs(a, now.s_m - now.clamp_m, EI_);
+  const Coefficients ct = Coeffs(a, then.s_m - then.clamp_m, EI_);
+  const Eigen::Vector3d lateral(f_H.x(), f_H.y(), 0.0);
+  const Eigen::Vector3d turn(-f_H.y(), f_H.x(), 0.0);  // z x F
+  double bound = std::abs(cn.uF - ct.uF) * (normal_H * lateral).norm() +
+                 r_max_m * std::abs(cn.thF - ct.thF) * (turn_H * turn).norm();
+  if (moments) {
+    const Eigen::Vector3d M_now = now.r_H_m.cross(f_H), M_then = then.r_H_m.cross(f_H);
+    bound += (cn.uM + r_max_m * cn.thM) * (M_now - M_then).norm() +
+             (std::abs(cn.uM - ct.uM) + r_max_m * std::abs(cn.thM - ct.thM)) * M_then.norm();
+  }
+  return bound;
+}
+
 Eigen::Vector3d BeamChain::CentreDisplacement(double s_m, const BeamLoad& j) const {
   const Coefficients c = Coeffs(s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
   const Eigen::Vector3d M = j.r_H_m.cross(j.f_H_N);

@@ -112,6 +112,14 @@ class BeamChain {
   double DisplacementBound(const BeamLoad& j, const Eigen::Vector3d& df_H, bool moments,
                            double r_max_m, double s_max_m, const Eigen::Matrix3d& normal_H,
                            const Eigen::Matrix3d& turn_H) const;
+  /// The same for the change (Compliance(i, now) - Compliance(i, then)) f_H of one force f_H
+  /// moved from `then` to `now` (another arc position or offset). With one clamp each term's
+  /// coefficient grows with the load's arc position at every point, and so does the difference
+  /// with the point's: its value at s_max bounds it. With two clamps, the two bounds added.
+  double DisplacementChangeBound(const BeamLoad& now, const BeamLoad& then,
+                                 const Eigen::Vector3d& f_H, bool moments, double r_max_m,
+                                 double s_max_m, const Eigen::Matrix3d& normal_H,
+                                 const Eigen::Matrix3d& turn_H) const;
   /// Displacement of the centre at s_m [m] and rotation of its section [rad], frame H, under
   /// load j (force and the moment of its offset).
   Eigen::Vector3d CentreDisplacement(double s_m, const BeamLoad& j) const;

@@ -93,6 +93,12 @@ struct Core::State {
     Eigen::Vector3d r_H_m = Eigen::Vector3d::Zero();    // surface point - centre, frame H
     bool active = true, released = false, sliding = false, shifted = false;
     bool matched = false, ghost = false;
+    // The linear model's reference (step 5): where last tick's shape carried f_lin, i.e. the
+    // arc position, offset and clamp of the load this one continues, and this load's clamp in
+    // the shape step 8 draws.
+    bool continues = false;
+    double lin_s_m = 0.0, lin_clamp_m = 0.0, clamp_m = 0.0;
+    Eigen::Vector3d lin_r_H_m = Eigen::Vector3d::Zero();
     // An end face's centre of pressure: its offset from the face's centre (frame H), relaxed
     // from tick to tick (below).
     bool pressure_centre = false;
@@ -731,6 +737,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const Load& before = m.prev[std::size_t(best)];
       taken[std::size_t(best)] = true;
       ld.matched = true;
+      ld.continues = true;
+      ld.lin_s_m = before.s_m;
+      ld.lin_r_H_m = before.r_H_m;
+      ld.lin_clamp_m = before.clamp_m;
       if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.force_W;
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
@@ -780,6 +790,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     ghost.released = true;
     ghost.sliding = ghost.shifted = false;
     ghost.ghost = true;
+    ghost.continues = true;  // its force is taken out where last tick's shape had it
+    ghost.lin_s_m = before.s_m;
+    ghost.lin_r_H_m = before.r_H_m;
+    ghost.lin_clamp_m = before.clamp_m;
   }
   if (truncated) out.flags |= kContactsTruncated;
   // Truncated, the set kept depends on what came before it: take the tick with every part.
@@ -805,10 +819,26 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const Eigen::Matrix3d lateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
   std::array<bool, kMaxLoads> member{};
   bool use_elastica = false;
+  // The linear model's reference (build_compliance): load j's force f_lin as last tick's shape
+  // carried it, at the arc position, offset and cut of the load it continues (a ghost: its own).
+  // False if load j carries no f_lin.
+  const auto reference_of = [&](int j, BeamLoad& then_j) {
+    const Load& lj = m.loads[std::size_t(j)];
+    if (!lj.continues || lj.f_lin_W.isZero(0.0)) return false;
+    then_j = m.beam_loads[std::size_t(j)];
+    then_j.s_m = lj.lin_s_m;
+    then_j.r_H_m = lj.lin_r_H_m;
+    then_j.clamp_m = lj.lin_clamp_m;
+    return true;
+  };
   const auto build_compliance = [&] {
+    // The cantilever's members. The nonlinear models' tangents are taken about last tick's
+    // forces, so a load that carried force then is one (its force is taken out through its
+    // column). The linear model takes last tick's shape out whole (below): its members are the
+    // loads in contact, and the cuts are the ones step 8 draws the shape with.
     for (int i = 0; i < load_count; ++i) {
       const Load& ld = m.loads[std::size_t(i)];
-      member[std::size_t(i)] = ld.active || !ld.f_lin_W.isZero(0.0);
+      member[std::size_t(i)] = ld.active || (want_elastica && !ld.f_lin_W.isZero(0.0));
     }
     int members = 0;
     const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
@@ -975,7 +1005,28 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         if (!member[std::size_t(j)]) continue;
         Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
         Wij = R_WH * Wij * R_WH.transpose();
-        ld.base_W -= Wij * m.loads[std::size_t(j)].f_lin_W;
+        if (want_elastica) ld.base_W -= Wij * m.loads[std::size_t(j)].f_lin_W;
+      }
+    }
+    // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
+    // by where last tick's loads were. The tick's shape is x_straight + W F (step 8), so
+    //     x = x0 - sum_j W(s_i, s_j last tick) F_lin_j + sum_j W_ij F_j,
+    // the tick's system then the drawn shape's, exactly. The incremental form the nonlinear
+    // models use, x = x0 + W (F - F_lin), takes F_lin as already acting at this tick's arc
+    // positions, offsets and cuts. Where a load moves along the tube that is far off: the end of
+    // a side's region jumping 9.4 mm with 5 N on it moved the rubber tube's tip by 64 mm that the
+    // system did not see, and the tube pinched in a groove went into its walls and was held back
+    // (the stability sweep's squeeze under the linear model and the coupled rule: held in 441 of
+    // 610 ticks, now none). The nonlinear models' tangents are not their shapes' compliance:
+    // there the incremental form stays (the linear coefficients as an estimate of the moved
+    // loads' term left the elastica's sweep at 66 of 80, other cases failing; docs/core.md).
+    if (!want_elastica) {
+      for (int j = 0; j < load_count; ++j) {
+        BeamLoad then_j;
+        if (!reference_of(j, then_j)) continue;
+        for (int i = 0; i < load_count; ++i)
+          m.loads[std::size_t(i)].base_W -=
+              R_WH * (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N);
       }
     }
   };
@@ -1203,10 +1254,27 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const Eigen::Matrix3d P_H = R_WH.transpose() * P_W * R_WH;
       const Eigen::Matrix3d Q_H = R_WH.transpose() * Q_W * R_WH;
       double moved_m = (P_W * dp_W).norm() + (Q_W * omega_W).norm() * reach_m;
-      for (int j = 0; j < load_count; ++j)
+      // The linear model (build_compliance) takes last tick's shape out where its loads were:
+      // W(i, now) F - W(i, then) F_lin is W(i, now) (F - F_lin) plus, where the load moved,
+      // (W(i, now) - W(i, then)) F_lin; a load out of contact adds -W(i, then) F_lin.
+      BeamLoad then_j;
+      for (int j = 0; j < load_count; ++j) {
+        const BeamLoad& now_j = m.beam_loads[std::size_t(j)];
+        if (!want_elastica && !member[std::size_t(j)]) {
+          if (reference_of(j, then_j))
+            moved_m += m.beam.DisplacementBound(then_j, then_j.f_H_N, true, offset_m, group.s_max_m,
+                                                P_H, Q_H);
+          continue;
+        }
         if (!df_H[std::size_t(j)].isZero(0.0))
-          moved_m += m.beam.DisplacementBound(m.beam_loads[std::size_t(j)], df_H[std::size_t(j)],
-                                              !use_elastica, offset_m, group.s_max_m, P_H, Q_H);
+          moved_m += m.beam.DisplacementBound(now_j, df_H[std::size_t(j)], !use_elastica, offset_m,
+                                              group.s_max_m, P_H, Q_H);
+        if (!want_elastica && reference_of(j, then_j) &&
+            !(then_j.s_m == now_j.s_m && then_j.r_H_m == now_j.r_H_m &&
+              then_j.clamp_m == now_j.clamp_m))
+          moved_m += m.beam.DisplacementChangeBound(now_j, then_j, then_j.f_H_N, true, offset_m,
+                                                    group.s_max_m, P_H, Q_H);
+      }
       idle_moved_m[std::size_t(g)] = moved_m;
     }
   };
@@ -1268,6 +1336,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         ld.released = true;  // once released in a tick it stays open: no cycling
         changed = true;
         changed_load = i;
+        if (!want_elastica) {
+          build_compliance();  // the linear model's cuts are the loads in contact
+          build_stick_compliance();
+        }
         break;
       }
       if (!ld.friction) continue;
@@ -1496,6 +1568,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   all.fill(true);
   int members = 0;
   const int groups = m.beam.Assign(m.beam_loads, beam_count, all, m.order, members);
+  for (int i = 0, k = 0; i < load_count; ++i)
+    if (m.loads[std::size_t(i)].active)
+      m.loads[std::size_t(i)].clamp_m = m.beam_loads[std::size_t(k++)].clamp_m;
   double load_N = 0.0;
   for (int j = 0; j < beam_count; ++j) load_N += m.beam_loads[std::size_t(j)].f_H_N.norm();
   if (m.elastica_held_off && load_N < 0.5 * m.held_off_load_N) m.elastica_held_off = false;

@@ -176,3 +176,62 @@ TEST_CASE("DisplacementBound bounds the compliance of every point up to s_max, a
   // at s_max, with the offset along the axis, add up along the force).
   CHECK(tightest > 0.98);
 }
+
+TEST_CASE("DisplacementChangeBound bounds a force's moved compliance at every point up to s_max",
+          "[core][beam]") {
+  // The linear model takes last tick's force out where its load was and puts it in where the
+  // load that continues it is (core.cpp); an idle part stays out while this bound of the change
+  // (Compliance(i, now) - Compliance(i, then)) f stays below its gap. Moves of a few
+  // millimetres, the offset turned a little, the clamp the same or not (a cut that moved).
+  const scene::Scene s = RubberTube();
+  const core::BeamChain chain(s);
+  const double l = s.tube.length_m, r_max = 0.03;
+  std::mt19937_64 rng(20261126);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
+  const auto random_unit = [&] {
+    Eigen::Vector3d v(unit(rng), unit(rng), unit(rng));
+    return Eigen::Vector3d(v.norm() > 1e-3 ? v.normalized() : Eigen::Vector3d::UnitX());
+  };
+  double tightest = 0.0;
+  int same_clamp = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    core::BeamLoad then;
+    then.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);
+    then.s_m = then.clamp_m + (l - then.clamp_m) * fraction(rng);
+    then.r_H_m = 0.008 * random_unit();
+    core::BeamLoad now = then;
+    if (trial % 5 == 0) now.clamp_m = 0.5 * l * fraction(rng);
+    now.s_m = std::clamp(then.s_m + 0.01 * unit(rng), now.clamp_m + 1e-6, l);
+    now.r_H_m = (then.r_H_m + 0.002 * random_unit()).normalized() * 0.008;
+    same_clamp += now.clamp_m == then.clamp_m;
+    const Eigen::Vector3d f_H = 5.0 * unit(rng) * random_unit();
+    const bool moments = trial % 2 == 0;
+    const double s_max = l * fraction(rng);
+    const Eigen::Vector3d axis = random_unit();
+    const int dims = 1 + trial % 3;
+    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), aa = axis * axis.transpose();
+    const Eigen::Matrix3d P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
+    const Eigen::Matrix3d Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+    const double bound = chain.DisplacementChangeBound(now, then, f_H, moments, r_max, s_max, P, Q);
+    for (int k = 0; k < 8; ++k) {
+      core::BeamLoad i;
+      i.s_m = k < 3 ? s_max : s_max * fraction(rng);
+      i.r_H_m = k == 0   ? Eigen::Vector3d(0.0, 0.0, r_max)
+                : k == 1 ? Eigen::Vector3d(0.0, 0.0, -r_max)
+                         : fraction(rng) * r_max * random_unit();
+      const double moved =
+          (P * ((chain.Compliance(i, now, moments) - chain.Compliance(i, then, moments)) * f_H))
+              .norm();
+      INFO("trial " << trial << " dims " << dims << " k " << k);
+      // Rounding: the bound is a sum of a few products of the same magnitudes, the change a
+      // difference of two compliances of the size of the bound's terms (1e-12 of them).
+      const double scale = chain.DisplacementBound(now, f_H, moments, r_max, s_max, P, Q) +
+                           chain.DisplacementBound(then, f_H, moments, r_max, s_max, P, Q);
+      CHECK(moved <= bound * (1.0 + 1e-12) + 1e-12 * scale + 1e-18);
+      if (bound > 0.0 && now.clamp_m == then.clamp_m) tightest = std::max(tightest, moved / bound);
+    }
+  }
+  CHECK(same_clamp > 10000);
+  // Not loose where the clamp stays: some points reach it to within 5 %.
+  CHECK(tightest > 0.95);
+}
