@@ -144,6 +144,9 @@ struct Core::State {
   // The shape already had a centreline point more than r1 / 2 inside a part (a scene or a reset
   // that starts there): there is no state out of the part to hold the tube in, so none is held.
   bool axis_inside = false;
+  // The flags of the shape last sent (linear fallback, beyond the linear range, rod, shape off
+  // its contacts): a tick held back sends that shape again, with them.
+  std::uint32_t shape_flags = 0;
   // The elastica's tangent compliance per segment and the loads it was computed for, its age in
   // ticks; the last two computed (`tangents[tangent_current]` the one used last). Two, because
   // a tip in stick-slip at the tick rate alternates between two loadings (the stuck and the
@@ -431,6 +434,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.rod_shape = false;
   m.rod_tangent_members = 0;
   m.collision.ForgetDistances();
+  m.shape_flags = 0;
   m.axis_inside = m.collision.AxisDeeperThan(
       std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(capsule_count_) + 1),
       X_WH.linear(), X_WH.translation(), 0.5 * scene_.tube.outer_radius_m);
@@ -1728,18 +1732,22 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // between exact samples, whose error is far below that), which lets the check bound them by
   // every fourth. The linear model's nodes need not be: all are taken.
   const double spacing_m = (m.elastica_shape || m.rod_shape) ? 1.1 * l / N : 0.0;
-  const bool inside = m.hold_out_of_parts &&
-                      m.collision.AxisDeeperThan(
-                          std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1),
-                          R_WH_new, p_W, 0.5 * scene_.tube.outer_radius_m, spacing_m);
-  if (inside && !m.axis_inside && p_W.allFinite() && R_WH_new.allFinite()) {
+  // Judged whether or not the guard is on, so that a shape already inside when it is turned on
+  // (or restored from a snapshot of a core without it) is not held.
+  const bool inside = m.collision.AxisDeeperThan(
+      std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1), R_WH_new, p_W,
+      0.5 * scene_.tube.outer_radius_m, spacing_m);
+  if (m.hold_out_of_parts && inside && !m.axis_inside && p_W.allFinite() && R_WH_new.allFinite()) {
     m.RestoreShape(std::size_t(N) + 1, out);
     Eigen::Vector3d hold_W =
         -(coupling_stiffness_ * (p_hand_W - m.p_held_prev_W) + coupling_damping_ * v_hand_W);
-    out.flags = kHeldBack | (out.flags & (kPenetration | kContactsTruncated));
+    // The shape sent is last tick's, with its flags; the contact set's are this tick's.
+    out.flags = kHeldBack | m.shape_flags | (out.flags & (kPenetration | kContactsTruncated));
     if (hold_W.norm() > max_force) {
+      // The spring saturated at the device's force, the held end apart from the hand: as in a
+      // tick that moves (a driver counts such ticks as the tube stalled).
       hold_W *= max_force / hold_W.norm();
-      out.flags |= kForceClamped;
+      out.flags |= kForceClamped | kProxySeparated;
     }
     if (out.torque_W_Nm.norm() > scene_.device.max_torque_Nm) out.flags |= kForceClamped;
     out.force_W_N = hold_W;  // the torque and the held end's pose stay last tick's
@@ -1765,6 +1773,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   m.p_hand_prev_W = p_hand_W;
   m.p_held_prev_W = p_W;
   m.R_held_prev_W = R_WH_new;
+  m.shape_flags =
+      out.flags & (kLinearFallback | kBeyondLinearRange | kRodShape | kShapeOffContacts);
   // Ghosts have done their work; the next tick continues this tick's real loads.
   m.prev_count = 0;
   for (int i = 0; i < load_count; ++i)

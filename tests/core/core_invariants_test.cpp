@@ -397,7 +397,7 @@ TEST_CASE("The core holds the tube back instead of carrying it through a part", 
   std::array<Eigen::Vector3d, core::kMaxCapsules + 1> centre;
   const std::span<Eigen::Vector3d> points(centre.data(), std::size_t(on.capsule_count()) + 1);
   std::mt19937_64 rng(20261125);
-  int held_ticks = 0, trials_held = 0, trials_through_off = 0;
+  int held_ticks = 0, trials_held = 0, trials_through_off = 0, switched_inside = 0;
   double deepest_on = -1.0, deepest_off = -1.0;
   for (int trial = 0; trial < 20; ++trial) {
     const Eigen::Isometry3d X = RandomGroovePose(s, rng);
@@ -428,20 +428,41 @@ TEST_CASE("The core holds the tube back instead of carrying it through a part", 
         const Eigen::Vector3d h = Y.translation();
         Eigen::Vector3d pull = -(coupling.stiffness_N_per_m * (h - out.X_WH.translation()) +
                                  coupling.damping_Ns_per_m * (h - hand_before) / T);
-        if (pull.norm() > s.device.max_force_N) pull *= s.device.max_force_N / pull.norm();
+        const bool clamped = pull.norm() > s.device.max_force_N;
+        if (clamped) pull *= s.device.max_force_N / pull.norm();
         CHECK((out.force_W_N - pull).norm() <= 1e-12 * (1.0 + pull.norm()));
+        // The shape sent is last tick's, with its flags; a saturated spring is a separated
+        // proxy, as in a tick that moves (the judge counts those as the tube stalled).
+        constexpr std::uint32_t kShapeFlags = core::kLinearFallback | core::kBeyondLinearRange |
+                                              core::kRodShape | core::kShapeOffContacts;
+        CHECK((out.flags & kShapeFlags) == (before.flags & kShapeFlags));
+        CHECK(((out.flags & core::kProxySeparated) != 0) == clamped);
       }
       hand_before = Y.translation();
     }
     trials_held += held_in_trial ? 1 : 0;
     trials_through_off += deepest_off_trial > 0.5 * r1 ? 1 : 0;
     deepest_off = std::max(deepest_off, deepest_off_trial);
+    // The guard turned on with the tube already through: there is no state out of the part to
+    // keep, and it is not held (it was, every tick after, while the guard judged only when on).
+    off.Centreline(points);
+    if (DeepestInside(s, points) > 0.5 * r1 + 0.1e-3) {  // inside now (the guard's nodes: 0.1 mm)
+      ++switched_inside;
+      off.set_hold_out_of_parts(true);
+      int held_after = 0;
+      const Eigen::Isometry3d Y = RandomStatePath(s.X_WH_start, X, 300);
+      for (int k = 0; k < 20; ++k)
+        held_after += (off.Step(t += T, Y).flags & core::kHeldBack) ? 1 : 0;
+      CHECK(held_after < 20);
+      off.set_hold_out_of_parts(false);
+    }
   }
   INFO(held_ticks << " held ticks in " << trials_held << " of 20 trials; without the guard "
                   << trials_through_off << " trials went deeper than r1/2, deepest "
                   << deepest_off * 1e3 << " mm; with it " << deepest_on * 1e3 << " mm");
   CHECK(trials_held >= 3);
   CHECK(trials_through_off >= 3);
+  CHECK(switched_inside >= 1);
   CHECK(deepest_off > 0.5 * r1);
   CHECK(deepest_on <= 0.5 * r1 + 1e-4);
 }
