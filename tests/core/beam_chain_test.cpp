@@ -14,6 +14,31 @@ scene::Scene RubberTube() {
   s.tube = {0.008, 0.005, 0.150, 3e6, 0.5};
   return s;
 }
+
+// The bound tests' random draws: a unit vector; the span of an idle group's normals (one axis,
+// the plane across it, or every direction) and what a turn's cross product with such a normal
+// keeps; and a point i where the bound must hold: at s_max with the offset r_max along the tube's
+// axis (where the section's turn moves it along the bend, k = 0, 1), at s_max anywhere (k = 2) or
+// anywhere before s_max.
+Eigen::Vector3d RandomUnit(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  Eigen::Vector3d v(unit(rng), unit(rng), unit(rng));
+  return v.norm() > 1e-3 ? v.normalized() : Eigen::Vector3d::UnitX();
+}
+void GroupSpan(const Eigen::Vector3d& axis, int dims, Eigen::Matrix3d& P, Eigen::Matrix3d& Q) {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), aa = axis * axis.transpose();
+  P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
+  Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+}
+core::BeamLoad BoundPoint(int k, double s_max, double r_max, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  core::BeamLoad i;
+  i.s_m = k < 3 ? s_max : s_max * fraction(rng);
+  i.r_H_m = k == 0   ? Eigen::Vector3d(0.0, 0.0, r_max)
+            : k == 1 ? Eigen::Vector3d(0.0, 0.0, -r_max)
+                     : fraction(rng) * r_max * RandomUnit(rng);
+  return i;
+}
 }  // namespace
 
 TEST_CASE("Elastica nodes by Hermite interpolation stay within 2 um of the exact shape",
@@ -137,34 +162,22 @@ TEST_CASE("DisplacementBound bounds the compliance of every point up to s_max, a
   const double l = s.tube.length_m, r_max = 0.03;
   std::mt19937_64 rng(20261125);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
-  const auto random_unit = [&] {
-    Eigen::Vector3d v(unit(rng), unit(rng), unit(rng));
-    return Eigen::Vector3d(v.norm() > 1e-3 ? v.normalized() : Eigen::Vector3d::UnitX());
-  };
   double tightest = 0.0;  // the largest |n . W df| / bound seen
   for (int trial = 0; trial < 20000; ++trial) {
     core::BeamLoad j;
     j.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);  // a later segment's clamp
     j.s_m = j.clamp_m + (l - j.clamp_m) * fraction(rng);
-    j.r_H_m = 0.008 * random_unit();
-    const Eigen::Vector3d df_H = 0.1 * unit(rng) * random_unit();
+    j.r_H_m = 0.008 * RandomUnit(rng);
+    const Eigen::Vector3d df_H = 0.1 * unit(rng) * RandomUnit(rng);
     const bool moments = trial % 2 == 0;
     const double s_max = l * fraction(rng);
-    const Eigen::Vector3d axis = random_unit();
     const int dims = 1 + trial % 3;
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), aa = axis * axis.transpose();
-    const Eigen::Matrix3d P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
-    const Eigen::Matrix3d Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+    Eigen::Matrix3d P, Q;
+    GroupSpan(RandomUnit(rng), dims, P, Q);
     const double bound = chain.DisplacementBound(j, df_H, moments, r_max, s_max, P, Q);
-    // Points i: at s_max with the offset r_max along the axis (where the section's turn moves
-    // the point along the bend) or anywhere, and random points before s_max. The largest
-    // |n . v| over unit n in P's range is |P v|.
+    // The largest |n . v| over unit n in P's range is |P v|.
     for (int k = 0; k < 8; ++k) {
-      core::BeamLoad i;
-      i.s_m = k < 3 ? s_max : s_max * fraction(rng);
-      i.r_H_m = k == 0   ? Eigen::Vector3d(0.0, 0.0, r_max)
-                : k == 1 ? Eigen::Vector3d(0.0, 0.0, -r_max)
-                         : fraction(rng) * r_max * random_unit();
+      const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
       const double moved = (P * (chain.Compliance(i, j, moments) * df_H)).norm();
       INFO("trial " << trial << " dims " << dims << " k " << k);
       // Rounding: the bound is a sum of a few products of the same magnitudes.
@@ -188,37 +201,27 @@ TEST_CASE("DisplacementChangeBound bounds a force's moved compliance at every po
   const double l = s.tube.length_m, r_max = 0.03;
   std::mt19937_64 rng(20261126);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
-  const auto random_unit = [&] {
-    Eigen::Vector3d v(unit(rng), unit(rng), unit(rng));
-    return Eigen::Vector3d(v.norm() > 1e-3 ? v.normalized() : Eigen::Vector3d::UnitX());
-  };
   double tightest = 0.0;
   int same_clamp = 0;
   for (int trial = 0; trial < 20000; ++trial) {
     core::BeamLoad then;
     then.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);
     then.s_m = then.clamp_m + (l - then.clamp_m) * fraction(rng);
-    then.r_H_m = 0.008 * random_unit();
+    then.r_H_m = 0.008 * RandomUnit(rng);
     core::BeamLoad now = then;
     if (trial % 5 == 0) now.clamp_m = 0.5 * l * fraction(rng);
     now.s_m = std::clamp(then.s_m + 0.01 * unit(rng), now.clamp_m + 1e-6, l);
-    now.r_H_m = (then.r_H_m + 0.002 * random_unit()).normalized() * 0.008;
+    now.r_H_m = (then.r_H_m + 0.002 * RandomUnit(rng)).normalized() * 0.008;
     same_clamp += now.clamp_m == then.clamp_m;
-    const Eigen::Vector3d f_H = 5.0 * unit(rng) * random_unit();
+    const Eigen::Vector3d f_H = 5.0 * unit(rng) * RandomUnit(rng);
     const bool moments = trial % 2 == 0;
     const double s_max = l * fraction(rng);
-    const Eigen::Vector3d axis = random_unit();
     const int dims = 1 + trial % 3;
-    const Eigen::Matrix3d I = Eigen::Matrix3d::Identity(), aa = axis * axis.transpose();
-    const Eigen::Matrix3d P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
-    const Eigen::Matrix3d Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
+    Eigen::Matrix3d P, Q;
+    GroupSpan(RandomUnit(rng), dims, P, Q);
     const double bound = chain.DisplacementChangeBound(now, then, f_H, moments, r_max, s_max, P, Q);
     for (int k = 0; k < 8; ++k) {
-      core::BeamLoad i;
-      i.s_m = k < 3 ? s_max : s_max * fraction(rng);
-      i.r_H_m = k == 0   ? Eigen::Vector3d(0.0, 0.0, r_max)
-                : k == 1 ? Eigen::Vector3d(0.0, 0.0, -r_max)
-                         : fraction(rng) * r_max * random_unit();
+      const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
       const double moved =
           (P * ((chain.Compliance(i, now, moments) - chain.Compliance(i, then, moments)) * f_H))
               .norm();
