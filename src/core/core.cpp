@@ -1020,10 +1020,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // positions, offsets and cuts. Where a load moves along the tube that is far off: the end of
     // a side's region jumping 9.4 mm with 5 N on it moved the rubber tube's tip by 64 mm that the
     // system did not see, and the tube pinched in a groove went into its walls and was held back
-    // (the stability sweep's squeeze under the linear model and the coupled rule: held in 441 of
-    // 610 ticks, now none). The nonlinear models' tangents are not their shapes' compliance:
-    // there the incremental form stays (the linear coefficients as an estimate of the moved
-    // loads' term left the elastica's sweep at 66 of 80, other cases failing; docs/core.md).
+    // (the stability sweep's squeeze motion under the linear model and the coupled rule: held in
+    // 441 of its 480 ticks, now none). The nonlinear models' tangents are not their shapes'
+    // compliance: there the incremental form stays (the linear coefficients as an estimate of the
+    // moved loads' term left the elastica's sweep at 66 of 80, other cases failing; docs/core.md).
     if (!want_elastica) {
       for (int j = 0; j < load_count; ++j) {
         BeamLoad then_j;
