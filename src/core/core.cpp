@@ -1015,15 +1015,17 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
     // by where last tick's loads were. The tick's shape is x_straight + W F (step 8), so
     //     x = x0 - sum_j W(s_i, s_j last tick) F_lin_j + sum_j W_ij F_j,
-    // the tick's system then the drawn shape's, exactly. The incremental form the nonlinear
-    // models use, x = x0 + W (F - F_lin), takes F_lin as already acting at this tick's arc
-    // positions, offsets and cuts. Where a load moves along the tube that is far off: the end of
-    // a side's region jumping 9.4 mm with 5 N on it moved the rubber tube's tip by 64 mm that the
-    // system did not see, and the tube pinched in a groove went into its walls and was held back
-    // (the stability sweep's squeeze motion under the linear model and the coupled rule: held in
-    // 441 of its 480 ticks, now none). The nonlinear models' tangents are not their shapes'
-    // compliance: there the incremental form stays (the linear coefficients as an estimate of the
-    // moved loads' term left the elastica's sweep at 66 of 80, other cases failing; docs/core.md).
+    // the tick's system then the drawn shape's (exactly while the held end keeps its orientation:
+    // F_lin is taken out in this tick's frame H, the shape drew it in last tick's; docs/core.md).
+    // The incremental form the nonlinear models use, x = x0 + W (F - F_lin), takes F_lin as
+    // already acting at this tick's arc positions, offsets and cuts. Where a load moves along the
+    // tube that is far off: the end of a side's region jumping 9.4 mm with 5 N on it moved the
+    // rubber tube's tip by 64 mm that the system did not see, and the tube pinched in a groove went
+    // into its walls and was held back (the stability sweep's squeeze motion under the linear model
+    // and the coupled rule: held in 441 of its 480 ticks, now none). The nonlinear models' tangents
+    // are not their shapes' compliance: there the incremental form stays (the linear coefficients
+    // as an estimate of the moved loads' term left the elastica's sweep at 66 of 80, other cases
+    // failing; docs/core.md).
     if (!want_elastica) {
       for (int j = 0; j < load_count; ++j) {
         BeamLoad then_j;

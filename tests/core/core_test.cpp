@@ -538,10 +538,11 @@ TEST_CASE("The linear model's tick is its shape: a load moving along the tube mo
     CHECK(held == 0);
     // Along the normal, what a contact's distance is made of, the system's point is the shape's
     // (measured 2e-8 m coupled, 1.5e-5 m segmented; before 0.59 and 1.67 mm). The test takes the
-    // surface point at r1 against the normal; the section's turn theta moves the real one by
-    // r1 (1 - cos theta) along it, up to 15 um at the pinched tip's 0.06 rad, and by r1 sin theta
-    // along the axis: the 0.018 mm (coupled) and 0.49 mm (segmented, the tip turned more) of the
-    // whole distance, which is checked within the contact band.
+    // surface point at r1 against the wall's normal; where the tube's axis is inclined to the
+    // wall by theta its surface point nearest the wall lies r1 (1 - cos theta) from there along
+    // the normal, up to 15 um at the pinched tip's 0.06 rad, and r1 sin theta along the axis: the
+    // 0.018 mm (coupled) and 0.49 mm (segmented, the tip inclined more) of the whole distance,
+    // which is checked within the contact band.
     CHECK(worst_n_m <= 0.05 * s.contact.threshold_m);
     CHECK(worst_m <= s.contact.threshold_m);
   }
