@@ -835,6 +835,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     then_j.clamp_m = lj.lin_clamp_m;
     return true;
   };
+  // Whether load j sits elsewhere than its reference: another arc position, offset or cut.
+  const auto moved = [&](int j, const BeamLoad& then_j) {
+    const BeamLoad& now_j = m.beam_loads[std::size_t(j)];
+    return !(then_j.s_m == now_j.s_m && then_j.r_H_m == now_j.r_H_m &&
+             then_j.clamp_m == now_j.clamp_m);
+  };
   const auto build_compliance = [&] {
     // The cantilever's members. The nonlinear models' tangents are taken about last tick's
     // forces, so a load that carried force then is one (its force is taken out through its
@@ -1030,9 +1036,15 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       for (int j = 0; j < load_count; ++j) {
         BeamLoad then_j;
         if (!reference_of(j, then_j)) continue;
+        // A member whose load has not moved: its column, just computed, is W(s_i, s_j then).
+        const bool same = member[std::size_t(j)] && !moved(j, then_j);
         for (int i = 0; i < load_count; ++i)
           m.loads[std::size_t(i)].base_W -=
-              R_WH * (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N);
+              same ? Eigen::Vector3d(m.W[std::size_t(i)][std::size_t(j)] *
+                                     m.loads[std::size_t(j)].f_lin_W)
+                   : Eigen::Vector3d(
+                         R_WH *
+                         (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N));
       }
     }
   };
@@ -1275,9 +1287,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         if (!df_H[std::size_t(j)].isZero(0.0))
           moved_m += m.beam.DisplacementBound(now_j, df_H[std::size_t(j)], !use_elastica, offset_m,
                                               group.s_max_m, P_H, Q_H);
-        if (!want_elastica && reference_of(j, then_j) &&
-            !(then_j.s_m == now_j.s_m && then_j.r_H_m == now_j.r_H_m &&
-              then_j.clamp_m == now_j.clamp_m))
+        if (!want_elastica && reference_of(j, then_j) && moved(j, then_j))
           moved_m += m.beam.DisplacementChangeBound(now_j, then_j, then_j.f_H_N, true, offset_m,
                                                     group.s_max_m, P_H, Q_H);
       }
