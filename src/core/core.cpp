@@ -29,11 +29,15 @@ constexpr int kMaxPasses = 3 * kMaxLoads + 4;
 constexpr int kTangentReuseTicks = 50;
 
 // f_k(N) = a + b N, tangent to mu_k N0 (N/N0)^beta at N (exact for beta = 1). At N = 0 with
-// beta < 1 the slope is infinite: the chord to N = 1e-9 N0 stands in for it.
-void LineariseKinetic(const scene::Friction& friction, double normal_N, double& a, double& b) {
+// beta < 1 the slope is infinite: the chord to N = 1e-9 N0 stands in for it. A load point of a
+// PC of several holds the share f_k(N_pc) N / N_pc (FrictionShare): its slope in its own N, the
+// PC's other points held, is (f_k / N) (1 + (beta - 1) N / N_pc).
+void LineariseKinetic(const scene::Friction& friction, double normal_N, double pc_normal_N,
+                      double& a, double& b) {
   const double N = std::max(normal_N, 1e-9 * friction.reference_load_N);
-  const double fk = FrictionLimit(friction, friction.kinetic_coefficient, N);
-  b = friction.exponent * fk / N;
+  const double fk = FrictionShare(friction, friction.kinetic_coefficient, N, pc_normal_N);
+  b = pc_normal_N > N ? fk / N * (1.0 + (friction.exponent - 1.0) * (N / pc_normal_N))
+                      : friction.exponent * fk / N;
   a = fk - b * N;
 }
 
@@ -1313,6 +1317,19 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
     return true;
   };
+  // The normal force of load i's PC in the current solve: its points' together (a point that
+  // pulls counts nothing; a ghost is a PC of its own). Friction is the PC's (FrictionShare).
+  const auto pc_normal_of = [&](int i) {
+    const Load& li = m.loads[std::size_t(i)];
+    double total_N = 0.0;
+    for (int j = 0; j < load_count; ++j) {
+      const Load& lj = m.loads[std::size_t(j)];
+      const int sj = slot[std::size_t(j)];
+      if (sj < 0 || (j != i && (li.pc < 0 || lj.pc != li.pc))) continue;
+      total_N += std::max(0.0, lj.normal_W.dot(m.z.segment<3>(3 * sj)));
+    }
+    return total_N;
+  };
   bool finite = true;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     finite = solve_system();
@@ -1360,8 +1377,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       }
       if (!ld.friction) continue;
       const Eigen::Vector3d Ft = F - normal_N * ld.normal_W;
+      const double pc_normal_N = pc_normal_of(i);
       if (!ld.sliding) {
-        const FrictionResult fr = ReturnMap(*ld.friction, Ft, normal_N, Kt);
+        const FrictionResult fr = ReturnMap(*ld.friction, Ft, normal_N, pc_normal_N, Kt);
         if (!fr.sliding) continue;
         if (scene_.model.slip == scene::SlipRule::kPaper && !ld.shifted) {
           // The paper: the contact point moves with the held end's tangential motion, then the
@@ -1372,15 +1390,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         } else {
           ld.sliding = true;
           ld.slide_dir_W = Ft / Ft.norm();  // |Ft| > f_s >= 0
-          LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
+          LineariseKinetic(*ld.friction, normal_N, pc_normal_N, ld.slide_a, ld.slide_b);
         }
         changed = true;
         changed_load = i;
       } else {
         // Newton on the kinetic law: relinearise f_k where the normal force now is.
-        const double fk = FrictionLimit(*ld.friction, ld.friction->kinetic_coefficient, normal_N);
+        const double fk =
+            FrictionShare(*ld.friction, ld.friction->kinetic_coefficient, normal_N, pc_normal_N);
         if (std::abs(fk - (ld.slide_a + ld.slide_b * normal_N)) > 1e-9 * (1.0 + fk)) {
-          LineariseKinetic(*ld.friction, normal_N, ld.slide_a, ld.slide_b);
+          LineariseKinetic(*ld.friction, normal_N, pc_normal_N, ld.slide_a, ld.slide_b);
           changed = true;
           changed_load = i;
         }
@@ -1483,7 +1502,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     if (ld.friction && si >= 0) {
       const double normal_N = std::max(0.0, ld.normal_W.dot(F));
       const Eigen::Vector3d Ft = F - ld.normal_W.dot(F) * ld.normal_W;
-      const double limit_N = FrictionLimit(*ld.friction, ld.friction->static_coefficient, normal_N);
+      const double limit_N =
+          FrictionShare(*ld.friction, ld.friction->static_coefficient, normal_N, pc_normal_of(i));
       if (Ft.norm() > limit_N) F -= Ft * (1.0 - limit_N / Ft.norm());
     }
     total_W += F;
@@ -1535,6 +1555,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     pc.part_element = found[std::size_t(k)].part_element;
     pc.distance_m = std::numeric_limits<double>::infinity();
     const scene::Friction* friction = nullptr;
+    double pc_normal_N = 0.0;  // the share each point's friction ratio is taken against
+    for (int i = 0; i < load_count; ++i) {
+      const Load& ld = m.loads[std::size_t(i)];
+      if (ld.pc == k && ld.active) pc_normal_N += std::max(0.0, ld.normal_W.dot(ld.force_W));
+    }
     for (int i = 0; i < load_count; ++i) {
       const Load& ld = m.loads[std::size_t(i)];
       if (ld.pc != k || !ld.active) continue;
@@ -1548,7 +1573,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       pc.moment_W_Nm += (ld.x_W - p_W).cross(ld.force_W);
       pc.sliding = pc.sliding || ld.sliding;
       if (ld.friction) {
-        const double limit = FrictionLimit(*ld.friction, ld.friction->static_coefficient, normal_N);
+        const double limit =
+            FrictionShare(*ld.friction, ld.friction->static_coefficient, normal_N, pc_normal_N);
         const double ratio = limit > 0.0 ? Ft.norm() / limit : (Ft.norm() > 0.0 ? 1.0 : 0.0);
         pc.friction_ratio = std::max(pc.friction_ratio, ratio);
       }

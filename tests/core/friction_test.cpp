@@ -10,6 +10,7 @@
 namespace {
 
 using tubeplan::core::FrictionLimit;
+using tubeplan::core::FrictionShare;
 using tubeplan::core::ReturnMap;
 using tubeplan::scene::Friction;
 
@@ -43,6 +44,36 @@ TEST_CASE("Friction limit at and near zero load is zero and finite", "[friction]
   CHECK(FrictionLimit(kRubber, 0.7, 1e-30) == Approx(0.7 * 1e-20).epsilon(1e-13));
 }
 
+TEST_CASE("A PC's points share its limit: the shares add up to f_max at its normal force",
+          "[friction]") {
+  std::mt19937_64 rng(20261125);
+  std::uniform_real_distribution<double> load(0.0, 10.0);
+  for (int trial = 0; trial < 1000; ++trial) {
+    // Two or three points pressed with random normal forces (N0 = 1 N).
+    const int n = 2 + trial % 2;
+    double N[3] = {load(rng), load(rng), n == 3 ? load(rng) : 0.0};
+    const double total = N[0] + N[1] + N[2];
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) sum += FrictionShare(kRubber, 0.7, N[i], total);
+    // Summing n shares rounds at most a few ulps.
+    CHECK(sum == Approx(FrictionLimit(kRubber, 0.7, total)).epsilon(1e-14));
+    // Each point holds less than a limit of its own would give it (f_max is concave for beta < 1)
+    // and the points together less than those would: by up to n^(1 - beta) for equal loads.
+    for (int i = 0; i < n; ++i)
+      CHECK(FrictionShare(kRubber, 0.7, N[i], total) <= FrictionLimit(kRubber, 0.7, N[i]));
+  }
+  // Two points of 2 N: limits of their own would hold 2^(1/3) times the PC's 4 N.
+  const double own = FrictionLimit(kRubber, 0.7, 2.0);
+  CHECK(2.0 * own ==
+        Approx(std::cbrt(2.0) * 2.0 * FrictionShare(kRubber, 0.7, 2.0, 4.0)).epsilon(1e-15));
+  // A PC of one point, and Coulomb's law, are the limit itself, bit for bit.
+  CHECK(FrictionShare(kRubber, 0.7, 2.5, 2.5) == FrictionLimit(kRubber, 0.7, 2.5));
+  CHECK(FrictionShare(kCoulomb, 0.3, 2.5, 7.0) == FrictionLimit(kCoulomb, 0.3, 2.5));
+  // A point that does not press holds nothing; a PC that does not press neither.
+  CHECK(FrictionShare(kRubber, 0.7, 0.0, 3.0) == 0.0);
+  CHECK(FrictionShare(kRubber, 0.7, 0.0, 0.0) == 0.0);
+}
+
 TEST_CASE("A tip stuck on a wall: k Delta until f_max, then the kinetic force", "[friction]") {
   // The issue's analytic case in the friction law's terms: the hand moves sideways by Delta, the
   // stuck tip's spring k = 3 E I / l^3 stretches, the trial force is k Delta. Below mu_s N it
@@ -53,7 +84,7 @@ TEST_CASE("A tip stuck on a wall: k Delta until f_max, then the kinetic force", 
   for (double delta_m = 0.0; delta_m < 0.3; delta_m += 0.005) {
     CAPTURE(delta_m);
     const Eigen::Vector3d trial(k * delta_m, 0.0, 0.0);
-    const auto r = ReturnMap(kRubber, trial, normal_N, k);
+    const auto r = ReturnMap(kRubber, trial, normal_N, normal_N, k);
     if (k * delta_m <= f_static) {
       CHECK_FALSE(r.sliding);
       CHECK(r.force_N == trial);
@@ -75,7 +106,7 @@ TEST_CASE("Return mapping: friction never exceeds f_max and opposes nothing it s
     for (int i = 0; i < 10000; ++i) {
       const Eigen::Vector3d trial(u(rng), u(rng), 0.0);
       const double normal_N = load(rng);
-      const auto r = ReturnMap(friction, trial, normal_N, 100.0);
+      const auto r = ReturnMap(friction, trial, normal_N, normal_N, 100.0);
       const double f_max = FrictionLimit(friction, friction.static_coefficient, normal_N);
       CHECK(r.force_N.norm() <= f_max * (1 + 1e-15));
       CHECK(r.force_N.allFinite());
@@ -89,12 +120,12 @@ TEST_CASE("Return mapping: friction never exceeds f_max and opposes nothing it s
 
 TEST_CASE("A frictionless contact carries no friction and slips freely", "[friction]") {
   const Friction none{};
-  const auto r = ReturnMap(none, Eigen::Vector3d(0.3, -0.4, 0.0), 2.0, 10.0);
+  const auto r = ReturnMap(none, Eigen::Vector3d(0.3, -0.4, 0.0), 2.0, 2.0, 10.0);
   CHECK(r.force_N.isZero(0.0));
   CHECK(r.sliding);
   CHECK(r.slip_m.isApprox(Eigen::Vector3d(0.03, -0.04, 0.0), 1e-15));
   // Zero trial force with zero load: stuck, nothing moves, no NaN from a 0/0 direction.
-  const auto zero = ReturnMap(kRubber, Eigen::Vector3d::Zero(), 0.0, 10.0);
+  const auto zero = ReturnMap(kRubber, Eigen::Vector3d::Zero(), 0.0, 0.0, 10.0);
   CHECK_FALSE(zero.sliding);
   CHECK(zero.force_N.isZero(0.0));
 }

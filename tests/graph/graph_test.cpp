@@ -454,6 +454,9 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
   const int dwell = 20;
   std::set<std::string> seen_nodes;
   std::set<std::pair<std::string, std::string>> seen_arcs;
+  // How often the motions took each transition, and how many ticks they spent in each CF.
+  std::map<std::pair<std::string, std::string>, int> arc_taken;
+  std::map<std::string, long> cf_ticks;
   for (const graph::Motion& m : motions) {
     core.Reset(s.X_WH_start);
     graph::MotionRunner runner(m, s.X_WH_start, s.model.time_step_s);
@@ -465,12 +468,14 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
       if (core.Step(k * s.model.time_step_s, runner.Next(core.last())).flags & core::kHeldBack)
         break;
       const std::string cf = core.FormationText();
+      ++cf_ticks[cf];
       held = cf == current ? held + 1 : 1;
       current = cf;
       if (k == 1) counted = cf, seen_nodes.insert(cf);
       if (held == dwell && cf != counted) {
         seen_nodes.insert(cf);
         seen_arcs.insert({counted, cf});
+        ++arc_taken[{counted, cf}];
         counted = cf;
       }
     }
@@ -479,44 +484,61 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
                                            [&](const auto& n) { return nodes.contains(n); });
   // A two-PC change the graph records through a brief state in between (A -> C -> B, docs/
   // graph.md) is covered by those two arcs.
-  const auto covered_arcs = std::count_if(seen_arcs.begin(), seen_arcs.end(), [&](const auto& a) {
+  const auto covered = [&](const std::pair<std::string, std::string>& a) {
     if (arcs.contains(a)) return true;
     return std::any_of(nodes.begin(), nodes.end(), [&](const std::string& c) {
       return arcs.contains({a.first, c}) && arcs.contains({c, a.second});
     });
-  });
+  };
+  const auto covered_arcs = std::count_if(seen_arcs.begin(), seen_arcs.end(), covered);
   for (const std::string& n : seen_nodes)
     if (!nodes.contains(n)) UNSCOPED_INFO("CF not in the graph: " << n);
-  for (const auto& a : seen_arcs) {
-    if (arcs.contains(a)) continue;
-    const bool via = std::any_of(nodes.begin(), nodes.end(), [&](const std::string& c) {
-      return arcs.contains({a.first, c}) && arcs.contains({c, a.second});
-    });
-    if (!via)
+  for (const auto& a : seen_arcs)
+    if (!covered(a))
       UNSCOPED_INFO("transition not in the graph: "
                     << a.first << " -> " << a.second << " ("
                     << graph::PcChanges(Cf(a.first.c_str()), Cf(a.second.c_str()))
-                    << " PC changes)");
+                    << " PC changes), taken " << arc_taken[a] << " times");
+  // The same, weighted by use: the ticks spent in CFs the graph has, the transitions taken that
+  // it has (a transition taken 5 times counts 5 times).
+  long ticks_all = 0, ticks_in = 0, taken_all = 0, taken_in = 0;
+  for (const auto& [cf, ticks] : cf_ticks) {
+    ticks_all += ticks;
+    if (nodes.contains(cf)) ticks_in += ticks;
+  }
+  for (const auto& [a, taken] : arc_taken) {
+    taken_all += taken;
+    if (covered(a)) taken_in += taken;
   }
   const double node_coverage = double(covered_nodes) / double(seen_nodes.size());
   const double arc_coverage = double(covered_arcs) / double(seen_arcs.size());
+  const double tick_coverage = double(ticks_in) / double(ticks_all);
+  const double taken_coverage = double(taken_in) / double(taken_all);
   WARN("coverage of 30 independent random motions: CFs "
        << covered_nodes << "/" << seen_nodes.size() << " (" << 100.0 * node_coverage
        << " %), transitions " << covered_arcs << "/" << seen_arcs.size() << " ("
-       << 100.0 * arc_coverage << " %)");
+       << 100.0 * arc_coverage << " %); by use: ticks " << 100.0 * tick_coverage
+       << " %, transitions taken " << taken_in << "/" << taken_all << " (" << 100.0 * taken_coverage
+       << " %)");
   // The exploration saturates (every CF it found was probed, docs/graph.md). With the core of
   // the linear fallback and the world-held stick every CF these motions went through was in the
   // graph (53/53) and 140 of 143 transitions. With the rod and the stick carried with the
   // contact (docs/core.md) they reach more states (63-65), and the graph misses 4-5 of them and
   // 13 of ~170 transitions (measured 92-94 % and 92 %): rare states of a side on the groove's top
   // edges, its marker flipping (Fs n/u left.top_inner), and wedges against floor and wall, which
-  // the probes from one stay per node do not reach. Issue 4 stays open for them. The floor, 90 %,
-  // keeps a margin of about three CFs and four transitions, so that exploration that misses
-  // common states fails here. Since motions end where the core holds the tube back from going
-  // through a part (stop 30), fewer states are reached (47/48 and 90/98 measured): the margin is
-  // four CFs and one transition.
+  // the probes from one stay per node do not reach. Since motions end where the core holds the
+  // tube back from going through a part (stop 30), fewer states are reached (47/48 and 90/98
+  // measured). Since a line contact's two points share their PC's friction limit (stop 32) the
+  // exploration from seed 1 no longer finds the side alone on a top inner edge with the edge on
+  // its concave side (Fs u left/right.top_inner: the axial friction's moment at the surface
+  // bends the tube that way; these motions spend 1.4 % of their ticks outside the graph's CFs);
+  // seeds 2 and 3 find them, seed 4 does not, nor does seed 4 with 200 random motions. Measured:
+  // 45/47 CFs, 80/92 transitions; 11 of the 12 missing ones taken once, 7 of them into or out
+  // of those two states. The floors keep a margin of two CFs and two transitions, and let the
+  // ticks outside the graph grow by 40 %: exploration that misses common states fails here.
   CHECK(node_coverage >= 0.90);
-  CHECK(arc_coverage >= 0.90);
+  CHECK(arc_coverage >= 0.84);
+  CHECK(tick_coverage >= 0.98);
 }
 
 }  // namespace

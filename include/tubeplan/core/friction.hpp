@@ -15,6 +15,16 @@ namespace tubeplan::core {
 /// case is needed beyond N <= 0, and denormal loads give denormal limits, never NaN.
 double FrictionLimit(const scene::Friction& friction, double coefficient, double normal_N);
 
+/// The limit is the PC's (physics.md: friction per PC): a PC carried by several load points (a
+/// line contact's two ends) holds f_max at their total normal force pc_normal_N, and a load point
+/// pressed with normal_N holds the share normal_N / pc_normal_N of it. The shares add up to the
+/// PC's limit, so the PC's friction, the sum of its points', stays within it; a limit taken per
+/// point would not for beta < 1, where f_max is concave and two points at their own limits hold
+/// up to 2^(1 - beta) times the PC's. Exactly FrictionLimit(normal_N) for a PC of one point
+/// (pc_normal_N <= normal_N) and for beta = 1.
+double FrictionShare(const scene::Friction& friction, double coefficient, double normal_N,
+                     double pc_normal_N);
+
 struct FrictionResult {
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();  ///< friction force on the tube [N]
   /// How far the stuck point must move along the contact plane so that the spring that produced
@@ -23,15 +33,16 @@ struct FrictionResult {
   bool sliding = false;
 };
 
-/// Stick first, then slide (return mapping). `trial_force_N` is the tangential force the contact
-/// would carry if the contact point stayed stuck, produced by a tangential spring of stiffness
-/// `tangential_stiffness_N_per_m` (> 0) stretched by trial_force / stiffness. If
-/// |trial| <= f_max(mu_s) the point sticks and the friction is the trial force. Otherwise it
-/// slides: the friction is the kinetic limit f_max(mu_k) along the trial force, and the point
-/// slips by (|trial| - f_k) / stiffness along it, after which the spring carries exactly f_k.
-/// Either way |force| <= f_max(mu_s). A frictionless contact returns zero force and full slip
-/// without evaluating the law (no friction work without friction).
+/// Stick first, then slide (return mapping), for a load point pressed with normal_N [N] of its
+/// PC's pc_normal_N (its limits are FrictionShare's). `trial_force_N` is the tangential force the
+/// contact would carry if the contact point stayed stuck, produced by a tangential spring of
+/// stiffness `tangential_stiffness_N_per_m` (> 0) stretched by trial_force / stiffness. If |trial|
+/// <= f_max(mu_s) the point sticks and the friction is the trial force. Otherwise it slides: the
+/// friction is the kinetic limit f_max(mu_k) along the trial force, and the point slips by (|trial|
+/// - f_k) / stiffness along it, after which the spring carries exactly f_k. Either way |force| <=
+/// the static share. A frictionless contact returns zero force and full slip without evaluating the
+/// law (no friction work without friction).
 FrictionResult ReturnMap(const scene::Friction& friction, const Eigen::Vector3d& trial_force_N,
-                         double normal_N, double tangential_stiffness_N_per_m);
+                         double normal_N, double pc_normal_N, double tangential_stiffness_N_per_m);
 
 }  // namespace tubeplan::core
