@@ -85,8 +85,9 @@ struct Core::State {
     Eigen::Vector3d centre0_W = Eigen::Vector3d::Zero();
     Eigen::Vector3d tangent0_W = Eigen::Vector3d::UnitZ();
     bool turn_seen = true;
-    Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  // stuck: held here tangentially
-    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();   // last tick's force (linearisation)
+    Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();   // stuck: held here tangentially
+    Eigen::Vector3d anchor0_W = Eigen::Vector3d::Zero();  // the anchor before the tick's solve
+    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();    // last tick's force (linearisation)
     // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
     // exact for beta = 1, where a = 0 and b = mu_k).
     Eigen::Vector3d slide_dir_W = Eigen::Vector3d::Zero();
@@ -1330,6 +1331,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
     return total_N;
   };
+  // Where the anchors were before the solve: a sliding point's slip is its anchor's travel.
+  for (int i = 0; i < load_count; ++i) {
+    Load& ld = m.loads[std::size_t(i)];
+    if (ld.friction) ld.anchor0_W = ld.anchor_W;
+  }
   bool finite = true;
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     finite = solve_system();
@@ -1572,6 +1578,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       pc.force_W_N += ld.force_W;
       pc.moment_W_Nm += (ld.x_W - p_W).cross(ld.force_W);
       pc.sliding = pc.sliding || ld.sliding;
+      // The kinetic force on the tube opposes the point's slip, along which the anchor follows.
+      if (ld.sliding) pc.friction_work_J += std::max(0.0, -Ft.dot(ld.anchor_W - ld.anchor0_W));
       if (ld.friction) {
         const double limit =
             FrictionShare(*ld.friction, ld.friction->static_coefficient, normal_N, pc_normal_N);
@@ -1779,8 +1787,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     m.RestoreShape(std::size_t(N) + 1, out);
     Eigen::Vector3d hold_W =
         -(coupling_stiffness_ * (p_hand_W - m.p_held_prev_W) + coupling_damping_ * v_hand_W);
-    // The shape sent is last tick's, with its flags; the contact set's are this tick's.
+    // The shape sent is last tick's, with its flags; the contact set's are this tick's. Nothing
+    // slipped: the next tick continues last tick's loads and their anchors.
     out.flags = kHeldBack | m.shape_flags | (out.flags & (kPenetration | kContactsTruncated));
+    for (int k = 0; k < out.contact_count; ++k) out.contacts[std::size_t(k)].friction_work_J = 0.0;
     if (hold_W.norm() > max_force) {
       // The spring saturated at the device's force, the held end apart from the hand: as in a
       // tick that moves (a driver counts such ticks as the tube stalled).

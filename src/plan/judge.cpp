@@ -82,14 +82,9 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
       if (-c.distance_m > limits_.max_penetration_m && v.reason.empty())
         Fail(at_, Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3,
                          t_s));
-      if (!c.sliding) continue;
-      for (const core::ContactState& before : last_.Contacts()) {
-        if (before.tube == c.tube && before.part_element == c.part_element)
-          v.friction_work_J += c.friction_W_N.norm() * (c.p_WC_m - before.p_WC_m).norm();
-      }
+      v.friction_work_J += c.friction_work_J;
     }
   }
-  last_ = out;
   stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
 
   // Debounce: a state counts once held `dwell` ticks.

@@ -105,6 +105,11 @@ struct ContactState {
   /// with mu_k = mu_s) and f_max of the total normal force.
   double friction_ratio = 0.0;
   double friction_limit_N = 0.0;
+  /// Work its friction dissipated this tick [J], >= 0: over its sliding load points, the kinetic
+  /// force times the slip of the stuck spring's anchor over the part (a stuck point dissipates
+  /// nothing: its spring holds the energy). Not the motion of p_WC_m, which jumps when the
+  /// deepest of a line contact's two points changes.
+  double friction_work_J = 0.0;
   bool sliding = false;  ///< any of its load points slides
 };
 

@@ -91,7 +91,6 @@ class Judging {
   int raw_held_ = 0;
   double raw_since_ = 0.0, raw_energy_ = 0.0, t_first_ = 0.0, t_last_ = 0.0;
   std::vector<std::string> passed_;
-  core::StepOutput last_{};
   long stuck_ticks_ = 0;
 };
 
