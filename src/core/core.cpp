@@ -1370,6 +1370,25 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       }
       const Eigen::Vector3d F = m.z.segment<3>(3 * si);
       const double normal_N = ld.normal_W.dot(F);
+      if (normal_N < 0.0 && ld.friction && !ld.sliding &&
+          scene_.model.slip == scene::SlipRule::kReturnMapping) {
+        // A stuck load that pulls slides first, and is released only if it still pulls then.
+        // Its stuck spring may be what pulls it off: a tick starts stuck, and a trial friction far
+        // beyond the limit (which is zero at N <= 0) drags the point away from the part. Released
+        // for the rest of the tick, the tube then springs back through the part: the rim of a
+        // tube drawn over an edge with mu = 2, bent 4 mm onto it, came off its corner this way
+        // and straightened 2.4 mm into the part's far face (`stability --only "roll over an edge
+        // mu=2"`); sliding, the contact kept pressing.
+        const Eigen::Vector3d Ft = F - normal_N * ld.normal_W;
+        if (Ft.norm() > 0.0) {
+          ld.sliding = true;
+          ld.slide_dir_W = Ft / Ft.norm();
+          LineariseKinetic(*ld.friction, 0.0, 0.0, ld.slide_a, ld.slide_b);
+          changed = true;
+          changed_load = i;
+          continue;
+        }
+      }
       if (normal_N < 0.0) {
         ld.active = false;
         ld.released = true;  // once released in a tick it stays open: no cycling

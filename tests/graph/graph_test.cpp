@@ -531,14 +531,16 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
   // measured). Since a line contact's two points share their PC's friction limit (stop 32) the
   // exploration from seed 1 no longer finds the side alone on a top inner edge with the edge on
   // its concave side (Fs u left/right.top_inner: the axial friction's moment at the surface
-  // bends the tube that way; these motions spend 1.4 % of their ticks outside the graph's CFs);
-  // seeds 2 and 3 find them, seed 4 does not, nor does seed 4 with 200 random motions. Measured:
-  // 45/47 CFs, 80/92 transitions; 11 of the 12 missing ones taken once, 7 of them into or out
-  // of those two states. The floors keep a margin of two CFs and two transitions, and let the
-  // ticks outside the graph grow by 40 %: exploration that misses common states fails here.
+  // bends the tube that way); seeds 2 and 3 find them, seed 4 does not, nor does seed 4 with
+  // 200 random motions. Measured then: 45/47 CFs, 80/92 transitions, 1.4 % of the motions' ticks
+  // outside the graph's CFs. Since a stuck load that pulls slides before it is released (stop
+  // 32): 48/51 CFs (those two, and the side on the floor and the right wall's outer face),
+  // 88/99 transitions, 1.7 % of the ticks outside. The floors keep a margin of two CFs and three
+  // transitions, and let the ticks outside the graph grow by half: exploration that misses
+  // common states fails here.
   CHECK(node_coverage >= 0.90);
-  CHECK(arc_coverage >= 0.84);
-  CHECK(tick_coverage >= 0.98);
+  CHECK(arc_coverage >= 0.85);
+  CHECK(tick_coverage >= 0.975);
 }
 
 }  // namespace
