@@ -133,9 +133,9 @@ TEST_CASE(
     "Stability: squeeze between walls (core defect: the paper's segmented rule is not passive)",
     "[stability][!mayfail]") {
   // Core defect: pinched between both walls (0.5 mm clearance, 5 N of penalty a side from the
-  // first tick) and swung, the energy held exceeds the hand's work from tick 116: the segmented
-  // rule's one-way compliance (docs/accuracy.md). From tick 135 the core holds the tube back
-  // from going through a wall (it went 6.4 mm in before), in most of the remaining ticks.
+  // first tick) and swung, the energy held exceeds the hand's work from tick 117: the segmented
+  // rule's one-way compliance (docs/accuracy.md). From tick 152 the core holds the tube back
+  // from going through a wall (it went 6.4 mm in before), in 459 of the 610 ticks.
   const study::StabilityResult r = RunNamed("squeeze between walls base");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.peak_force_N <= 8.5 * (1 + 1e-6));
