@@ -77,7 +77,7 @@ SeriesWriter::SeriesWriter(SeriesFormat format, bool mesh) : format_(format), me
   for (int k = 1; k <= core::kMaxContacts; ++k) {
     const std::string p = "pc" + std::to_string(k);
     text_ += "," + p + "," + p + "_s," + p + "_depth," + p + "_normal," + p + "_friction," + p +
-             "_limit," + p + "_state";
+             "_limit," + p + "_state," + p + "_work";
   }
   if (mesh_)
     for (int k = 0; k < kMeshPoints; ++k) {
@@ -112,7 +112,7 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
     s += ',' + FlagsText(out.flags) + ',' + std::to_string(out.contact_count);
     for (int k = 0; k < core::kMaxContacts; ++k) {
       if (k >= out.contact_count) {
-        s += ",,,,,,,";
+        s += ",,,,,,,,";
         continue;
       }
       const core::ContactState& pc = out.contacts[std::size_t(k)];
@@ -122,7 +122,8 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
         s += ',';
         AppendNumber(s, v);
       }
-      s += pc.sliding ? ",sliding" : ",stuck";
+      s += pc.sliding ? ",sliding," : ",stuck,";
+      AppendNumber(s, pc.friction_work_J);
     }
     if (mesh_)
       for (const Eigen::Vector3d& p : centreline)
@@ -161,6 +162,7 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
                    {"friction", pc.friction_W_N.norm()},
                    {"limit", pc.friction_limit_N},
                    {"state", pc.sliding ? "sliding" : "stuck"},
+                   {"work", pc.friction_work_J},
                    {"n", {pc.normal_W.x(), pc.normal_W.y(), pc.normal_W.z()}},
                    {"point", {pc.p_WC_m.x(), pc.p_WC_m.y(), pc.p_WC_m.z()}}});
   }
