@@ -36,12 +36,12 @@ struct FrictionResult {
 /// Stick first, then slide (return mapping), for a load point pressed with normal_N [N] of its
 /// PC's pc_normal_N (its limits are FrictionShare's). `trial_force_N` is the tangential force the
 /// contact would carry if the contact point stayed stuck, produced by a tangential spring of
-/// stiffness `tangential_stiffness_N_per_m` (> 0) stretched by trial_force / stiffness. If |trial|
-/// <= f_max(mu_s) the point sticks and the friction is the trial force. Otherwise it slides: the
-/// friction is the kinetic limit f_max(mu_k) along the trial force, and the point slips by (|trial|
-/// - f_k) / stiffness along it, after which the spring carries exactly f_k. Either way |force| <=
-/// the static share. A frictionless contact returns zero force and full slip without evaluating the
-/// law (no friction work without friction).
+/// stiffness `tangential_stiffness_N_per_m` (> 0) stretched by trial_force / stiffness. If the
+/// trial is within the static share the point sticks and the friction is the trial force.
+/// Otherwise it slides: the friction is the kinetic share f_k along the trial force, and the
+/// point slips by (|trial| minus f_k) / stiffness along it, after which the spring carries
+/// exactly f_k. Either way |force| <= the static share. A frictionless contact returns zero force
+/// and full slip without evaluating the law (no friction work without friction).
 FrictionResult ReturnMap(const scene::Friction& friction, const Eigen::Vector3d& trial_force_N,
                          double normal_N, double pc_normal_N, double tangential_stiffness_N_per_m);
 
