@@ -30,6 +30,16 @@ void GroupSpan(const Eigen::Vector3d& axis, int dims, Eigen::Matrix3d& P, Eigen:
   P = dims == 1 ? aa : dims == 2 ? Eigen::Matrix3d(I - aa) : I;
   Q = dims == 1 ? Eigen::Matrix3d(I - aa) : I;
 }
+// A load j of a trial: on the whole tube (every third trial) or on a later segment, whose clamp
+// is in the tube's first half; at an arc position beyond its clamp, 8 mm off the centreline.
+core::BeamLoad RandomLoad(int trial, double l, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  core::BeamLoad j;
+  j.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);
+  j.s_m = j.clamp_m + (l - j.clamp_m) * fraction(rng);
+  j.r_H_m = 0.008 * RandomUnit(rng);
+  return j;
+}
 core::BeamLoad BoundPoint(int k, double s_max, double r_max, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> fraction(0.0, 1.0);
   core::BeamLoad i;
@@ -164,10 +174,7 @@ TEST_CASE("DisplacementBound bounds the compliance of every point up to s_max, a
   std::uniform_real_distribution<double> unit(-1.0, 1.0), fraction(0.0, 1.0);
   double tightest = 0.0;  // the largest |n . W df| / bound seen
   for (int trial = 0; trial < 20000; ++trial) {
-    core::BeamLoad j;
-    j.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);  // a later segment's clamp
-    j.s_m = j.clamp_m + (l - j.clamp_m) * fraction(rng);
-    j.r_H_m = 0.008 * RandomUnit(rng);
+    const core::BeamLoad j = RandomLoad(trial, l, rng);
     const Eigen::Vector3d df_H = 0.1 * unit(rng) * RandomUnit(rng);
     const bool moments = trial % 2 == 0;
     const double s_max = l * fraction(rng);
@@ -204,10 +211,7 @@ TEST_CASE("DisplacementChangeBound bounds a force's moved compliance at every po
   double tightest = 0.0;
   int same_clamp = 0;
   for (int trial = 0; trial < 20000; ++trial) {
-    core::BeamLoad then;
-    then.clamp_m = trial % 3 == 0 ? 0.0 : 0.5 * l * fraction(rng);
-    then.s_m = then.clamp_m + (l - then.clamp_m) * fraction(rng);
-    then.r_H_m = 0.008 * RandomUnit(rng);
+    const core::BeamLoad then = RandomLoad(trial, l, rng);
     core::BeamLoad now = then;
     if (trial % 5 == 0) now.clamp_m = 0.5 * l * fraction(rng);
     now.s_m = std::clamp(then.s_m + 0.01 * unit(rng), now.clamp_m + 1e-6, l);
