@@ -42,7 +42,8 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"energy_exit_J", v.energy_exit_J},
                              {"beyond_linear_s", v.beyond_linear_s},
                              {"shape_off_s", v.shape_off_s},
-                             {"held_s", v.held_s}});
+                             {"held_s", v.held_s},
+                             {"segmentation_off_s", v.segmentation_off_s}});
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -108,6 +109,11 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
       t << "      warning: for " << v.held_s
         << " s the core held the tube back from going through a part (flag held): the tube did "
            "not follow the plan's hand there\n";
+    if (v.segmentation_off_s > 0.0)
+      t << "      warning: for " << v.segmentation_off_s
+        << " s the segmented rule was outside its range (flag segmentation_off: it left out more "
+           "than eps/10 at a load point): the verdict rests on forces the coupled rule would "
+           "correct (multi_contact: coupled)\n";
   }
   t.precision(precision);
 }

@@ -64,6 +64,8 @@ std::string_view FlagName(std::uint32_t bit) {
       return "shape_off";
     case core::kHeldBack:
       return "held";
+    case core::kSegmentationOff:
+      return "segmentation_off";
     default:
       return "unknown";
   }

@@ -239,7 +239,7 @@ struct Core::Impl : Core::State {
     // The output's shape figures and PCs (its pose and wrench are not written before step 9).
     std::array<ContactState, kMaxContacts> contacts{};
     int contact_count = 0;
-    double energy_J = 0.0, max_strain = 0.0, tip_deflection_m = 0.0;
+    double energy_J = 0.0, max_strain = 0.0, tip_deflection_m = 0.0, segmentation_error_m = 0.0;
   } shape_save;
   bool shape_saved = false;
   bool hold_out_of_parts = true;
@@ -282,6 +282,7 @@ struct Core::Impl : Core::State {
     to.energy_J = from.energy_J;
     to.max_strain = from.max_strain;
     to.tip_deflection_m = from.tip_deflection_m;
+    to.segmentation_error_m = from.segmentation_error_m;
   }
   void SaveTangentChoice() {
     if (tangent_choice_saved) return;
@@ -1752,6 +1753,25 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // replay that went there is not taken for the tube's motion.
   if (!m.elastica_shape && !m.rod_shape && out.tip_deflection_m > l / 3.0)
     out.flags |= kBeyondLinearRange;
+  // The segmented rule's error: a load on a later segment bends no segment before it, so the
+  // displacement it causes at an earlier load point on the one cantilever from the held end is
+  // left out. Estimated with the linear influence coefficients (whatever model shapes the tube:
+  // the estimate of an error, as the capsule count's sagitta is), and compared with eps / 10.
+  out.segmentation_error_m = 0.0;
+  if (scene_.model.multi_contact == scene::MultiContactRule::kSegmented && groups > 1) {
+    for (int i = 0; i < beam_count; ++i) {
+      const BeamLoad& at = m.beam_loads[std::size_t(i)];
+      Eigen::Vector3d left_out_m = Eigen::Vector3d::Zero();
+      for (int j = 0; j < beam_count; ++j) {
+        BeamLoad beyond = m.beam_loads[std::size_t(j)];
+        if (!(beyond.clamp_m > at.clamp_m)) continue;
+        beyond.clamp_m = 0.0;
+        left_out_m += m.beam.CentreDisplacement(at.s_m, beyond);
+      }
+      out.segmentation_error_m = std::max(out.segmentation_error_m, left_out_m.norm());
+    }
+    if (out.segmentation_error_m > 0.1 * eps) out.flags |= kSegmentationOff;
+  }
 
   // Markers (contact-states.md): no bending below the threshold; the end face and rim never
   // deform; a side contact is concave or convex by the side of the bend it touches, judged by
@@ -1831,7 +1851,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   out.torque_W_Nm = torque_W;
   if (force_saturated || torque_W.norm() > scene_.device.max_torque_Nm) out.flags |= kForceClamped;
   const bool all_finite = force_W.allFinite() && torque_W.allFinite() && p_W.allFinite() &&
-                          std::isfinite(energy_J) && std::isfinite(strain);
+                          std::isfinite(energy_J) && std::isfinite(strain) &&
+                          std::isfinite(out.segmentation_error_m);
   if (!all_finite) {
     Reset(X_W_hand);
     out.flags |= kSolverFault;
@@ -1840,8 +1861,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   m.p_hand_prev_W = p_hand_W;
   m.p_held_prev_W = p_W;
   m.R_held_prev_W = R_WH_new;
-  m.shape_flags =
-      out.flags & (kLinearFallback | kBeyondLinearRange | kRodShape | kShapeOffContacts);
+  m.shape_flags = out.flags & (kLinearFallback | kBeyondLinearRange | kRodShape |
+                               kShapeOffContacts | kSegmentationOff);
   // Ghosts have done their work; the next tick continues this tick's real loads.
   m.prev_count = 0;
   for (int i = 0; i < load_count; ++i)

@@ -81,10 +81,17 @@ enum StepFlag : std::uint32_t {
   /// were kept where they were, and the operator feels the coupling's spring and damper
   /// stretched to the hand (docs/core.md, "Through a part").
   kHeldBack = 1u << 9,
+  /// The paper's segmented rule, with loads on more than one segment, left out more than eps / 10
+  /// of displacement at a load point (StepOutput::segmentation_error_m): the rule bends each
+  /// segment by its own loads only, so the loads beyond a side contact do not move it. There the
+  /// rule is outside its range: a displacement error of eps / 10 is a force error of K eps / 10
+  /// (the capsule count's tolerance, docs/core.md), and the rule's one-way compliance can make
+  /// energy (the stability sweep's squeeze). The coupled rule has no such error.
+  kSegmentationOff = 1u << 10,
 };
 /// How many StepFlag bits there are (bits 0 .. kStepFlagCount - 1).
-inline constexpr int kStepFlagCount = 10;
-static_assert(kHeldBack == 1u << (kStepFlagCount - 1),
+inline constexpr int kStepFlagCount = 11;
+static_assert(kSegmentationOff == 1u << (kStepFlagCount - 1),
               "kStepFlagCount must follow the last StepFlag bit");
 
 /// One principal contact in a tick, in the core's compact form.
@@ -125,7 +132,12 @@ struct StepOutput {
   double energy_J = 0.0;          ///< bending energy
   double max_strain = 0.0;        ///< largest bending strain (outer fibre at a clamp) [-]
   double tip_deflection_m = 0.0;  ///< lateral deflection of the free end from the straight tube
-  std::uint32_t flags = 0;        ///< StepFlag bits
+  /// Under the segmented rule, the largest displacement [m] it leaves out at a load point: what
+  /// the solved loads on later segments would move that point by on the one cantilever from the
+  /// held end (linear influence coefficients, an estimate of the rule's error). Zero under the
+  /// coupled rule, and with loads on one segment.
+  double segmentation_error_m = 0.0;
+  std::uint32_t flags = 0;  ///< StepFlag bits
   std::span<const ContactState> Contacts() const {
     return {contacts.data(), static_cast<std::size_t>(contact_count)};
   }

@@ -36,6 +36,10 @@ struct TransitionVerdict {
   /// Time the core held the tube back from going through a part (core flag held): there the
   /// tube did not follow the hand, and the operator felt the coupling's spring.
   double held_s = 0.0;
+  /// Time the paper's segmented rule was outside its range (core flag segmentation_off: it left
+  /// out more than eps / 10 of displacement at a load point): the verdict then rests on forces
+  /// off by more than K eps / 10; the coupled rule has no such error.
+  double segmentation_off_s = 0.0;
 };
 
 struct Observation {
