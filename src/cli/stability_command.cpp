@@ -47,6 +47,11 @@ int RunStability(const StabilityOptions& o, Streams io) {
       j["first_held_tick"] =
           r.first_held_tick >= 0 ? nlohmann::json(r.first_held_tick) : nlohmann::json();
       j["warning"] = r.warning.empty() ? nlohmann::json() : nlohmann::json(r.warning);
+      j["outside_validity"] = r.outside;
+      j["judged_with"] = r.judged_coupled ? "coupled" : "as given";
+      j["first_segmentation_off_tick"] = r.first_segmentation_off_tick >= 0
+                                             ? nlohmann::json(r.first_segmentation_off_tick)
+                                             : nlohmann::json();
       cases.push_back(j);
     }
     io.out << nlohmann::json{{"cases", cases}, {"pass", all}}.dump(2) << "\n";
@@ -62,7 +67,7 @@ int RunStability(const StabilityOptions& o, Streams io) {
       cell[{r.parameter, r.motion}] = &r;
     }
     io.out << std::left << std::setw(16) << "case";
-    for (const std::string& m : motions) io.out << std::setw(23) << m;
+    for (const std::string& m : motions) io.out << std::setw(31) << m;
     io.out << "\n";
     for (const std::string& p : parameters) {
       io.out << std::setw(16) << p;
@@ -71,14 +76,17 @@ int RunStability(const StabilityOptions& o, Streams io) {
         std::string text = "-";
         if (it != cell.end()) {
           const study::StabilityResult& r = *it->second;
+          // "coupled": judged with the coupled rule, the segmented one outside its range;
           // "held": the core held the tube back from going through a part in some ticks.
-          const std::string notes = std::string(r.warning.empty() ? "" : "outside") +
-                                    (r.warning.empty() || r.held_ticks == 0 ? "" : ", ") +
-                                    (r.held_ticks > 0 ? "held" : "");
+          std::string notes;
+          for (const auto& [on, note] :
+               {std::pair{r.judged_coupled, "coupled"}, std::pair{r.outside, "outside"},
+                std::pair{r.held_ticks > 0, "held"}})
+            if (on) notes += (notes.empty() ? "" : ", ") + std::string(note);
           text = (r.pass ? "pass" : "FAIL @" + std::to_string(r.first_failing_tick)) +
                  (notes.empty() ? "" : " (" + notes + ")");
         }
-        io.out << std::setw(23) << text;
+        io.out << std::setw(31) << text;
       }
       io.out << "\n";
     }

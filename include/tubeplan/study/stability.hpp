@@ -47,6 +47,15 @@ struct StabilityResult {
   /// first (-1 if none): a case that passes by being held is shown as such.
   int held_ticks = 0;
   int first_held_tick = -1;
+  /// Outside the model's validity (a warning, not a failure, for the physical checks).
+  bool outside = false;
+  /// First tick the paper's segmented rule left out more than eps / 10 of displacement at a load
+  /// point (core::kSegmentationOff), -1 if never. From there the rule is outside its range: the
+  /// case is then judged with the coupled rule (`judged_coupled`), and what the segmented run
+  /// failed goes into the warning. Its safety checks (finite, same bits, force bounds, solver)
+  /// still count.
+  int first_segmentation_off_tick = -1;
+  bool judged_coupled = false;
   int ticks = 0;
   double peak_force_N = 0.0;
 };
