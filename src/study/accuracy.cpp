@@ -235,6 +235,10 @@ struct CoreRun {
   // First tick (from 1) the core flagged its shape off its contacts' points, and a tube and a
   // part overlapping: where a row's error stops being the model's and becomes a failure.
   int first_shape_off_tick = -1, first_penetration_tick = -1;
+  // First tick the paper's segmented rule was outside its range (core::kSegmentationOff), and the
+  // most it left out at a load point.
+  int first_segmentation_off_tick = -1;
+  double segmentation_error_m = 0.0;
   // Ticks the core held the tube back from going through a part: their force is the coupling's,
   // not the contacts' (docs/core.md, "Through a part").
   int held_ticks = 0, first_held_tick = -1;
@@ -267,6 +271,9 @@ CoreRun RunCore(const scene::Scene& s, const Scenario& sc) {
         run.first_shape_off_tick = run.ticks;
       if ((out.flags & core::kPenetration) && run.first_penetration_tick < 0)
         run.first_penetration_tick = run.ticks;
+      if ((out.flags & core::kSegmentationOff) && run.first_segmentation_off_tick < 0)
+        run.first_segmentation_off_tick = run.ticks;
+      run.segmentation_error_m = std::max(run.segmentation_error_m, out.segmentation_error_m);
       if (out.flags & core::kHeldBack) {
         if (run.first_held_tick < 0) run.first_held_tick = run.ticks;
         ++run.held_ticks;
@@ -518,6 +525,11 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
         row.detail += Fmt("; SHAPE OFF ITS CONTACTS from tick %d", run.first_shape_off_tick);
       if (run.first_penetration_tick >= 0)
         row.detail += Fmt("; tube and part overlap from tick %d", run.first_penetration_tick);
+      if (run.first_segmentation_off_tick >= 0)
+        row.detail +=
+            Fmt("; SEGMENTED RULE OUT OF RANGE from tick %d (%.3g mm left out at most, "
+                "linear estimate)",
+                run.first_segmentation_off_tick, run.segmentation_error_m * 1e3);
       if (run.held_ticks > 0)
         row.detail += Fmt("; HELD BACK from going through a part in %d of %d ticks, from tick %d",
                           run.held_ticks, run.ticks, run.first_held_tick);
