@@ -72,6 +72,11 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     part.R_PW = part.R_WP.transpose();
     part.p_PW = -(part.R_PW * part.p_WP);
     part.half_m = 0.5 * box.size_m;
+    part.minus_half_m = -part.half_m;
+    for (int a = 0; a < 3; ++a) {
+      part.edge_above_m[a] = part.half_m[a] - part_tolerance_m_;
+      part.edge_below_m[a] = -part.half_m[a] + part_tolerance_m_;
+    }
     part.aligned = part.R_WP == Eigen::Matrix3d::Identity();
     parts_.push_back(part);
   }
@@ -292,8 +297,8 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
                                                                const Eigen::Vector3d& q_P) const {
   std::uint8_t mask = 0;
   for (int a = 0; a < 3; ++a) {
-    if (q_P[a] >= part.half_m[a] - part_tolerance_m_) mask |= std::uint8_t(1u << kPositiveFace[a]);
-    if (q_P[a] <= -part.half_m[a] + part_tolerance_m_) mask |= std::uint8_t(1u << kNegativeFace[a]);
+    mask |= std::uint8_t(unsigned(q_P[a] >= part.edge_above_m[a]) << kPositiveFace[a]);
+    mask |= std::uint8_t(unsigned(q_P[a] <= part.edge_below_m[a]) << kNegativeFace[a]);
   }
   if (mask != 0) return mask;
   // Not on the surface (only when the shapes overlap): the face nearest to the point.
@@ -311,7 +316,7 @@ bool Collision::PassesBroadPhase(const Part& part, const Eigen::Vector3d& a_P,
   for (int k = 0; k < 3; ++k) {
     const double lo = std::min(a_P[k], b_P[k]) - grow;
     const double hi = std::max(a_P[k], b_P[k]) + grow;
-    if (lo > part.half_m[k] || hi < -part.half_m[k]) return false;
+    if (lo > part.half_m[k] || hi < part.minus_half_m[k]) return false;
   }
   return true;
 }

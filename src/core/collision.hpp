@@ -156,7 +156,11 @@ class Collision {
     // matrices, which cost a tenth of a tick here.
     Eigen::Matrix3d R_PW = Eigen::Matrix3d::Identity(), R_WP = Eigen::Matrix3d::Identity();
     Eigen::Vector3d p_PW = Eigen::Vector3d::Zero(), p_WP = Eigen::Vector3d::Zero();
-    Eigen::Vector3d half_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d half_m = Eigen::Vector3d::Zero(), minus_half_m = Eigen::Vector3d::Zero();
+    // FaceMask's planes per axis, half_m - part_tolerance_m_ and -half_m + part_tolerance_m_: a
+    // point at or above the first lies on the face at +half_m, at or below the second on the one
+    // at -half_m. Made once: FaceMask runs once a contact.
+    std::array<double, 3> edge_above_m{}, edge_below_m{};
     // Parts set square to the world (most scenes' floors and walls) skip the rotation: a
     // product with the identity gives the same numbers, so nothing else changes.
     bool aligned = false;
