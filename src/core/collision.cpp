@@ -693,7 +693,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         p_tube_W = part.ToWorld(p_P);
         q_part_W = part.ToWorld(q_P);
       }
-      RawContact c;
+      // Made in place, not copied there (out has room: checked above); a pair that yields no
+      // contact leaves it past count.
+      RawContact& c = out[std::size_t(count)];
+      c = RawContact{};
       c.part = part.index;
       const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
       if (signed_depth) {
@@ -768,17 +771,18 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // would make the load jump by the cylinder's length from tick to tick. Both ends of the
         // generator go out instead, each with its own distance to the face's plane.
         const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
+        const RawContact side = c;  // out[count] may take the first end
         for (const double end : {-half_m, half_m}) {
           if (count == static_cast<int>(out.size())) return count;
-          RawContact e = c;
+          RawContact e = side;
           e.p_W_m = centre_W + radial_W + end * axis_W;
-          e.distance_m = c.distance_m + c.normal_W.dot(e.p_W_m - p_tube_W);
+          e.distance_m = side.distance_m + side.normal_W.dot(e.p_W_m - p_tube_W);
           e.s_m = std::max(0.0, s0 + half_m + end);
           if (e.distance_m < band_m && e.distance_m > 0.0) out[std::size_t(count++)] = e;
         }
         continue;
       }
-      out[std::size_t(count++)] = c;
+      ++count;
     }
   }
   return count;

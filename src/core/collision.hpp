@@ -110,9 +110,9 @@ class Collision {
   /// in arc length from the held end) are `nodes_W`, with the free end's axis `tip_tangent_W`.
   /// The last intervals (at least r1 of tube) are one straight cylinder along the tip tangent, so
   /// that no capsule's round cap reaches past the flat end face. Writes at most out.size() contacts
-  /// and returns how many; no allocation. Pairs closer than `band_m` are returned (the core asks
-  /// for more than epsilon so that a contact about to close this tick is in its system, and one
-  /// releasing leaves smoothly).
+  /// and returns how many (the entry past them may be overwritten too); no allocation. Pairs closer
+  /// than `band_m` are returned (the core asks for more than epsilon so that a contact about to
+  /// close this tick is in its system, and one releasing leaves smoothly).
   ///
   /// `idle` (optional) names parts that may be left out; see IdleParts. An end piece within the
   /// band of a part it could face (its axis within the tilt at which an end face presses at a
