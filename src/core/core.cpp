@@ -597,17 +597,19 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // to close in the tick, and the tube went through the edge with no force (`stability --only
   // "roll over an edge speed=2m/s"`, tick 2). It grows from the deepest piece: the piece that
   // opened the PC may lie outside it.
+  // Per PC, the largest distance of a piece in its region: made once, not once a raw contact.
+  std::array<double, kMaxContacts> region_m{};
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
     pc.first = pc.last = pc.deepest;
+    region_m[std::size_t(k)] = std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps);
   }
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
     if (k < 0) continue;
     const RawContact& r = m.raw[std::size_t(i)];
     PcFound& pc = found[std::size_t(k)];
-    if (r.distance_m > std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps))
-      continue;
+    if (r.distance_m > region_m[std::size_t(k)]) continue;
     if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
     if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
   }
