@@ -52,8 +52,8 @@ struct StabilityResult {
   /// First tick the paper's segmented rule left out more than eps / 10 of displacement at a load
   /// point (core::kSegmentationOff), -1 if never. From there the rule is outside its range: the
   /// case is then judged with the coupled rule (`judged_coupled`), and what the segmented run
-  /// failed goes into the warning. Its safety checks (finite, same bits, force bounds, solver)
-  /// still count.
+  /// failed goes into the warning. The segmented run's safety checks (finite, same bits, force
+  /// bounds, solver) still count, and so do its physical checks before that tick.
   int first_segmentation_off_tick = -1;
   bool judged_coupled = false;
   int ticks = 0;
