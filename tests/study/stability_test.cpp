@@ -34,9 +34,10 @@ TEST_CASE("Stability: push into a wall, steel-stiff tube (E = 200 GPa)", "[stabi
 TEST_CASE("Stability: push into a wall past the buckling load, the shipped rubber tube",
           "[stability]") {
   // Pressed along its axis at the device's 8.5 N (9.5 times the cantilever's Euler load) the
-  // rubber tube's tip stays on the wall: the elastica is held off past buckling and the linear
-  // model carries the push (docs/core.md). Before, the first-mode elastica swung the tip away,
-  // the contact opened and the tube sprang back 4 mm into the wall, over and over.
+  // rubber tube's tip stays on the wall: the elastica is held off past buckling and the rod
+  // carries the push (docs/core.md). Before, the first-mode elastica swung the tip away, the
+  // contact opened and the tube sprang back 4 mm into the wall, over and over. It holds only
+  // while the push is exactly along the axis: 0.1 mm off it, the tube buckles (test below).
   const study::StabilityResult r = RunNamed("push into a wall base");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
@@ -91,6 +92,47 @@ TEST_CASE("Stability: fast pass at 2 m/s through a 1 mm wall, rubber tube", "[st
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
   CHECK(r.warning.find("tunnelling") == std::string::npos);
+}
+
+TEST_CASE(
+    "Stability: push into a wall 0.1 mm off the axis (core defect: the shape is drawn under dead "
+    "loads past the free end's Euler load)",
+    "[stability][!mayfail]") {
+  // Core defect: the same push with the hand 0.1 mm out of the motion's plane. The stuck tip pins
+  // the column, whose buckling load is then 2.05 pi^2 EI / l^2 = 7.4 N (more with the end face's
+  // tilt stiffness). But from 0.92 N, just past the free end's Euler load pi^2 EI / (4 l^2) =
+  // 0.9 N (tick 83, where the rod takes over from the elastica), the rod draws the shape under
+  // the tick's solved forces as dead loads, under which the straight cantilever is unstable:
+  // the tip is 0.06 mm off the axis at tick 84, 0.75 at 85, 6.3 at 86 and 23 mm at 87, the shape
+  // off its contacts, and the energy held passes the hand's work at tick 87. On the exact axis
+  // nothing breaks the symmetry and the case passes (above). The fix is a shape step that
+  // carries the contacts' stiffness (docs/accuracy.md).
+  const study::StabilityResult r = RunNamed("push into a wall off-plane=0.1mm");
+  INFO(r.detail << " | " << r.warning);
+  CHECK(r.pass);
+}
+
+TEST_CASE(
+    "Stability: fast pass 0.1 mm off the axis (core defect: the pushed column buckles and goes "
+    "through)",
+    "[stability][!mayfail]") {
+  // Core defect, the push's at 2 m/s: pressed on the 1 mm wall at the device's 8.5 N, the tube
+  // buckles as soon as anything breaks the symmetry (a hand 0.01 mm off the axis is enough), and
+  // the buckled tube goes through the wall (tick 13). No relaxation of the end face's centre of
+  // pressure, from -1.5 to 1, keeps it straight (docs/accuracy.md).
+  const study::StabilityResult r = RunNamed("fast pass off-plane=0.1mm");
+  INFO(r.detail << " | " << r.warning);
+  CHECK(r.pass);
+}
+
+TEST_CASE("Stability: roll over an edge 0.1 mm off its plane", "[stability]") {
+  // A motion that bends the tube anyway: 0.1 mm out of its plane changes nothing of substance,
+  // and the case passes as the in-plane one does. (The off-plane variation, which the push and
+  // the fast pass fail above, is not what fails them.)
+  const study::StabilityResult r = RunNamed("roll over an edge off-plane=0.1mm");
+  INFO(r.detail << " | " << r.warning);
+  CHECK(r.pass);
+  CHECK(r.warning.empty());
 }
 
 TEST_CASE("Stability: slide along a wall (core defect: the column snaps when its pushed tip slips)",

@@ -26,6 +26,8 @@ struct StabilityCase {
   Motion motion = Motion::kPushIntoWall;
   scene::Scene scene;
   double speed_m_per_s = 0.05;
+  /// The hand's offset out of the motion's plane (world y) at every waypoint [m].
+  double off_plane_m = 0.0;
   std::string parameter;  ///< the parameter varied from the base case ("base" for none)
   /// Empty when the case lies inside the model's validity; otherwise why not (the case then
   /// passes or fails on the safety checks only: finite, force bounds, same bits).
