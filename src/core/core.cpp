@@ -175,6 +175,11 @@ struct Core::State {
   // where the beam does not carry the offsets' moments (the elastica), for loads with friction:
   // the stuck spring does not see it (section 5).
   std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W_turn{};  // world frame
+  // The rod's tangent at the shape's loads (frame H), where the shape is pinned (section 8).
+  std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W_pin{};
+  // The dead-load shape, kept while a pin is tried and put back if the pin is refused.
+  std::array<RodSegment, kMaxLoads> rod_segments_dead{}, rod_segments_step{};
+  std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_dead_H{};
   SystemMatrix M;
   SystemVector rhs, z;
   Eigen::PartialPivLU<SystemMatrix> lu;
@@ -1672,6 +1677,112 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         m.beam.SolveRodChain(m.beam_loads, beam_count, m.order, m.rod_segments,
                              std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
     m.rod_shape = m.rod_segment_count > 0;
+  }
+  if (m.rod_shape) {
+    // The rod draws the shape under the tick's forces as dead loads. Past the free end's Euler
+    // load a cantilever under a dead axial load is unstable: its points move by metres per newton
+    // sideways, and a force within the solve's rounding puts the shape off the points the tick's
+    // system held, though the contacts pin it there (the rubber tube pushed onto a wall 0.1 mm
+    // off its axis: 0.07, 0.75, 6.3 mm in three ticks, `stability --only "push into a wall
+    // off-plane"`). Where the shape is off sideways by more than eps / 10 (the capsule count's
+    // tolerance), the loads the shape is drawn under are corrected by Newton with the rod's
+    // tangent (each step backtracked until it brings the shape closer) until it passes through
+    // those points, if that takes a small change, 1 % of the loads: the shape the tick's system
+    // solved for, under the forces it solved within that. The tick's forces stay as solved.
+    // Refused (the dead-load shape kept, flagged shape_off as before): a snap, whose shape no
+    // small change reaches, and the free end's buckling load itself (within ~10 %), where the
+    // dead-load solve is centimetres off and Newton on the forces does not reach the points in
+    // a tick's six steps (tests/core/core_test.cpp).
+    const auto worst_off = [&] {
+      double off_m = 0.0;
+      for (int j = 0; j < beam_count; ++j)
+        off_m = std::max(off_m, (interpolate_node(m.beam_loads[std::size_t(j)].s_m) -
+                                 m.predicted_H[std::size_t(j)])
+                                    .head<2>()
+                                    .norm());
+      return off_m;
+    };
+    const double pin_tolerance_m = 0.1 * eps;
+    if (worst_off() > pin_tolerance_m) {
+      std::array<Eigen::Vector3d, kMaxLoads> f_dead_H;
+      double f_total_N = 0.0;
+      for (int j = 0; j < beam_count; ++j) {
+        f_dead_H[std::size_t(j)] = m.beam_loads[std::size_t(j)].f_H_N;
+        f_total_N += f_dead_H[std::size_t(j)].norm();
+      }
+      m.rod_segments_dead = m.rod_segments;
+      m.nodes_dead_H = m.nodes_H;
+      const int segments_dead = m.rod_segment_count;
+      bool pinned = false;
+      double change_N = 0.0, last_off_m = worst_off();
+      const double change_bound_N = 1e-2 * f_total_N;
+      const int n = 2 * beam_count;
+      for (int iteration = 0; iteration < 4 && !pinned; ++iteration) {
+        for (auto& row : m.W_pin) row.fill(Eigen::Matrix3d::Zero());
+        bool ok = true;
+        for (int g = 0; g < m.rod_segment_count && ok; ++g)
+          ok = m.beam.RodCompliance(m.rod_segments[std::size_t(g)], m.W_pin);
+        if (!ok) break;
+        // Sideways only (x, y of H): the rod does not stretch, so where its length puts a point
+        // along the axis no force moves it (the system's linearised shortening differs from the
+        // rod's by the step's second order).
+        m.M.setZero(n, n);
+        m.rhs.setZero(n);
+        for (int i = 0; i < beam_count; ++i) {
+          for (int j = 0; j < beam_count; ++j)
+            m.M.block<2, 2>(2 * i, 2 * j) =
+                m.W_pin[std::size_t(i)][std::size_t(j)].topLeftCorner<2, 2>();
+          m.rhs.segment<2>(2 * i) =
+              (m.predicted_H[std::size_t(i)] - interpolate_node(m.beam_loads[std::size_t(i)].s_m))
+                  .head<2>();
+        }
+        m.lu.compute(m.M);
+        m.z = m.lu.solve(m.rhs);
+        if (!m.z.allFinite()) break;
+        // The step, or a half, a quarter or an eighth of it, each solved from the rod's solution
+        // before it, must bring the shape closer: at the free end's buckling load the full step
+        // can land the rod on its buckled branch, centimetres off.
+        std::array<Eigen::Vector3d, kMaxLoads> f_step_H;
+        for (int j = 0; j < beam_count; ++j)
+          f_step_H[std::size_t(j)] = m.beam_loads[std::size_t(j)].f_H_N;
+        m.rod_segments_step = m.rod_segments;
+        const int segments_step = m.rod_segment_count;
+        double off_m = last_off_m;
+        bool closer = false;
+        for (const double fraction : {1.0, 0.5, 0.25, 0.125}) {
+          m.rod_segments = m.rod_segments_step;
+          m.rod_segment_count = segments_step;
+          for (int j = 0; j < beam_count; ++j) {
+            m.beam_loads[std::size_t(j)].f_H_N = f_step_H[std::size_t(j)];
+            m.beam_loads[std::size_t(j)].f_H_N.head<2>() += fraction * m.z.segment<2>(2 * j);
+          }
+          m.rod_segment_count = m.beam.SolveRodChain(
+              m.beam_loads, beam_count, m.order, m.rod_segments,
+              std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1));
+          if (m.rod_segment_count <= 0) continue;
+          off_m = worst_off();
+          if (off_m < last_off_m) {
+            closer = true;
+            break;
+          }
+        }
+        if (!closer) break;
+        change_N = 0.0;
+        for (int j = 0; j < beam_count; ++j)
+          change_N += (m.beam_loads[std::size_t(j)].f_H_N - f_dead_H[std::size_t(j)]).norm();
+        // A change beyond the bound is not a shape within reach of the tick's forces (a snap).
+        if (!(change_N <= change_bound_N)) break;
+        last_off_m = off_m;
+        pinned = off_m <= pin_tolerance_m;
+      }
+      if (!(pinned && change_N <= change_bound_N)) {
+        for (int j = 0; j < beam_count; ++j)
+          m.beam_loads[std::size_t(j)].f_H_N = f_dead_H[std::size_t(j)];
+        m.rod_segments = m.rod_segments_dead;
+        m.nodes_H = m.nodes_dead_H;
+        m.rod_segment_count = segments_dead;
+      }
+    }
   }
   const double EI = m.beam.bending_stiffness_Nm2();
   const double r1 = scene_.tube.outer_radius_m;
