@@ -216,7 +216,14 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
     if (next_load >= 0)
       stop = std::max(stop, loads[std::size_t(order[std::size_t(next_load)])].s_m);
     if (next_sample > 0) stop = std::max(stop, samples.s_m[next_sample - 1]);
-    const int steps = std::max(1, static_cast<int>(std::ceil((s - stop) / max_step_m_ - 1e-9)));
+    // An interval no longer than a step (the usual one: the samples are the chain's nodes,
+    // closer than max_step_m_) is one step: its quotient is at most 1 (rounding is monotonic),
+    // so the ceiling below is at most 1 and the count 1 either way, without the ceiling's
+    // rounding sequence (no SSE4.1 round instruction here).
+    const double span_m = s - stop;
+    const int steps = span_m <= max_step_m_
+                          ? 1
+                          : std::max(1, static_cast<int>(std::ceil(span_m / max_step_m_ - 1e-9)));
     const double h = (s - stop) / steps;
     for (int k = 0; k < steps; ++k) {
       const Eigen::Vector3d t = R.col(2);
