@@ -111,6 +111,16 @@ Coefficients Coeffs(double a, double b, double EI) {
 
 Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool moments) const {
   const Coefficients c = Coeffs(i.s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  if (!moments && std::isfinite(c.uM) && std::isfinite(c.thM)) {
+    // Without the offset moment (Rj = 0: the elastica's ticks, a call per load pair and
+    // member) its two products are 3 x 3 products with a zero matrix. With finite coefficients
+    // (Coeffs makes them +0 or positive) every entry of both is +0: uM kZ Rj is subtracted
+    // from a matrix whose entries it leaves as they are, and thM kLateral Rj added to thF kZ
+    // only turns a -0 there into +0, which adding the zero matrix does too. So the result has
+    // the same bits without the two products (a third of the elastica's tick in this
+    // function).
+    return c.uF * kLateral - Skew(i.r_H_m) * (c.thF * kZ + Eigen::Matrix3d::Zero());
+  }
   const Eigen::Matrix3d Rj = moments ? Skew(j.r_H_m) : Eigen::Matrix3d::Zero();
   return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
 }
