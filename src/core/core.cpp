@@ -28,6 +28,16 @@ constexpr int kMaxPasses = 3 * kMaxLoads + 4;
 // live session of weeks at 1 kHz never overflows them.
 constexpr int kTangentReuseTicks = 50;
 
+// The tick's system of n = kN unknowns by the fixed-size LU. Out of line: inlined into the
+// tick, the 9 x 9 factorisation pushed Eigen's small helpers elsewhere in it out of line, and
+// ticks of other sizes paid for it.
+template <int kN>
+[[gnu::noinline]] void SolveFixed(Eigen::PartialPivLU<Eigen::Matrix<double, kN, kN>>& lu,
+                                  const SystemMatrix& M, const SystemVector& rhs, SystemVector& z) {
+  lu.compute(M.topLeftCorner<kN, kN>());
+  z = lu.solve(rhs.head<kN>());
+}
+
 // f_k(N) = a + b N, tangent to mu_k N0 (N/N0)^beta at N (exact for beta = 1). At N = 0 with
 // beta < 1 the slope is infinite: the chord to N = 1e-9 N0 stands in for it. A load point of a
 // PC of several holds the share f_k(N_pc) N / N_pc (FrictionShare): its slope in its own N, the
@@ -185,6 +195,7 @@ struct Core::State {
   Eigen::PartialPivLU<SystemMatrix> lu;
   Eigen::PartialPivLU<Eigen::Matrix3d> lu3;
   Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu6;
+  Eigen::PartialPivLU<Eigen::Matrix<double, 9, 9>> lu9;
 };
 
 // The set-up that ticks only read (Collision's GJK solver carries nothing between queries: its
@@ -1201,15 +1212,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
     }
     if (reduced) {
-      // One load or two (most ticks): the fixed-size factorisation, the same partial pivoting in
-      // the same order (the same bits) without the dynamic one's blocking and bookkeeping, which
-      // cost a 3 x 3 system ~700 instructions.
+      // One load, two or three (most ticks): the fixed-size factorisation, the same partial
+      // pivoting in the same order (the same bits) without the dynamic one's blocking and
+      // bookkeeping, which cost a 3 x 3 system ~700 instructions (and a 9 x 9 one, three PCs in
+      // the groove, ~1500).
       if (n == 3) {
         m.lu3.compute(m.M.topLeftCorner<3, 3>());
         m.z = m.lu3.solve(m.rhs.head<3>());
       } else if (n == 6) {
         m.lu6.compute(m.M.topLeftCorner<6, 6>());
         m.z = m.lu6.solve(m.rhs.head<6>());
+      } else if (n == 9) {
+        SolveFixed(m.lu9, m.M, m.rhs, m.z);
       } else if (n > 0) {
         m.lu.compute(m.M);
         m.z = m.lu.solve(m.rhs);
