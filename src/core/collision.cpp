@@ -103,6 +103,9 @@ bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& 
   // the axis is outside the box) in the narrow phase too, which would discard it. A pair within
   // 1 nm + delta of the band is evaluated. Squared: no root; their rounding is relative 1e-16.
   // Nothing kept (-infinity) or a NaN anywhere compares false: evaluated.
+  // No slack (a pair in the band, a hundred a tick for a tube lying in the groove) decides it
+  // before the motions are formed.
+  if (!(kept.d_m - (std::max(band_m, 0.0) + kCoherenceMargin_m) > 0.0)) return false;
   return KeptBeyondBand(kept, (a_W - kept.a_W_m).squaredNorm(), (b_W - kept.b_W_m).squaredNorm(),
                         band_m);
 }
@@ -273,12 +276,13 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
 // a second call, an eighth of the query's instructions.
 [[gnu::always_inline]] inline bool Collision::CapsuleBoxDistance(
     const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P, double& distance_m,
-    Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P, Eigen::Vector3d& normal_P) const {
+    Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P, Eigen::Vector3d& c_P,
+    double& axis_m) const {
   double t = 0.0, axis_sq = 0.0;
   if (!OneFaceDistanceSquared(a_P, b_P, part.half_m, axis_sq, t))
     axis_sq = SegmentBoxDistanceSquaredAnyFace(a_P, b_P, part.half_m, t);
-  const double axis_m = std::sqrt(axis_sq);
-  const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
+  axis_m = std::sqrt(axis_sq);
+  c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
   q_part_P = c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m);
   // Below a micrometre the direction from the box to the axis is not defined well enough: that
   // is the axis inside the box, for which no signed distance is given.
@@ -287,7 +291,6 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   // depth r1 - |c - q| is then exact (the nearest box point q is the foot of the deepest point's
   // normal), so the penalty keeps growing past K eps instead of saturating at the surface.
   distance_m = axis_m - radius_m_;
-  normal_P = (c_P - q_part_P) / axis_m;
   p_tube_P = c_P + (q_part_P - c_P) * (radius_m_ / axis_m);
   return true;
 }
@@ -643,9 +646,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // The capsule on the end piece's axis contains the cylinder: if it is farther than the
         // band, so is the cylinder, and FCL's GJK (microseconds) is not needed. It is the
         // distance kept for the end piece.
-        double bound_m = 0.0;
-        Eigen::Vector3d unused_p, unused_q, unused_n;
-        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_n)) {
+        double bound_m = 0.0, unused_axis_m = 0.0;
+        Eigen::Vector3d unused_p, unused_q, unused_c;
+        if (CapsuleBoxDistance(part, a_P, b_P, bound_m, unused_p, unused_q, unused_c,
+                               unused_axis_m)) {
           Keep(kept_k, a_W, b_W, bound_m);
           if (bound_m >= band_m) continue;
         }
@@ -662,10 +666,15 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       bool signed_depth = false;  // overlapping with a trusted depth: d < 0, normal given
       bool from_gjk = false;
       if (!is_end) {
-        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_P, q_P, n_P);
+        Eigen::Vector3d c_P;
+        double axis_m = 0.0;
+        separated = CapsuleBoxDistance(part, a_P, b_P, d, p_P, q_P, c_P, axis_m);
         signed_depth = separated && d <= 0.0;
         if (separated) Keep(kept_k, a_W, b_W, d);
         if (separated && d >= band_m) continue;
+        // The normal from the box to the axis, read only with a signed depth (a pair apart
+        // takes its normal in the world frame, below).
+        if (signed_depth) n_P = (c_P - q_P) / axis_m;
       } else if (CylinderBoxFaceDistance(a_P, b_P, radius_m_, part.half_m, d, p_P, q_P)) {
         // The end piece nearest to a face (the usual case: the tip on the floor, the end against
         // a wall) in closed form; FCL's GJK only for an edge or a vertex nearest, or overlap.

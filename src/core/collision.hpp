@@ -181,13 +181,14 @@ class Collision {
                         double band_m) const;
   // Capsule (segment a-b swept by r1) against the box, in closed form: the signed distance
   // (negative when the capsule dips into the box with its axis outside; then exact too), the
-  // deepest or nearest tube point, the nearest box point and the normal from the part into the
-  // tube, all in the part's frame (most pieces that pass the broad phase turn out farther than the
-  // band and need nothing in the world frame). False only when the axis reaches into the box (no
-  // defined direction).
+  // deepest or nearest tube point, the nearest box point, and the axis point nearest the box and
+  // its distance from it, whose difference over that distance is the normal from the part into
+  // the tube (formed by the caller where it is read), all in the part's frame (most pieces that
+  // pass the broad phase turn out farther than the band and need nothing in the world frame).
+  // False only when the axis reaches into the box (no defined direction).
   bool CapsuleBoxDistance(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
                           double& distance_m, Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P,
-                          Eigen::Vector3d& normal_P) const;
+                          Eigen::Vector3d& c_P, double& axis_m) const;
   struct KeptDistance;
   // Whether the idle part parts_[part_i], left out by its last evaluation (valid summary), still
   // is: every node has moved too little since for it to matter (world frame only). Then it adds
