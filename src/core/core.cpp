@@ -590,9 +590,17 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   for (int i = 0; i < raw_count; ++i) {
     const RawContact& r = m.raw[std::size_t(i)];
     int k = 0;
-    while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
-                                found[std::size_t(k)].part_element == r.part_element))
-      ++k;
+    // Query gives a part's pieces in a run, so most raw contacts have the elements of the one
+    // before: its PC is theirs (a PC's elements are no other's, so the search finds that one).
+    const RawContact* const before = i > 0 ? &m.raw[std::size_t(i) - 1] : nullptr;
+    if (before != nullptr && pc_of[std::size_t(i) - 1] >= 0 && before->tube == r.tube &&
+        before->part_element == r.part_element) {
+      k = pc_of[std::size_t(i) - 1];
+    } else {
+      while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
+                                  found[std::size_t(k)].part_element == r.part_element))
+        ++k;
+    }
     pc_of[std::size_t(i)] = k;
     if (k == found_count) {
       if (found_count == kMaxContacts) {
@@ -615,10 +623,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // opened the PC may lie outside it.
   // Per PC, the largest distance of a piece in its region: made once, not once a raw contact.
   std::array<double, kMaxContacts> region_m{};
+  // And the arc positions of its first and last raw contacts so far, kept beside them.
+  std::array<double, kMaxContacts> first_s_m{}, last_s_m{};
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
     pc.first = pc.last = pc.deepest;
     region_m[std::size_t(k)] = std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps);
+    first_s_m[std::size_t(k)] = last_s_m[std::size_t(k)] = m.raw[std::size_t(pc.deepest)].s_m;
   }
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
@@ -626,8 +637,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const RawContact& r = m.raw[std::size_t(i)];
     PcFound& pc = found[std::size_t(k)];
     if (r.distance_m > region_m[std::size_t(k)]) continue;
-    if (r.s_m < m.raw[std::size_t(pc.first)].s_m) pc.first = i;
-    if (r.s_m > m.raw[std::size_t(pc.last)].s_m) pc.last = i;
+    if (r.s_m < first_s_m[std::size_t(k)]) pc.first = i, first_s_m[std::size_t(k)] = r.s_m;
+    if (r.s_m > last_s_m[std::size_t(k)]) pc.last = i, last_s_m[std::size_t(k)] = r.s_m;
   }
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
