@@ -586,15 +586,41 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     lo_W = lo_W.cwiseMin(nodes_W[i]);
     hi_W = hi_W.cwiseMax(nodes_W[i]);
   }
+  // And, for an aligned part that the tube's box reaches into by less than half its extent along
+  // some axis (a tube reaching it with its end only: the tip on the floor), the box of each run
+  // of kGroup capsules (their nodes): a run whose box is out of the part's grown box has every
+  // capsule out of it in the broad phase (each capsule's coordinates lie within its run's, and
+  // rounding is monotonic, so its grown extent lies beyond the run's). The runs out of reach
+  // from the held end on are passed over whole, and their nodes are not taken into the part's
+  // frame. Where the capsules mostly pass (a tube lying on the part) the runs would only add
+  // tests; testing every run, not only the leading ones, cost the tube lying in the groove more
+  // than it saved.
+  const int capsules = pieces - 1;
+  bool groups_made = false;
+  const auto make_groups = [&] {
+    for (int g = 0; g * kGroup < capsules; ++g) {
+      const std::size_t first = std::size_t(g * kGroup);
+      const std::size_t last = std::size_t(std::min((g + 1) * kGroup, capsules));  // last node
+      Eigen::Vector3d lo_g = nodes_W[first], hi_g = nodes_W[first];
+      for (std::size_t i = first + 1; i <= last; ++i) {
+        lo_g = lo_g.cwiseMin(nodes_W[i]);
+        hi_g = hi_g.cwiseMax(nodes_W[i]);
+      }
+      group_lo_W_[std::size_t(g)] = lo_g;
+      group_hi_W_[std::size_t(g)] = hi_g;
+    }
+    groups_made = true;
+  };
   for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
     // The nodes in the part's frame, made only for a part the tube may reach and that is not
     // still left out (most of the groove's ticks leave out both walls).
     bool in_part_frame = false;
-    const auto to_part_frame = [&] {
+    // (From node `first` on: the loop below reads no node before its first piece's.)
+    const auto to_part_frame = [&](std::size_t first = 0) {
       if (in_part_frame) return;
-      for (std::size_t i = 0; i < node_count; ++i) nodes_P_[i] = part.ToPart(nodes_W[i]);
+      for (std::size_t i = first; i < node_count; ++i) nodes_P_[i] = part.ToPart(nodes_W[i]);
       in_part_frame = true;
     };
     Eigen::Vector3d lo, hi;
@@ -624,8 +650,29 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     } else {
       summaries_[part_i].valid = false;
     }
-    to_part_frame();
-    for (int k = 0; k < pieces; ++k) {
+    bool by_group = false;
+    if (part.aligned) {
+      const Eigen::Array3d reach = (hi.array().min(part.half_m.array() + grow) -
+                                    lo.array().max(part.minus_half_m.array() - grow));
+      by_group = (2.0 * reach < hi.array() - lo.array()).any();
+    }
+    int k_begin = 0;
+    if (by_group) {
+      if (!groups_made) make_groups();
+      for (; k_begin < capsules; k_begin += kGroup) {
+        const Eigen::Vector3d lo_g = group_lo_W_[std::size_t(k_begin / kGroup)] + part.p_PW;
+        const Eigen::Vector3d hi_g = group_hi_W_[std::size_t(k_begin / kGroup)] + part.p_PW;
+        if (!(((lo_g.array() - grow) > part.half_m.array()).any() ||
+              ((hi_g.array() + grow) < part.minus_half_m.array()).any()))
+          break;
+      }
+      k_begin = std::min(k_begin, capsules);
+    }
+    if (k_begin == 0)
+      to_part_frame();
+    else
+      to_part_frame(std::size_t(k_begin));
+    for (int k = k_begin; k < pieces; ++k) {
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
       const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];

@@ -237,6 +237,10 @@ class Collision {
   mutable int narrow_calls_ = 0;
   mutable int coherent_skips_ = 0;
   mutable std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_P_{};  // scratch
+  // Query's boxes of runs of kGroup capsules, world frame (scratch).
+  static constexpr int kGroup = 8;
+  mutable std::array<Eigen::Vector3d, (kMaxCapsules + kGroup - 1) / kGroup> group_lo_W_{},
+      group_hi_W_{};
   // A lower bound on the distance from a piece's capsule (its axis a-b swept by r1; for the end
   // piece the capsule that contains its cylinder) to a part, with the axis's ends when it was
   // computed. Per part, kMaxCapsules pieces; sized at construction, so Query allocates nothing.
