@@ -1,3 +1,4 @@
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -7,21 +8,29 @@
 namespace tubeplan::core {
 namespace {
 
-// std::pow(base, exponent), the last result kept per thread. A tick asks for the same power
-// several times (a load point's static and kinetic shares, its PC's limit at the PC's load), and
-// pow costs a hundred instructions or more. The same bits in, the same bits out: pow is a function
-// of its arguments alone.
+// std::pow(base, exponent), the last four results kept per thread. A tick asks for the same
+// power several times (a load point's static and kinetic shares, its PC's limit at the PC's load;
+// with several PCs their loads in turn, and each pass of the solve asks again), and pow costs a
+// hundred instructions or more. The same bits in, the same bits out: pow is a function of its
+// arguments alone. (Looking at the newest first, or keeping the last one apart, cost more than
+// the plain scan.)
 double LoadPower(double base, double exponent) {
-  thread_local std::uint64_t last_base = 0, last_exponent = 0;
-  thread_local double last_power = 1.0;  // std::pow(0.0, 0.0), for the bits above
+  struct Entry {
+    std::uint64_t base = 0, exponent = 0;
+    double power = 1.0;  // std::pow(0.0, 0.0), for the bits above
+  };
+  thread_local std::array<Entry, 4> cache{};
+  thread_local unsigned next = 0;  // the oldest, replaced next
   const auto base_bits = std::bit_cast<std::uint64_t>(base);
   const auto exponent_bits = std::bit_cast<std::uint64_t>(exponent);
-  if (base_bits != last_base || exponent_bits != last_exponent) {
-    last_base = base_bits;
-    last_exponent = exponent_bits;
-    last_power = std::pow(base, exponent);
-  }
-  return last_power;
+  for (const Entry& e : cache)
+    if (e.base == base_bits && e.exponent == exponent_bits) return e.power;
+  Entry& e = cache[next];
+  next = (next + 1) % cache.size();
+  e.base = base_bits;
+  e.exponent = exponent_bits;
+  e.power = std::pow(base, exponent);
+  return e.power;
 }
 
 }  // namespace
