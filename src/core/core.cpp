@@ -564,13 +564,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
 
   // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
   // one's PC (an edge of the face a side lies on, the rim of an end face lying flat).
+  // Only an edge, a vertex or the rim bounds another element: a face touched by the end face or
+  // the side joins nothing (most pairs of a tube lying in a groove; this loop is quadratic in
+  // them). That is tested before the scan and again after each join, the only change to it.
+  const auto joins_nothing = [](const RawContact& r) {
+    return IsFaceMask(r.face_mask) && r.tube != states::TubeElement::kEndRim;
+  };
   for (int i = 0; i < raw_count; ++i) {
     RawContact& a = m.raw[std::size_t(i)];
+    if (joins_nothing(a)) continue;
     for (int j = 0; j < raw_count; ++j) {
-      // Only an edge, a vertex or the rim bounds another element: a face touched by the end
-      // face or the side joins nothing (most pairs of a tube lying in a groove; this loop is
-      // quadratic in them).
-      if (IsFaceMask(a.face_mask) && a.tube != states::TubeElement::kEndRim) break;
       const RawContact& b = m.raw[std::size_t(j)];
       if (i == j || a.part != b.part) continue;
       const bool part_bounds = (a.face_mask & b.face_mask) == b.face_mask;
@@ -579,6 +582,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         a.face_mask = b.face_mask;
         a.part_element = b.part_element;
         a.tube = b.tube;
+        if (joins_nothing(a)) break;
         j = -1;  // its new element may itself be bounded by another's: look again
       }
     }
