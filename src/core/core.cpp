@@ -97,7 +97,11 @@ struct Core::State {
     bool turn_seen = true;
     Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();   // stuck: held here tangentially
     Eigen::Vector3d anchor0_W = Eigen::Vector3d::Zero();  // the anchor before the tick's solve
-    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();    // last tick's force (linearisation)
+    Eigen::Vector3d f_lin_W = Eigen::Vector3d::Zero();    // what last tick's shape was drawn under
+    // The force the shape step (8) drew the tube under: force_W, or the force that pinned the
+    // rod's shape to the points the contacts held. The next tick linearises about that shape, so
+    // about this force (f_lin_W of the load that continues this one).
+    Eigen::Vector3d shape_force_W = Eigen::Vector3d::Zero();
     // Sliding: friction a + b N along slide_dir (f_k(N) linearised at the last normal force;
     // exact for beta = 1, where a = 0 and b = mu_k).
     Eigen::Vector3d slide_dir_W = Eigen::Vector3d::Zero();
@@ -785,7 +789,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       ld.lin_r_H_m = before.r_H_m;
       ld.lin_clamp_m = before.clamp_m;
       if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
-      ld.f_lin_W = before.force_W;
+      ld.f_lin_W = before.shape_force_W;
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
   }
@@ -828,7 +832,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     Load& ghost = m.loads[std::size_t(load_count++)];
     ghost = before;
     ghost.pc = -1;
-    ghost.f_lin_W = before.force_W;
+    ghost.f_lin_W = before.shape_force_W;
     ghost.active = false;
     ghost.released = true;
     ghost.sliding = ghost.shifted = false;
@@ -1594,6 +1598,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
     }
     ld.force_W = f_load_W[std::size_t(i)];
+    ld.shape_force_W = ld.force_W;
     ld.distance_m += ld.normal_W.dot(ld.x_W - ld.x0_W);
     if (!ld.active || !ld.friction) {
       ld.anchor_W = ld.stick_x_W;
@@ -1717,7 +1722,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // tolerance), the loads the shape is drawn under are corrected by Newton with the rod's
     // tangent (each step backtracked until it brings the shape closer) until it passes through
     // those points, if that takes a small change, 1 % of the loads: the shape the tick's system
-    // solved for, under the forces it solved within that. The tick's forces stay as solved.
+    // solved for, under the forces it solved within that. The tick's forces stay as solved,
+    // but the next tick linearises about this shape, so about the forces it was drawn under
+    // (shape_force_W): linearised about the solved forces instead, x = x0 + W (F - F_lin) took
+    // a shape and a force that do not belong together, and the two drifted apart tick by tick
+    // (the rubber tube slid along a wall with its tip stuck and 4 N on it: the pin's change of
+    // the lateral load grew from 0.036 to 0.040 N in four ticks, a quarter of that load, until
+    // it passed the 1 % bound, the pin was refused and the tube snapped, tick 550).
     // Refused (the dead-load shape kept, flagged shape_off as before): a snap, whose shape no
     // small change reaches, and the free end's buckling load itself (within ~10 %), where the
     // dead-load solve is centimetres off and Newton on the forces does not reach the points in
@@ -1811,6 +1822,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         m.rod_segments = m.rod_segments_dead;
         m.nodes_H = m.nodes_dead_H;
         m.rod_segment_count = segments_dead;
+      } else {
+        for (int i = 0, k = 0; i < load_count; ++i)
+          if (m.loads[std::size_t(i)].active)
+            m.loads[std::size_t(i)].shape_force_W = R_WH * m.beam_loads[std::size_t(k++)].f_H_N;
       }
     }
   }
