@@ -765,8 +765,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     if (!(unseen.norm() <= shape_tolerance_m)) return stretch;
     return Eigen::Vector3d(stretch - (unseen - n1 * n1.dot(unseen)));
   };
+  // The face tilted past where its centre of pressure reaches the rim: the collision calls the
+  // contact the rim (or, the rim joined to the side beside it in the band, the side), but last
+  // tick's relaxed centre lagged behind it, and the load point jumped to the rim, turning the
+  // end by the moment's jump in one tick (the rubber tube slid along a wall, ticks 604-605: the
+  // point jumped 1.1 mm at 3.9 N, matched as the side the lateral force fell from 0.105 to
+  // 0.036 N, and the next tick's shape was 14 mm off its contact). Such a load continues the
+  // centre of pressure first, and goes on relaxing towards the rim (the collision's point,
+  // below) until it is there.
+  const double rim_m = scene_.tube.outer_radius_m - 0.1 * eps;
+  const auto continues_centre = [&](const Load& ld, const Load& before) {
+    return ld.tube != states::TubeElement::kEndFace && ld.s_m >= l && before.pressure_centre &&
+           before.cop_H_m.norm() < rim_m;
+  };
   std::array<bool, kMaxLoads> taken{};
-  for (int pass = 0; pass < 2; ++pass) {
+  for (int pass = 0; pass < 3; ++pass) {
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       if (ld.matched) continue;
@@ -775,10 +788,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       for (int q = 0; q < m.prev_count; ++q) {
         const Load& before = m.prev[std::size_t(q)];
         if (taken[std::size_t(q)] || before.part_element != ld.part_element) continue;
-        if (pass == 0 && !before.SameKey(ld)) continue;
+        if (pass == 0 && !continues_centre(ld, before)) continue;
+        if (pass == 1 && !before.SameKey(ld)) continue;
         const double ds = std::abs(before.s_m - ld.s_m);
-        if (pass == 0 || ds <= best_ds) best = q, best_ds = ds;
-        if (pass == 0) break;
+        if (pass < 2 || ds <= best_ds) best = q, best_ds = ds;
+        if (pass < 2) break;
       }
       if (best < 0) continue;
       const Load& before = m.prev[std::size_t(best)];
@@ -790,6 +804,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       ld.lin_clamp_m = before.clamp_m;
       if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.shape_force_W;
+      if (pass == 0) {
+        // Keyed as the face it continues, so that the next tick's face finds it again and the
+        // side beside it, in the band, does not.
+        ld.pressure_centre = true;
+        ld.tube = before.tube;
+      }
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
   }

@@ -105,9 +105,13 @@ TEST_CASE(
   // the face's moment follows its tilt a tick late, outside the tick's system, so there the
   // column snaps sideways (66 degrees at tick 418) and the energy held passes the hand's work at
   // tick 417. On the exact axis nothing breaks the symmetry and the case passes (above).
+  // The snapped tube then strains 0.516, past the linear-elastic 0.5, so the sweep reports the
+  // case outside the model's validity with the passivity failure in its warning: the defect
+  // stays until the warning is empty too.
   const study::StabilityResult r = RunNamed("push into a wall off-plane=0.1mm");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
+  CHECK(r.warning.empty());
 }
 
 TEST_CASE(
@@ -134,19 +138,36 @@ TEST_CASE("Stability: roll over an edge 0.1 mm off its plane", "[stability]") {
   CHECK(r.warning.empty());
 }
 
-TEST_CASE("Stability: slide along a wall (core defect: the column snaps when its pushed tip slips)",
-          "[stability][!mayfail]") {
+TEST_CASE(
+    "Stability: slide along a wall (core defect: the end face's centre-of-pressure law makes "
+    "energy)",
+    "[stability][!mayfail]") {
   // Core defect: the hand pushes the tube's end face onto the wall with ~4 N along its axis and
-  // moves sideways. Stuck, the tip is pinned and the column holds (its buckling load is
-  // 2.05 pi^2 EI / l^2 = 7.4 N); when it slips its only lateral restraint is the kinetic
-  // friction, 0.3 N, and the free-tip buckling load pi^2 EI / (4 l^2) = 0.9 N is far exceeded: the
-  // massless tube snaps to a buckled shape centimetres away. The tick's system, linearised at
-  // the unbuckled state, does not see it; the rod's shape under the solved loads leaves the
-  // contacts (flag shape_off from tick 537), the next ticks chatter between that shape and the
-  // straight one, and at tick 538 the energy held is 2.4 times the hand's work.
+  // moves sideways; the tip stays stuck and the leaning column (its P-Delta moment held by the
+  // coupling) tilts the face. The face presses at its centre of pressure e = tilt (r1^2 + r2^2)
+  // / (4 (eps - d_centre)) with the penalty at that point, K (eps - d_e): a force law that is not
+  // the gradient of any energy, and it makes 0.85 mJ over ticks 275-600 (the energy held minus
+  // the hand's work climbs from -1.01 to -0.16 mJ while the face tilts; it stays flat once the
+  // rim carries the load). At tick 604 the excess passes the slack by 0.07 mJ (22.96 mJ held
+  // against 22.76 mJ put in). With the penalty at the face's centre instead, K (eps - d_centre),
+  // the drift turns to a loss, but the switch to the rim then jumps by K r1 tilt, 3 N, and the
+  // contact chatters between face and rim (docs/accuracy.md).
   const study::StabilityResult r = RunNamed("slide along a wall base");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
+}
+
+TEST_CASE("Stability: slide along a wall, the tube stays on the contact it is pushed onto",
+          "[stability]") {
+  // The slide's column, its tip stuck and 4 N along its axis, is held by its contact: its shape
+  // stays on the points the tick's system held through the whole motion and the hold after it
+  // (core::kShapeOffContacts never raised). Before stop 35 the rod's pinned shape drifted off
+  // its linearisation (tick 552) and, once that was fixed, the load point jumped from the lagging
+  // centre of pressure to the rim (tick 605); each time the tube snapped centimetres sideways.
+  const study::StabilityResult r = RunNamed("slide along a wall base");
+  INFO(r.detail << " | " << r.warning);
+  CHECK(r.first_shape_off_tick == -1);
+  CHECK(r.held_ticks == 0);
 }
 
 TEST_CASE("Stability: roll over an edge, the side pressed on it with stuck friction, then drawn",
