@@ -772,10 +772,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // point jumped 1.1 mm at 3.9 N, matched as the side the lateral force fell from 0.105 to
   // 0.036 N, and the next tick's shape was 14 mm off its contact). Such a load continues the
   // centre of pressure first, and goes on relaxing towards the rim (the collision's point,
-  // below) until it is there.
+  // below) until it is there. So does a rim that follows a face lying flat (from its centre):
+  // with a stiff penalty (K = 1e7 N/m, or eps = 1e-5 m) the centre of pressure reaches the rim
+  // at a tilt of about 1e-4 rad, while the face still counts as flat, and the moment N r1
+  // arrived in one tick (`stability --only "slide along a wall K=1e+07N/m"`, tick 270).
   const double rim_m = scene_.tube.outer_radius_m - 0.1 * eps;
   const auto continues_centre = [&](const Load& ld, const Load& before) {
-    return ld.tube != states::TubeElement::kEndFace && ld.s_m >= l && before.pressure_centre &&
+    return ld.tube != states::TubeElement::kEndFace && ld.s_m >= l &&
+           (before.pressure_centre || before.tube == states::TubeElement::kEndFace) &&
            before.cop_H_m.norm() < rim_m;
   };
   std::array<bool, kMaxLoads> taken{};
