@@ -122,6 +122,8 @@ struct Core::State {
     // from tick to tick (below).
     bool pressure_centre = false;
     Eigen::Vector3d cop_H_m = Eigen::Vector3d::Zero();
+    // Whether the collision found the tube's surface inside the part here.
+    bool overlap = false;
     bool SameKey(const Load& o) const {
       return tube == o.tube && part_element == o.part_element && end == o.end;
     }
@@ -690,6 +692,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // nearest point.
     ld.x0_W = r.p_W_m;
     ld.pressure_centre = r.pressure_centre;
+    ld.overlap = r.overlap;
     const scene::Friction& friction =
         scene::FrictionAt(scene_, elements_[std::size_t(r.part_element)].part_index);
     ld.friction = friction.IsFrictionless() ? nullptr : &friction;
@@ -770,17 +773,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // tick's relaxed centre lagged behind it, and the load point jumped to the rim, turning the
   // end by the moment's jump in one tick (the rubber tube slid along a wall, ticks 604-605: the
   // point jumped 1.1 mm at 3.9 N, matched as the side the lateral force fell from 0.105 to
-  // 0.036 N, and the next tick's shape was 14 mm off its contact). Such a load continues the
-  // centre of pressure first, and goes on relaxing towards the rim (the collision's point,
-  // below) until it is there. So does a rim that follows a face lying flat (from its centre):
-  // with a stiff penalty (K = 1e7 N/m, or eps = 1e-5 m) the centre of pressure reaches the rim
-  // at a tilt of about 1e-4 rad, while the face still counts as flat, and the moment N r1
-  // arrived in one tick (`stability --only "slide along a wall K=1e+07N/m"`, tick 270).
-  const double rim_m = scene_.tube.outer_radius_m - 0.1 * eps;
+  // 0.036 N, and the next tick's shape was 14 mm off its contact). Such a rim, on a face and not
+  // overlapping it (where the collision's centre of pressure applies), continues the active
+  // centre of pressure before any other load, and the centre goes on relaxing towards the rim
+  // (below) until it is within eps/10 of it; a rim that overlaps the face ends it. Not a face
+  // lying flat, loaded at its centre: with a stiff penalty (K = 1e7 N/m) its load then sat near
+  // the centre for hundreds of ticks, the relaxation's step being 1 / (1 + g) with g in the
+  // thousands, while the end pivoted freely and its rim sank into the wall; a fixed step of a
+  // fifth of the way jumped 1.6 mm in the first tick and snapped the tube as before.
+  const double rim_close_m = 0.1 * eps;
   const auto continues_centre = [&](const Load& ld, const Load& before) {
-    return ld.tube != states::TubeElement::kEndFace && ld.s_m >= l &&
-           (before.pressure_centre || before.tube == states::TubeElement::kEndFace) &&
-           before.cop_H_m.norm() < rim_m;
+    if (ld.tube == states::TubeElement::kEndFace || ld.s_m < l || ld.overlap || !before.active ||
+        !before.pressure_centre || !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask))
+      return false;
+    const Eigen::Vector3d rim_H = R_WH.transpose() * (ld.x0_W - m.nodes_W[std::size_t(N)]);
+    return (rim_H - before.cop_H_m).norm() > rim_close_m;
   };
   std::array<bool, kMaxLoads> taken{};
   for (int pass = 0; pass < 3; ++pass) {
