@@ -50,12 +50,16 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       // The end face counts as flat on a face, or the last piece's side as flat on it, when its
       // far side is within a tenth of epsilon of its near side.
       tube_tolerance_m_(0.1 * scene.contact.threshold_m),
-      eps_m_(scene.contact.threshold_m),
-      inner_radius_m_(scene.tube.inner_radius_m) {
+      eps_m_(scene.contact.threshold_m) {
   {
-    const double r1 = scene.tube.outer_radius_m, r2 = scene.tube.inner_radius_m;
-    const double tilt = 4.0 * eps_m_ * r1 / (r1 * r1 + r2 * r2);
-    facing_axis_sq_ = 1.0 - tilt * tilt;
+    const double r1 = scene.tube.outer_radius_m;
+    // The dome's height is the tube's geometric tolerance (the capsules' chord error has the
+    // same bound, ChainCapsuleCount): the cap over the rim circle with it has
+    // R = (r1^2 + h^2) / (2 h).
+    dome_height_m_ = std::min(tube_tolerance_m_, 0.5 * r1);
+    dome_radius_m_ = (r1 * r1 + dome_height_m_ * dome_height_m_) / (2.0 * dome_height_m_);
+    dome_sin_max_ = r1 / dome_radius_m_;
+    facing_axis_sq_ = 1.0 - dome_sin_max_ * dome_sin_max_;
   }
   // FCL's default 1e-6 leaves micrometres of error in d, i.e. 1e-2 N at K = 1e4 N/m.
   solver_.gjk_tolerance = 1e-12;
@@ -783,38 +787,37 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
         const double tilt = axis_W.cross(c.normal_W).norm();  // sin of end face to contact plane
         const bool side_flat = std::abs(axis_W.dot(c.normal_W)) * end_m_ < tube_tolerance_m_;
-        // The end face pressed on a face of the part, slightly tilted: the penalty presses the
-        // annulus like a bed of springs, K (eps - d) growing linearly towards the lowest rim
-        // point. While the whole annulus is within eps the centre of pressure lies at
-        //     e = sin(tilt) (r1^2 + r2^2) / (4 (eps - d_centre))
-        // from the face's centre towards that point (the pressure's first moment over its
-        // resultant); it is an end-face contact loaded there until e reaches the rim, and a rim
-        // contact beyond. So the load point moves continuously from the centre to the rim as
-        // the face tilts, instead of jumping by r1 (a jump of the offset moment r1 N that
-        // swung the rubber tube's tip by 4 cm and back, tick after tick).
+        // The end face pressed on a face of the part, slightly tilted. A flat disc's contact
+        // point jumps by r1 as the tilt changes sign, and the penalty's bed of springs (a centre
+        // of pressure at tilt (r1^2 + r2^2) / (4 (eps - d_centre)) from the centre) is not the
+        // gradient of any energy: a tilting face made energy (docs/accuracy.md). The face is a
+        // spherical cap over the rim circle instead, of height h (the tube's geometric
+        // tolerance) and radius R, and the whole end is moved back along its axis by h, so that
+        // its apex is the face's centre: a convex body, whose lowest point
+        //     e = R sin(tilt) from the centre,  d = d_centre - R (1 - cos(tilt))
+        // moves continuously from the centre to the rim, where it meets the rim's point (its
+        // distance d_rim + h cos(tilt)) at sin(tilt) = r1 / R with the same distance and
+        // normal. K (eps - d)^2 / 2 of the lowest point is then a potential of the end's pose.
         const double radial_m = radial_W.norm();
-        const double indent_centre_m = eps_m_ - (c.distance_m + radius_m_ * tilt);
-        const double pressure_centre_m =
-            indent_centre_m > 0.0
-                ? tilt * (radius_m_ * radius_m_ + inner_radius_m_ * inner_radius_m_) /
-                      (4.0 * indent_centre_m)
-                : std::numeric_limits<double>::infinity();
+        const double cos_tilt = std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
+        const double centre_m = c.distance_m + radius_m_ * tilt;
+        const bool on_face = !side_flat && IsFaceMask(c.face_mask) && !c.overlap;
         bool at_pressure_centre = false;
         if (radial_m < radius_m_ - tube_tolerance_m_) {
           c.tube = states::TubeElement::kEndFace;
-        } else if (!side_flat && IsFaceMask(c.face_mask) && !c.overlap &&
-                   pressure_centre_m < radius_m_) {
+        } else if (on_face && tilt < dome_sin_max_) {
           c.tube = states::TubeElement::kEndFace;
           at_pressure_centre = c.pressure_centre = true;
-          // The load point: the face's centre moved by e towards the lowest rim point.
-          p_tube_W = centre_W + half_m * axis_W +
-                     (radial_m > 0.0 ? (pressure_centre_m / radial_m) * radial_W
-                                     : Eigen::Vector3d::Zero().eval());
-          c.distance_m += radius_m_ * tilt - pressure_centre_m * tilt;  // d where it presses
+          const double e_m = dome_radius_m_ * tilt;
+          p_tube_W =
+              centre_W + half_m * axis_W +
+              (radial_m > 0.0 ? (e_m / radial_m) * radial_W : Eigen::Vector3d::Zero().eval());
+          c.distance_m = centre_m - dome_radius_m_ * (1.0 - cos_tilt);
         } else if (!side_flat && 2.0 * radius_m_ * tilt < tube_tolerance_m_) {
           c.tube = states::TubeElement::kEndFace;
         } else if (!side_flat) {
           c.tube = states::TubeElement::kEndRim;
+          if (on_face) c.distance_m += dome_height_m_ * cos_tilt;
         }
         if (c.tube == states::TubeElement::kEndFace && !at_pressure_centre)
           p_tube_W = centre_W + half_m * axis_W;  // lying flat, or on an edge: the face's centre

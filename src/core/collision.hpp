@@ -123,6 +123,8 @@ class Collision {
   /// The end cylinder's length (at least r1): a point of the end piece is within it plus r1 of
   /// the tip.
   double end_length_m() const { return end_m_; }
+  /// The radius of the dome that stands for the end face on a part's face (collision.cpp).
+  double dome_radius_m() const { return dome_radius_m_; }
 
   /// Narrow-phase evaluations (closed form or GJK) of the last Query, for the benchmarks'
   /// figures; pairs settled by an earlier query's distance (below) are not among them.
@@ -228,11 +230,15 @@ class Collision {
   double end_m_ = 0.0;    // its length, end_pieces_ * piece_m_ >= r1
   double part_tolerance_m_ = 0.0;
   double tube_tolerance_m_ = 0.0;
-  double eps_m_ = 0.0;           // the contact threshold epsilon
-  double inner_radius_m_ = 0.0;  // r2: the end face is an annulus
-  // An end face presses at a centre of pressure only while tilted less than
-  // 4 eps r1 / (r1^2 + r2^2) from a face (collision.cpp): 1 - that squared, the least square of
-  // the end's axis component along a face normal at which it can (above 1: never).
+  double eps_m_ = 0.0;  // the contact threshold epsilon
+  // The end face on a part's face is a spherical cap over the rim, of height dome_height_m_ and
+  // radius dome_radius_m_; it is the lowest point while sin(tilt) < dome_sin_max_ = r1 / R.
+  double dome_height_m_ = 0.0;
+  double dome_radius_m_ = 0.0;
+  double dome_sin_max_ = 0.0;
+  // An end face presses at its dome's lowest point only while sin(tilt) < dome_sin_max_ from a
+  // face (collision.cpp): 1 - that squared, the least square of the end's axis component along a
+  // face normal at which it can.
   double facing_axis_sq_ = 0.0;
   mutable int narrow_calls_ = 0;
   mutable int coherent_skips_ = 0;

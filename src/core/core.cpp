@@ -824,28 +824,35 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
   }
-  // An end face's centre of pressure follows its tilt, and the offset moment it carries tilts
-  // the end in turn: computed from last tick's tilt that loop has the gain
-  //     g = K (r1^2 + r2^2) / 4 * l / (E I)
-  // (the face's rotational stiffness under the penalty over the tube's at its end: 4 for the
-  // rubber tube), and with g > 1 it oscillates with a growing amplitude. Moving the load point
-  // only 1 / (1 + g) of the way from last tick's offset to this tick's target is the Newton
-  // step of that linear loop: it settles in one tick when g is right, and stays stable for any
-  // true gain up to 1 + 2 g.
+  // An end face's load point (the lowest point of its dome, collision.cpp) follows its tilt,
+  // e = R sin(tilt), and the offset moment N e it carries tilts the end in turn: computed from
+  // last tick's tilt that loop has the gain
+  //     g = N R * l / (E I)
+  // (the dome's rotational stiffness under the load N over the tube's at its end), and with
+  // g > 1 it oscillates with a growing amplitude. Moving the load point only 1 / (1 + g) of the
+  // way from last tick's offset to this tick's target is the Newton step of that linear loop:
+  // it settles in one tick when g is right, and stays stable for any true gain up to 1 + 2 g.
+  // N is the force the shape was drawn under (none for a new contact: it starts at its target).
   {
-    const double r1 = scene_.tube.outer_radius_m, r2 = scene_.tube.inner_radius_m;
-    const double gain = K * (r1 * r1 + r2 * r2) / 4.0 * l / m.beam.bending_stiffness_Nm2();
-    const double relax = 1.0 / (1.0 + gain);
+    const double tilt_compliance = m.collision.dome_radius_m() * l / m.beam.bending_stiffness_Nm2();
+    const double half_by_radius = 0.5 / m.collision.dome_radius_m();
     const Eigen::Vector3d& tip_W = m.nodes_W[std::size_t(N)];
+    const Eigen::Vector3d end_axis_W = tangent_at(l);
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       if (!ld.pressure_centre || ld.ghost) continue;
+      const double relax =
+          1.0 / (1.0 + std::max(0.0, ld.f_lin_W.dot(ld.normal_W)) * tilt_compliance);
       const Eigen::Vector3d target_H = R_WH.transpose() * (ld.x0_W - tip_W);
       const Eigen::Vector3d step_H = relax * (target_H - ld.cop_H_m);
       ld.cop_H_m += step_H;
       const Eigen::Vector3d x0_W = tip_W + R_WH * ld.cop_H_m;
-      // The end face is planar: the distance at the new point differs along the normal.
-      ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W);
+      // The distance at the dome's point there: the face plane's change along the normal, and
+      // the dome's fall from its apex, |x|^2 / (2 R) along the axis (cos(tilt) along the
+      // normal), at the new point less at the old.
+      ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W) +
+                       std::abs(ld.normal_W.dot(end_axis_W)) *
+                           (ld.cop_H_m.squaredNorm() - target_H.squaredNorm()) * half_by_radius;
       // The pressure moves over the face, the material does not slip: the stretch stays.
       ld.anchor_W += x0_W - ld.x0_W;
       ld.x0_W = x0_W;
