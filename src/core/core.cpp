@@ -768,18 +768,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     if (!(unseen.norm() <= shape_tolerance_m)) return stretch;
     return Eigen::Vector3d(stretch - (unseen - n1 * n1.dot(unseen)));
   };
-  // The face tilted past where its centre of pressure reaches the rim: the collision calls the
-  // contact the rim (or, the rim joined to the side beside it in the band, the side), but last
-  // tick's relaxed centre lagged behind it, and the load point jumped to the rim, turning the
-  // end by the moment's jump in one tick (the rubber tube slid along a wall, ticks 604-605: the
-  // point jumped 1.1 mm at 3.9 N, matched as the side the lateral force fell from 0.105 to
-  // 0.036 N, and the next tick's shape was 14 mm off its contact). Such a rim, on a face and not
-  // overlapping it (where the collision's centre of pressure applies), continues the active
-  // centre of pressure before any other load, and the centre goes on relaxing towards the rim
-  // (below) until it is within eps/10 of it; a rim that overlaps the face ends it. Not a face
-  // lying flat, loaded at its centre: with a stiff penalty (K = 1e7 N/m) its load then sat near
-  // the centre for hundreds of ticks, the relaxation's step being 1 / (1 + g) with g in the
-  // thousands, while the end pivoted freely and its rim sank into the wall; a fixed step of a
+  // The face tilted past where its load point (its centre of pressure before stop 36, its dome's
+  // lowest point since) reaches the rim: the collision calls the contact the rim (or, the rim
+  // joined to the side beside it in the band, the side), but last tick's relaxed point lagged
+  // behind it, and the load point jumped to the rim, turning the end by the moment's jump in one
+  // tick (the rubber tube slid along a wall, ticks 604-605: the point jumped 1.1 mm at 3.9 N,
+  // matched as the side the lateral force fell from 0.105 to 0.036 N, and the next tick's shape was
+  // 14 mm off its contact). Such a rim, on a face and not overlapping it (where the collision's
+  // dome applies), continues the active relaxed point before any other load, and the point goes on
+  // relaxing towards the rim (below) until the last step to it changes the load's force by at most
+  // 1 %: within min(eps/10, 0.01 N / K) of it (within eps/10, a K = 1e7 N/m slide's continuation
+  // ended with its distance stepping by 0.093 mm, 930 N of penalty; the contact opened and the tube
+  // sprang into the wall, held back for the last 97 ticks). A rim that overlaps the face ends it.
+  // Not a face lying flat, loaded at its centre: with a stiff penalty (K = 1e7 N/m) its load then
+  // sat near the centre for hundreds of ticks, the relaxation's step being 1 / (1 + g) with g in
+  // the thousands, while the end pivoted freely and its rim sank into the wall; a fixed step of a
   // fifth of the way jumped 1.6 mm in the first tick and snapped the tube as before.
   const double rim_close_m = 0.1 * eps;
   const auto continues_centre = [&](const Load& ld, const Load& before) {
@@ -787,7 +790,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         !before.pressure_centre || !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask))
       return false;
     const Eigen::Vector3d rim_H = R_WH.transpose() * (ld.x0_W - m.nodes_W[std::size_t(N)]);
-    return (rim_H - before.cop_H_m).norm() > rim_close_m;
+    const double N_before = before.shape_force_W.dot(before.normal_W);
+    const double close_m =
+        N_before > 0.0 ? std::min(rim_close_m, 0.01 * N_before / K) : rim_close_m;
+    return (rim_H - before.cop_H_m).norm() > close_m;
   };
   std::array<bool, kMaxLoads> taken{};
   for (int pass = 0; pass < 3; ++pass) {
