@@ -31,7 +31,8 @@ struct RawContact {
   /// whose axis is outside the part, else 0.
   double distance_m = 0.0;
   bool overlap = false;
-  /// An end face pressed on a face, tilted: p_W_m is its centre of pressure (collision.cpp).
+  /// An end face pressed on a face within its dome's tilt: p_W_m is the dome's lowest point, on
+  /// the face plane (collision.cpp; the field keeps the name of the centre of pressure it was).
   bool pressure_centre = false;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
@@ -115,9 +116,9 @@ class Collision {
   /// close this tick is in its system, and one releasing leaves smoothly).
   ///
   /// `idle` (optional) names parts that may be left out; see IdleParts. An end piece within the
-  /// band of a part it could face (its axis within the tilt at which an end face presses at a
-  /// centre of pressure, collision.cpp) keeps that part in: such a contact carries its centre
-  /// of pressure from tick to tick.
+  /// band of a part it could face (its axis within the tilt at which an end face presses at its
+  /// dome's lowest point, collision.cpp) keeps that part in: such a contact carries its relaxed
+  /// point from tick to tick.
   int Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vector3d& tip_tangent_W,
             double band_m, std::span<RawContact> out, IdleParts* idle = nullptr) const;
   /// The end cylinder's length (at least r1): a point of the end piece is within it plus r1 of

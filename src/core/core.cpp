@@ -118,8 +118,8 @@ struct Core::State {
     bool continues = false;
     double lin_s_m = 0.0, lin_clamp_m = 0.0, clamp_m = 0.0;
     Eigen::Vector3d lin_r_H_m = Eigen::Vector3d::Zero();
-    // An end face's centre of pressure: its offset from the face's centre (frame H), relaxed
-    // from tick to tick (below).
+    // An end face's load point (its dome's lowest point; its centre of pressure before stop 36):
+    // its offset from the face's centre (frame H), relaxed from tick to tick (below).
     bool pressure_centre = false;
     Eigen::Vector3d cop_H_m = Eigen::Vector3d::Zero();
     // Whether the collision found the tube's surface inside the part here.
@@ -553,7 +553,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   if (leave_out_idle) {
     std::fill(m.may_leave_out.begin(), m.may_leave_out.end(), std::uint8_t{1});
     for (int q = 0; q < m.prev_count; ++q) {
-      // A load that carried force is in this tick's system; an end face's centre of pressure is
+      // A load that carried force is in this tick's system; an end face's relaxed load point is
       // carried to the next tick even while open.
       const Load& before = m.prev[std::size_t(q)];
       if (before.part_element >= 0 &&
@@ -687,7 +687,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     ld.s_m = r.tube == states::TubeElement::kSide ? std::clamp(r.s_m, 0.0, l) : l;
     ld.distance_m = r.distance_m;
     ld.normal_W = r.normal_W;
-    // An end face pressed on a face presses at its centre of pressure (collision.cpp: the face's
+    // An end face pressed on a face presses at its dome's lowest point (collision.cpp: the face's
     // centre when it lies flat, moving towards the rim as it tilts), wherever GJK put its
     // nearest point.
     ld.x0_W = r.p_W_m;
@@ -730,7 +730,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // into the new tangent plane, plus what the material under last tick's point moved that the
   // tick's system did not see (its motion in the shape drawn from the solved loads, less the
   // motion the system predicted and the spring already counted; e.g. the bending by an end
-  // face's moment as its centre of pressure moves). Within the tick the point moves with the
+  // face's moment as its load point moves). Within the tick the point moves with the
   // material (x = x0 + the tick's motion), so the stretch grows by the material's tangential
   // motion there and by nothing else.
   const auto tangent_at = [&](double s_m) {
@@ -795,7 +795,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         N_before > 0.0 ? std::min(rim_close_m, 0.01 * N_before / K) : rim_close_m;
     return (rim_H - before.cop_H_m).norm() > close_m;
   };
+  // And back: the face tilting back under the dome's range while the rim carried the load (a
+  // slide reversed). The rim's load, matched by its key, went to the last capsule's side in the
+  // band, and the face's new point started from nothing at its target, unrelaxed: the tube
+  // snapped (the base slide driven back, tick 1494, 2.3 mJ over the slack; found in review). The
+  // face continues the rim's active load, its point relaxing from the rim's.
+  const auto continues_rim = [&](const Load& ld, const Load& before) {
+    return ld.pressure_centre && ld.tube == states::TubeElement::kEndFace && !ld.overlap &&
+           before.active && !before.pressure_centre && !before.ghost && before.s_m >= l;
+  };
   std::array<bool, kMaxLoads> taken{};
+  // Loads that continue a face's point with the rim as its target (pass 0, above).
+  std::array<bool, kMaxLoads> on_rim{};
   for (int pass = 0; pass < 3; ++pass) {
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
@@ -805,7 +816,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       for (int q = 0; q < m.prev_count; ++q) {
         const Load& before = m.prev[std::size_t(q)];
         if (taken[std::size_t(q)] || before.part_element != ld.part_element) continue;
-        if (pass == 0 && !continues_centre(ld, before)) continue;
+        if (pass == 0 && !continues_centre(ld, before) && !continues_rim(ld, before)) continue;
         if (pass == 1 && !before.SameKey(ld)) continue;
         const double ds = std::abs(before.s_m - ld.s_m);
         if (pass < 2 || ds <= best_ds) best = q, best_ds = ds;
@@ -821,11 +832,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       ld.lin_clamp_m = before.clamp_m;
       if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.shape_force_W;
-      if (pass == 0) {
+      if (pass == 0 && !ld.pressure_centre) {
         // Keyed as the face it continues, so that the next tick's face finds it again and the
         // side beside it, in the band, does not.
         ld.pressure_centre = true;
         ld.tube = before.tube;
+        on_rim[std::size_t(i)] = true;
+      } else if (pass == 0) {
+        ld.cop_H_m = before.r_H_m;  // a face continuing the rim: from the rim's point
       }
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
@@ -856,9 +870,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       // The distance at the dome's point there: the face plane's change along the normal, and
       // the dome's fall from its apex, |x|^2 / (2 R) along the axis (cos(tilt) along the
       // normal), at the new point less at the old.
-      ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W) +
-                       std::abs(ld.normal_W.dot(end_axis_W)) *
-                           (ld.cop_H_m.squaredNorm() - target_H.squaredNorm()) * half_by_radius;
+      // A rim continuing the face's point keeps the rim's own distance: the face plane's at the
+      // lagging point lies farther by the lag times sin(tilt), to first order (0.13 mm, 1.3 N of
+      // 3.7 N, in the base slide; found in review), where the dome's is within |lag|^2 / 2R.
+      if (!on_rim[std::size_t(i)])
+        ld.distance_m += ld.normal_W.dot(x0_W - ld.x0_W) +
+                         std::abs(ld.normal_W.dot(end_axis_W)) *
+                             (ld.cop_H_m.squaredNorm() - target_H.squaredNorm()) * half_by_radius;
       // The pressure moves over the face, the material does not slip: the stretch stays.
       ld.anchor_W += x0_W - ld.x0_W;
       ld.x0_W = x0_W;

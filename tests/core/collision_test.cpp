@@ -234,7 +234,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   // A third with the same history that may leave every part out (the core's IdleParts, at a
   // floor of epsilon): each contact of a part it left out must lie in one of its groups, at
   // least the group's gap away, no farther along the tube than its s_max, with a normal in its
-  // span; and no end face at a centre of pressure is left out.
+  // span; and no end face at its dome's lowest point is left out.
   const core::Collision idle(s, parts, capsules, element_of);
   const std::vector<std::uint8_t> may_leave_out(s.parts.size(), 1);
   std::array<core::RawContact, core::kMaxRawContacts> got_idle{};
