@@ -201,6 +201,22 @@ struct TubePose {
   double bend_rad = 0.0;
 };
 
+// The shipped groove scene (its tube, contact law and parts).
+scene::Scene GrooveScene() {
+  io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene.has_value());
+  return *loaded.scene;
+}
+
+// Each face mask its own element: the contacts carry the mask twice.
+std::vector<std::array<int, 64>> MaskElements(std::size_t parts) {
+  std::vector<std::array<int, 64>> element_of(parts);
+  for (auto& table : element_of)
+    for (int m = 0; m < 64; ++m) table[std::size_t(m)] = m;
+  return element_of;
+}
+
 }  // namespace
 
 TEST_CASE("Distances kept from earlier queries change no contact, and leave out only idle parts",
@@ -210,10 +226,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   // query, jumps across the scene, jumps back to an earlier pose, the band changing), its
   // contacts must be those of a Collision that has never queried, bit for bit. The groove
   // scene, plus a tilted block on the floor (rotated part, edges and vertices nearest, GJK).
-  io::SceneLoadResult loaded =
-      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
-  REQUIRE(loaded.scene.has_value());
-  scene::Scene s = *loaded.scene;
+  scene::Scene s = GrooveScene();
   scene::BoxPart block;
   block.name = "block";
   block.size_m = Eigen::Vector3d(0.012, 0.03, 0.012);
@@ -224,10 +237,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   s.parts.push_back(block);
   std::vector<std::uint32_t> parts;
   for (std::uint32_t p = 0; p < s.parts.size(); ++p) parts.push_back(p);
-  // Each face mask its own element: the contacts carry the mask twice.
-  std::vector<std::array<int, 64>> element_of(s.parts.size());
-  for (auto& table : element_of)
-    for (int m = 0; m < 64; ++m) table[std::size_t(m)] = m;
+  const std::vector<std::array<int, 64>> element_of = MaskElements(s.parts.size());
   const int capsules = 24;
   const double piece_m = s.tube.length_m / capsules;
   const core::Collision kept(s, parts, capsules, element_of);
@@ -364,10 +374,7 @@ TEST_CASE("A centreline deeper than r1/2 in a part is found, by every fourth nod
   // part's box, with or without the promise of the spacing (which bounds the nodes by every
   // fourth). Near misses are common: poses are drawn so that the deepest node lies within a few
   // millimetres of the threshold.
-  io::SceneLoadResult loaded =
-      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
-  REQUIRE(loaded.scene.has_value());
-  const scene::Scene& s = *loaded.scene;
+  const scene::Scene s = GrooveScene();
   std::vector<std::uint32_t> parts;
   for (std::uint32_t p = 0; p < s.parts.size(); ++p) parts.push_back(p);
   std::vector<std::array<int, 64>> element_of(s.parts.size());
@@ -446,10 +453,7 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   // the wall is C + R n (n the wall's normal into it) while that lies in the cap, the rim's
   // lowest point (moved back by h) beyond: computed here as vectors, not by the collision's
   // scalar formulas.
-  io::SceneLoadResult loaded =
-      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
-  REQUIRE(loaded.scene.has_value());
-  scene::Scene s = *loaded.scene;
+  scene::Scene s = GrooveScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m;
   const double h = 0.1 * s.contact.threshold_m, R = (r1 * r1 + h * h) / (2.0 * h);
   const double d_c = 0.6e-3, wall_z = 0.5;  // the rim stays out of the wall to 0.07 rad
@@ -460,10 +464,8 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   wall.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, wall_z + 0.01);
   s.parts.push_back(wall);
   const std::vector<std::uint32_t> parts{0};
-  std::vector<std::array<int, 64>> element_of(1);
-  for (int m = 0; m < 64; ++m) element_of[0][std::size_t(m)] = m;
   const int capsules = 24;
-  const core::Collision collision(s, parts, capsules, element_of);
+  const core::Collision collision(s, parts, capsules, MaskElements(1));
   CHECK(collision.dome_radius_m() == Approx(R).epsilon(1e-12));
   const Eigen::Vector3d F(0.0, 0.0, wall_z - d_c), n = Eigen::Vector3d::UnitZ();
   struct End {
