@@ -163,12 +163,14 @@ TEST_CASE("A soft tube's end face pressed on a wall resists its tilt: N R, the d
   CHECK_FALSE(out.contacts[0].sliding);
   const double N = out.contacts[0].normal_force_N;
   const double k_face = 1.0 / (1.0 / 400.0 + EndFaceTipCompliance(s, N) + 1.0 / 1e4);
-  // 2 %: the closed form takes the tilt small (0.3 degrees here: the dome's e = R sin(tilt) and
-  // the linear beam) and N as it is now; the point contact's answer is 57 % lower, far outside.
+  // 0.1 %: the closed form takes the tilt small (0.3 degrees here: the dome's e = R sin(tilt)
+  // against R tilt, 1e-5) and N as it is now (the tilt's change of N over the last ticks, held);
+  // measured 2e-5. The point contact's answer is 57 % lower, far outside; a dome 1.3 times as
+  // high is 7.8 % off.
   // The coupling and the penalty in series, the face 0.5 mm from the wall and the hand 1 mm in:
   // 400 N/m (1 mm - p) = 1e4 N/m (0.5 mm + p), N = 0.577 N (2 %: the tilt moves the face).
   CHECK(N == Approx(400.0 * 1e4 * 1.5e-3 / (400.0 + 1e4)).epsilon(0.02));
-  CHECK(-out.force_W_N.x() == Approx(0.5e-3 * k_face).epsilon(0.02));
+  CHECK(-out.force_W_N.x() == Approx(0.5e-3 * k_face).epsilon(1e-3));
   CHECK(-out.force_W_N.x() > 2.0 * 0.5e-3 * k_point);
 }
 
