@@ -77,11 +77,14 @@ int RunStability(const StabilityOptions& o, Streams io) {
         if (it != cell.end()) {
           const study::StabilityResult& r = *it->second;
           // "coupled": judged with the coupled rule, the segmented one outside its range;
-          // "held": the core held the tube back from going through a part in some ticks.
+          // "held": the core held the tube back from going through a part in some ticks;
+          // "shape off": a pass whose shape left the points its contacts held (a FAIL's line
+          // below says so): the checks passed a replay that is not the tube's motion there.
           std::string notes;
           for (const auto& [on, note] :
                {std::pair{r.judged_coupled, "coupled"}, std::pair{r.outside, "outside"},
-                std::pair{r.held_ticks > 0, "held"}})
+                std::pair{r.held_ticks > 0, "held"},
+                std::pair{r.pass && r.first_shape_off_tick >= 0, "shape off"}})
             if (on) notes += (notes.empty() ? "" : ", ") + std::string(note);
           text = (r.pass ? "pass" : "FAIL @" + std::to_string(r.first_failing_tick)) +
                  (notes.empty() ? "" : " (" + notes + ")");
