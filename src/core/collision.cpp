@@ -528,9 +528,8 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
   return true;
 }
 
-bool Collision::AxisDeeperThan(std::span<const Eigen::Vector3d> nodes_H,
-                               const Eigen::Matrix3d& R_WH, const Eigen::Vector3d& p_WH,
-                               double depth_m, double spacing_m) const {
+bool Collision::AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eigen::Matrix3d& R_WH,
+                            const Eigen::Vector3d& p_WH, double depth_m, double spacing_m) const {
   // The nodes' bounding box in frame H, then per part the box that contains it in the part's
   // frame; only a part that box reaches deep enough into is tried node by node. With nodes at
   // most spacing_m apart, every node lies within two spacings of one of every fourth node (and
@@ -555,17 +554,51 @@ bool Collision::AxisDeeperThan(std::span<const Eigen::Vector3d> nodes_H,
   for (const Part& part : parts_) {
     // A node deeper than depth_m has |q| < half - depth_m along every axis of the part.
     const Eigen::Vector3d inner_m = part.half_m - Eigen::Vector3d::Constant(depth_m);
-    if (!(inner_m.array() > 0.0).all()) continue;
+    // A part no deeper than that along one axis (a sheet) has no such inside: the axis goes
+    // through it where it crosses from beyond one of its faces to beyond the opposite one, more
+    // than depth_m inside its other faces (a tube folded round the sheet's edge does not).
+    int thin_axis = -1, thin_count = 0;
+    for (int a = 0; a < 3; ++a)
+      if (!(inner_m[a] > 0.0)) thin_axis = a, ++thin_count;
+    if (thin_count > 1) continue;  // a rod or a speck: no face to cross through
+    const bool sheet = thin_count == 1;
+    const Eigen::Vector3d reject_m = sheet ? part.half_m : inner_m;
     const Eigen::Matrix3d R_PH = part.R_PW * R_WH;
     const Eigen::Vector3d p_PH = part.R_PW * p_WH + part.p_PW;
     const Eigen::Vector3d reach_P = R_PH.cwiseAbs() * half_H;
-    if ((((R_PH * centre_H + p_PH).cwiseAbs() - reach_P).array() >= inner_m.array()).any())
+    if ((((R_PH * centre_H + p_PH).cwiseAbs() - reach_P).array() >= reject_m.array()).any())
       continue;
-    for (const Eigen::Vector3d& x : nodes_H) {
-      const Eigen::Vector3d q = R_PH * x + p_PH;
-      if (std::abs(q.x()) < inner_m.x() && std::abs(q.y()) < inner_m.y() &&
-          std::abs(q.z()) < inner_m.z())
-        return true;
+    if (!sheet) {
+      for (const Eigen::Vector3d& x : nodes_H) {
+        const Eigen::Vector3d q = R_PH * x + p_PH;
+        if (std::abs(q.x()) < inner_m.x() && std::abs(q.y()) < inner_m.y() &&
+            std::abs(q.z()) < inner_m.z())
+          return true;
+      }
+      continue;
+    }
+    // The sheet: walking the nodes, the side of the last node beyond a face (0 before any), and
+    // whether the centreline has crossed the mid-plane inside the other faces since it.
+    if (nodes_H.empty()) continue;
+    const int a = thin_axis, b = (a + 1) % 3, c = (a + 2) % 3;
+    const double half_a = part.half_m[a];
+    int side = 0;
+    bool crossed = false;
+    Eigen::Vector3d q_prev = R_PH * nodes_H[0] + p_PH;
+    for (std::size_t k = 0; k < nodes_H.size(); ++k) {
+      const Eigen::Vector3d q = k == 0 ? q_prev : (R_PH * nodes_H[k] + p_PH).eval();
+      if (k > 0 && (q_prev[a] < 0.0) != (q[a] < 0.0)) {
+        const double t = q_prev[a] / (q_prev[a] - q[a]);  // in [0, 1]: the signs differ
+        const Eigen::Vector3d at = q_prev + t * (q - q_prev);
+        if (std::abs(at[b]) < inner_m[b] && std::abs(at[c]) < inner_m[c]) crossed = true;
+      }
+      const int here = q[a] >= half_a ? 1 : (q[a] <= -half_a ? -1 : 0);
+      if (here != 0) {
+        if (crossed && side == -here) return true;
+        side = here;  // the same side again: back out where it came in, not through
+        crossed = false;
+      }
+      q_prev = q;
     }
   }
   return false;

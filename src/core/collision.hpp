@@ -134,15 +134,18 @@ class Collision {
   /// band by a distance an earlier Query computed (temporal coherence, collision.cpp).
   int last_coherent_skips() const { return coherent_skips_; }
 
-  /// Whether a node of the centreline `nodes_H` (held-end frame H), placed by (R_WH, p_WH), lies
-  /// deeper than `depth_m` inside a part: past every face plane by more than that. The core keeps
-  /// the tube from going there (docs/core.md, "Through a part"). A part thinner than 2 depth_m
-  /// has no such inside. The nodes' bounding box is tried against each part first, so a tube
-  /// nowhere near that deep costs a box test a part. `spacing_m` > 0 promises that consecutive
-  /// nodes are at most that far apart (a shape that keeps its length: the elastica's, the rod's);
-  /// the box is then taken over every fourth node and grown by twice it, a quarter of the work.
-  bool AxisDeeperThan(std::span<const Eigen::Vector3d> nodes_H, const Eigen::Matrix3d& R_WH,
-                      const Eigen::Vector3d& p_WH, double depth_m, double spacing_m = 0.0) const;
+  /// Whether the centreline `nodes_H` (held-end frame H), placed by (R_WH, p_WH), goes through a
+  /// part: a node lies deeper than `depth_m` inside it (past every face plane by more than
+  /// that), or, for a part no thicker than 2 depth_m along one axis (a sheet, which has no such
+  /// inside), the centreline crosses it from beyond one face to beyond the opposite one, more
+  /// than `depth_m` inside its other faces. The core keeps the tube from going there
+  /// (docs/core.md, "Through a part"). The nodes' bounding box is tried against each part
+  /// first, so a tube nowhere near it costs a box test a part. `spacing_m` > 0 promises that
+  /// consecutive nodes are at most that far apart (a shape that keeps its length: the elastica's,
+  /// the rod's); the box is then taken over every fourth node and grown by twice it, a quarter of
+  /// the work.
+  bool AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eigen::Matrix3d& R_WH,
+                   const Eigen::Vector3d& p_WH, double depth_m, double spacing_m = 0.0) const;
 
   /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
   /// its narrow-phase count does: the core forgets them when it is reset or restored, so that

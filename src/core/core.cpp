@@ -162,8 +162,8 @@ struct Core::State {
   int rod_tangent_members = 0, rod_tangent_age = 0;
   double held_off_load_N = 0.0;
   std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
-  // The shape already had a centreline point more than r1 / 2 inside a part (a scene or a reset
-  // that starts there): there is no state out of the part to hold the tube in, so none is held.
+  // The shape already went through a part (Collision::AxisThrough; a scene or a reset that
+  // starts there): there is no state out of the part to hold the tube in, so none is held.
   bool axis_inside = false;
   // The flags of the shape last sent (linear fallback, beyond the linear range, rod, shape off
   // its contacts): a tick held back sends that shape again, with them.
@@ -463,7 +463,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.rod_tangent_members = 0;
   m.collision.ForgetDistances();
   m.shape_flags = 0;
-  m.axis_inside = m.collision.AxisDeeperThan(
+  m.axis_inside = m.collision.AxisThrough(
       std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(capsule_count_) + 1),
       X_WH.linear(), X_WH.translation(), 0.5 * scene_.tube.outer_radius_m);
   out_ = StepOutput{};
@@ -2025,8 +2025,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   }
 
   // Through a part: the tick's shape puts a centreline point more than r1 / 2 inside a part
-  // (there the tube is going through it: the penalty pressed its surface in by 1.5 r1), from a
-  // shape that did not. The proxy is placed where the contacts allow (issue 3): the tube is not
+  // (there the tube is going through it: the penalty pressed its surface in by 1.5 r1), or its
+  // centreline across a sheet thinner than r1 (the fast pass's 1 mm wall, which has no such
+  // inside: a buckled tube that snapped back straight went through it), from a shape that did
+  // not. The proxy is placed where the contacts allow (issue 3): the tube is not
   // moved there. It stays as it was, the held end too, and the operator feels the coupling's
   // spring and damper stretched from the held end to the hand, up to the device's force: a wall.
   // The tick's loads were solved with a compliance its shape did not follow (the segmented
@@ -2039,7 +2041,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const double spacing_m = (m.elastica_shape || m.rod_shape) ? 1.1 * l / N : 0.0;
   // Judged whether or not the guard is on, so that a shape already inside when it is turned on
   // (or restored from a snapshot of a core without it) is not held.
-  const bool inside = m.collision.AxisDeeperThan(
+  const bool inside = m.collision.AxisThrough(
       std::span<const Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1), R_WH_new, p_W,
       0.5 * scene_.tube.outer_radius_m, spacing_m);
   if (m.hold_out_of_parts && inside && !m.axis_inside && p_W.allFinite() && R_WH_new.allFinite()) {

@@ -1,6 +1,7 @@
 // The core's closed-form distances against FCL's GJK, an independent method.
 #include "core/collision.hpp"  // private to the core (src/)
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cmath>
@@ -415,8 +416,8 @@ TEST_CASE("A centreline deeper than r1/2 in a part is found, by every fourth nod
     (expected ? inside : outside) += 1;
     near += std::abs(deepest - depth) < 2e-3 ? 1 : 0;
     INFO("trial " << trial << ": deepest node " << deepest * 1e3 << " mm");
-    CHECK(collision.AxisDeeperThan(nodes, R_WH, p_WH, depth) == expected);
-    CHECK(collision.AxisDeeperThan(nodes, R_WH, p_WH, depth, h) == expected);
+    CHECK(collision.AxisThrough(nodes, R_WH, p_WH, depth) == expected);
+    CHECK(collision.AxisThrough(nodes, R_WH, p_WH, depth, h) == expected);
   }
   // Random curves seldom put their deepest node exactly where only the growth, or only the last
   // node, reaches: two made so, over the floor (its top at z = 0, deeper than r1/2 = 4 mm is
@@ -429,19 +430,92 @@ TEST_CASE("A centreline deeper than r1/2 in a part is found, by every fourth nod
                                          Eigen::Vector3d(0, 0, -2 * h), Eigen::Vector3d(0, 0, -h),
                                          Eigen::Vector3d(0, 0, 0)};
   const Eigen::Vector3d fold_at(0.0, 0.0, -4.5e-3 + 2 * h);  // its tip 0.5 mm past r1/2
-  CHECK(collision.AxisDeeperThan(fold, I, fold_at, depth));
-  CHECK(collision.AxisDeeperThan(fold, I, fold_at, depth, h));
-  CHECK_FALSE(collision.AxisDeeperThan(fold, I, fold_at + Eigen::Vector3d(0, 0, 1e-3), depth, h));
+  CHECK(collision.AxisThrough(fold, I, fold_at, depth));
+  CHECK(collision.AxisThrough(fold, I, fold_at, depth, h));
+  CHECK_FALSE(collision.AxisThrough(fold, I, fold_at + Eigen::Vector3d(0, 0, 1e-3), depth, h));
   std::array<Eigen::Vector3d, 8> hook;
   for (int k = 0; k < 8; ++k)
     hook[std::size_t(k)] = Eigen::Vector3d(h * std::min(k, 4), 0.0, -h * std::max(0, k - 4));
   const Eigen::Vector3d hook_at(0.0, 0.0, -4.5e-3 + 3 * h);
-  CHECK(collision.AxisDeeperThan(hook, I, hook_at, depth));
-  CHECK(collision.AxisDeeperThan(hook, I, hook_at, depth, h));
+  CHECK(collision.AxisThrough(hook, I, hook_at, depth));
+  CHECK(collision.AxisThrough(hook, I, hook_at, depth, h));
   INFO(inside << " inside, " << outside << " outside, " << near << " within 2 mm of r1/2");
   CHECK(inside > 200);
   CHECK(outside > 200);
   CHECK(near > 50);
+}
+
+TEST_CASE("A centreline through a sheet is found: from beyond one face to beyond the other",
+          "[core][collision]") {
+  // A part 1 mm thick has no inside deeper than r1/2 = 4 mm (the groove's tube), so a tube whose
+  // shape snapped through it (the stability sweep's fast pass through a 1 mm wall, before this)
+  // was never held. Through it is: the centreline crossing its mid-plane more than r1/2 inside
+  // its other faces, from a node beyond one face to a node beyond the other. The sheet is
+  // 60 x 40 x 1 mm, tilted; the curves are made in its frame P (z along its normal) and placed
+  // by a pose of the held end, so the answer comes through the same frames as the core's.
+  scene::Scene s = GrooveScene();
+  const double r1 = s.tube.outer_radius_m, depth = 0.5 * r1, spacing = 2e-3;
+  s.parts.clear();
+  scene::BoxPart sheet;
+  sheet.name = "sheet";
+  sheet.size_m = Eigen::Vector3d(0.06, 0.04, 1e-3);
+  sheet.X_WP.linear() = scene::RotationFromRpy({0.3, -0.2, 0.7});
+  sheet.X_WP.translation() = Eigen::Vector3d(0.01, -0.02, 0.05);
+  s.parts.push_back(sheet);
+  const std::vector<std::uint32_t> parts = {0};
+  const core::Collision collision(s, parts, 48, MaskElements(1));
+  const Eigen::Matrix3d R_WH = scene::RotationFromRpy({-0.4, 0.5, 0.1});
+  const Eigen::Vector3d p_WH(0.002, 0.003, -0.001);
+  // Node k of a curve given in P at points p_P(k), in frame H.
+  const auto through = [&](const std::vector<Eigen::Vector3d>& points_P) {
+    std::vector<Eigen::Vector3d> nodes_H;
+    for (const Eigen::Vector3d& p_P : points_P)
+      nodes_H.push_back(R_WH.transpose() * (sheet.X_WP * p_P - p_WH));
+    const bool all = collision.AxisThrough(nodes_H, R_WH, p_WH, depth);
+    // The same answer with the spacing promised (its box test over every fourth node).
+    CHECK(collision.AxisThrough(nodes_H, R_WH, p_WH, depth, spacing * 1.01) == all);
+    return all;
+  };
+  // A straight line along the normal at (x, y), nodes `spacing` apart from z0 for `count`.
+  const auto line = [&](double x, double y, double z0, int count) {
+    std::vector<Eigen::Vector3d> points;
+    for (int k = 0; k < count; ++k) points.emplace_back(x, y, z0 + spacing * k);
+    return points;
+  };
+  // Through the middle: with a node in the sheet (z = 0) and with none (nodes at -1 and +1 mm).
+  CHECK(through(line(0.0, 0.0, -0.01, 11)));
+  CHECK(through(line(0.0, 0.0, -0.009, 10)));
+  // Backwards (from the far side): through as well.
+  std::vector<Eigen::Vector3d> back = line(0.0, 0.0, -0.009, 10);
+  std::reverse(back.begin(), back.end());
+  CHECK(through(back));
+  // Its end in the sheet, 0.2 mm short of the far face: pressed in, not through.
+  CHECK_FALSE(through(line(0.0, 0.0, -0.0098, 6)));
+  // Crossing 3 mm inside the sheet's edge (x = 27 mm of 30, y = 17 of 20): within r1/2 of it, as a
+  // tube bent round the edge would; 5 mm inside it: through.
+  CHECK_FALSE(through(line(0.027, 0.0, -0.009, 10)));
+  CHECK(through(line(0.025, 0.0, -0.009, 10)));
+  CHECK_FALSE(through(line(0.0, -0.017, -0.009, 10)));  // the same along y (20 mm)
+  CHECK(through(line(0.0, -0.015, -0.009, 10)));
+  // Beside the sheet altogether (x = 40 mm): never through.
+  CHECK_FALSE(through(line(0.04, 0.0, -0.009, 10)));
+  // A hairpin: down into the sheet to 0.2 mm short of its far face and back out the side it came
+  // from; and one that goes on beyond the far face before turning back: that one went through.
+  std::vector<Eigen::Vector3d> hairpin = line(0.0, 0.0, -0.0098, 6);
+  for (int k = 4; k >= 0; --k)
+    hairpin.push_back(hairpin[std::size_t(k)] + Eigen::Vector3d(0.001, 0, 0));
+  CHECK_FALSE(through(hairpin));
+  std::vector<Eigen::Vector3d> beyond = line(0.0, 0.0, -0.009, 7);  // to z = +3 mm
+  for (int k = 5; k >= 0; --k)
+    beyond.push_back(beyond[std::size_t(k)] + Eigen::Vector3d(0.001, 0, 0));
+  CHECK(through(beyond));
+  // Round the edge: from under the sheet, out past its edge at x = 30 mm, over it: not through.
+  CHECK_FALSE(through({{0.02, 0.0, -0.004},
+                       {0.028, 0.0, -0.004},
+                       {0.034, 0.0, -0.001},
+                       {0.034, 0.0, 0.001},
+                       {0.028, 0.0, 0.004},
+                       {0.02, 0.0, 0.004}}));
 }
 
 TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into the rim's",

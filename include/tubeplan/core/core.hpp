@@ -77,9 +77,10 @@ enum StepFlag : std::uint32_t {
   /// motion.
   kShapeOffContacts = 1u << 8,
   /// The tick's solution would have put a point of the tube's centreline more than r1 / 2 inside
-  /// a part (the tube going through it), from a state where none was: the tube and the held end
-  /// were kept where they were, and the operator feels the coupling's spring and damper
-  /// stretched to the hand (docs/core.md, "Through a part").
+  /// a part, or the centreline across a part thinner than r1 (the tube going through it), from a
+  /// state where neither was: the tube and the held end were kept where they were, and the
+  /// operator feels the coupling's spring and damper stretched to the hand (docs/core.md,
+  /// "Through a part").
   kHeldBack = 1u << 9,
   /// The paper's segmented rule, with loads on more than one segment, left out more than eps / 10
   /// of displacement at a load point (StepOutput::segmentation_error_m): the rule bends each
