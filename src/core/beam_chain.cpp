@@ -504,6 +504,52 @@ int BeamChain::SolveRodChain(const std::array<BeamLoad, kMaxLoads>& loads, int c
   return segment_count;
 }
 
+bool BeamChain::SolveRodPinned(std::array<BeamLoad, kMaxLoads>& loads, int count,
+                               const std::array<int, kMaxLoads>& order,
+                               std::array<RodSegment, kMaxLoads>& segments,
+                               const Eigen::Matrix3d& start_end_R,
+                               const std::array<Eigen::Vector3d, kMaxLoads>& pinned_H,
+                               std::span<Eigen::Vector3d> nodes) const {
+  const std::size_t node_count = nodes.size();
+  if (count <= 0 || node_count < 2 || node_count > std::size_t(kMaxCapsules) + 1) return false;
+  const bool coupled = rule_ == scene::MultiContactRule::kCoupled;
+  const int group = loads[std::size_t(order[0])].group;
+  for (int k = 1; k < count && !coupled; ++k)
+    if (loads[std::size_t(order[std::size_t(k)])].group != group) return false;
+  // One segment clamped at the held end: its frame S is H.
+  std::array<model::RodLoad, kMaxLoads> loads_S{};
+  std::array<Eigen::Vector2d, kMaxLoads> pinned_xy;
+  for (int q = 0; q < count; ++q) {
+    const BeamLoad& load = loads[std::size_t(order[std::size_t(q)])];
+    loads_S[std::size_t(q)] = model::RodLoad{std::max(load.s_m, 0.0), load.f_H_N, load.r_H_m};
+    pinned_xy[std::size_t(q)] = pinned_H[std::size_t(order[std::size_t(q)])].head<2>();
+  }
+  std::array<double, kMaxCapsules + 1> node_s{};
+  for (std::size_t k = 0; k < node_count; ++k)
+    node_s[k] = length_m_ * double(k) / double(node_count - 1);
+  model::RodSolution start;
+  start.end_R = start_end_R;
+  const model::RodSolution solution = rod_.SolvePinned(
+      std::span<model::RodLoad>(loads_S.data(), std::size_t(count)), start,
+      std::span<const Eigen::Vector2d>(pinned_xy.data(), std::size_t(count)),
+      model::RodSamples{std::span<const double>(node_s.data(), node_count), nodes, {}});
+  if (!solution.converged) return false;
+  RodSegment& seg = segments[0];
+  seg.solution = solution;
+  seg.load_count = count;
+  seg.end_turn_count = 0;
+  seg.origin_H.setZero();
+  seg.R_HS.setIdentity();
+  seg.clamp_m = 0.0;
+  seg.end_m = solution.end_m;
+  for (int q = 0; q < count; ++q) {
+    seg.index[std::size_t(q)] = order[std::size_t(q)];
+    seg.loads_S[std::size_t(q)] = loads_S[std::size_t(q)];
+    loads[std::size_t(order[std::size_t(q)])].f_H_N = loads_S[std::size_t(q)].f_N;
+  }
+  return true;
+}
+
 bool BeamChain::RodCompliance(
     RodSegment& segment, std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const {
   const int n = segment.load_count;

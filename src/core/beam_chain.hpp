@@ -174,6 +174,18 @@ class BeamChain {
                     const std::array<int, kMaxLoads>& order,
                     std::array<RodSegment, kMaxLoads>& segments,
                     std::span<Eigen::Vector3d> nodes = {}) const;
+  /// The rod chain of one segment (the coupled rule, or the segmented rule with every load in
+  /// one group) solved with its loads' forces across the held end's axis (x, y of H) unknown:
+  /// those that put the centre at each load's arc position at (x, y) of `pinned_H` (indexed as
+  /// `loads`), model::Rod::SolvePinned, started from the end frame `start_end_R`. On success
+  /// the loads' x, y forces, the segment (as SolveRodChain leaves it) and the centreline at
+  /// `nodes` are the solution's, and it returns true; otherwise nothing is written.
+  bool SolveRodPinned(std::array<BeamLoad, kMaxLoads>& loads, int count,
+                      const std::array<int, kMaxLoads>& order,
+                      std::array<RodSegment, kMaxLoads>& segments,
+                      const Eigen::Matrix3d& start_end_R,
+                      const std::array<Eigen::Vector3d, kMaxLoads>& pinned_H,
+                      std::span<Eigen::Vector3d> nodes) const;
   /// Tangent compliance of a solved segment's loads to each other, frame H, written to
   /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular.
   bool RodCompliance(RodSegment& segment,

@@ -1766,6 +1766,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
   }
   // Where the elastica does not cover the loading, or is held off, the rod shapes the tube.
+  // Last tick's end frame, if the rod shaped it, for the pin below, which starts from it.
+  const Eigen::Matrix3d rod_start_end_R = m.rod_shape && m.rod_segment_count > 0
+                                              ? m.rod_segments[0].solution.end_R
+                                              : Eigen::Matrix3d::Identity();
   m.rod_shape = false;
   if (want_elastica && beam_count > 0 && !m.elastica_shape) {
     // The solve draws the nodes on its way (a converged chain's shape, as RodNodes would).
@@ -1791,10 +1795,15 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // (the rubber tube slid along a wall with its tip stuck and 4 N on it: the pin's change of
     // the lateral load grew from 0.036 to 0.040 N in four ticks, a quarter of that load, until
     // it passed the 1 % bound, the pin was refused and the tube snapped, tick 550).
+    // Where that is refused and the chain is one segment, the rod is solved with the load points'
+    // sideways forces unknown (model::Rod::SolvePinned), from last tick's end frame: Newton on the
+    // end's turn and those forces together, under the same bound. At the free end's Euler load
+    // the dead-load solve lands on its buckled branch, 13.9 mm off (the push 0.1 mm off its axis,
+    // tick 82), and the Newton on the forces alone, stepping from that shape, got it to 6.5 mm
+    // and was refused; held, the column stays straight to its own buckling load (7.3 N, tick
+    // 415), the loads changed by 0.04-0.6 mN a tick.
     // Refused (the dead-load shape kept, flagged shape_off as before): a snap, whose shape no
-    // small change reaches, and the free end's buckling load itself (within ~10 %), where the
-    // dead-load solve is centimetres off and Newton on the forces does not reach the points in
-    // a tick's four steps (tests/core/core_test.cpp).
+    // small change reaches, such as the held column's own buckling.
     const auto worst_off = [&] {
       double off_m = 0.0;
       for (int j = 0; j < beam_count; ++j)
@@ -1878,13 +1887,29 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         last_off_m = off_m;
         pinned = off_m <= pin_tolerance_m;
       }
-      if (!(pinned && change_N <= change_bound_N)) {
+      const auto restore_dead = [&] {
         for (int j = 0; j < beam_count; ++j)
           m.beam_loads[std::size_t(j)].f_H_N = f_dead_H[std::size_t(j)];
         m.rod_segments = m.rod_segments_dead;
         m.nodes_H = m.nodes_dead_H;
         m.rod_segment_count = segments_dead;
-      } else {
+      };
+      pinned = pinned && change_N <= change_bound_N;
+      if (!pinned) {
+        restore_dead();
+        // The pinned solve (above): from last tick's end frame, where the column still stood.
+        if (m.beam.SolveRodPinned(
+                m.beam_loads, beam_count, m.order, m.rod_segments, rod_start_end_R, m.predicted_H,
+                std::span<Eigen::Vector3d>(m.nodes_H.data(), std::size_t(N) + 1))) {
+          m.rod_segment_count = 1;
+          change_N = 0.0;
+          for (int j = 0; j < beam_count; ++j)
+            change_N += (m.beam_loads[std::size_t(j)].f_H_N - f_dead_H[std::size_t(j)]).norm();
+          pinned = worst_off() <= pin_tolerance_m && change_N <= change_bound_N;
+          if (!pinned) restore_dead();
+        }
+      }
+      if (pinned) {
         for (int i = 0, k = 0; i < load_count; ++i)
           if (m.loads[std::size_t(i)].active)
             m.loads[std::size_t(i)].shape_force_W = R_WH * m.beam_loads[std::size_t(k++)].f_H_N;

@@ -2,6 +2,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <type_traits>
 
@@ -609,6 +610,112 @@ RodSolution Rod::SolveFrom(std::span<const RodLoad> loads, const Eigen::Matrix3d
   solution.max_moment_Nm = std::isfinite(result.max_moment_Nm) ? result.max_moment_Nm : 0.0;
   solution.end_m = end;
   solution.end_p_m = result.end_p.allFinite() ? result.end_p : Eigen::Vector3d(0.0, 0.0, end);
+  return solution;
+}
+
+RodSolution Rod::SolvePinned(std::span<RodLoad> loads, const RodSolution& start,
+                             std::span<const Eigen::Vector2d> pinned_xy_m,
+                             const RodSamples& shape) const {
+  Order order{};
+  const int count = SortedOrder(loads, order);
+  const std::span<const int> sorted(order.data(), std::size_t(count));
+  RodSolution solution;
+  if (count == 0 || pinned_xy_m.size() != std::size_t(count)) return solution;
+  const double end = loads[std::size_t(order[std::size_t(count - 1)])].s_m;
+  // The loads' arc positions in ascending order: where the centre is pinned (offset zero).
+  std::array<double, kMaxLoads> s_sorted{};
+  std::array<Eigen::Vector3d, kMaxLoads> zero_r, p;
+  for (int k = 0; k < count; ++k) {
+    s_sorted[std::size_t(k)] = loads[std::size_t(order[std::size_t(k)])].s_m;
+    zero_r[std::size_t(k)].setZero();
+  }
+  const RodSamples at_loads{std::span<const double>(s_sorted.data(), std::size_t(count)),
+                            std::span<Eigen::Vector3d>(p.data(), std::size_t(count)),
+                            {}};
+  constexpr int kMaxDirections = 3 + 3 * kMaxLoads;
+  constexpr int kMaxUnknowns = 3 + 2 * kMaxLoads;
+  using Matrix =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxUnknowns, kMaxUnknowns>;
+  using Vector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxUnknowns, 1>;
+  const int unknowns = 3 + 2 * count;
+  Tangent<kMaxDirections> tangent;
+  tangent.directions = 3 + 3 * count;
+  tangent.surface_r_m = std::span<const Eigen::Vector3d>(zero_r.data(), std::size_t(count));
+  // The residuals: the root's turn from the clamp [rad], and each pinned centre's miss divided by
+  // the end's arc position (so that both are angles).
+  Vector residual(unknowns);
+  const auto evaluate = [&](std::span<const RodLoad> trial_loads, const Eigen::Matrix3d& Q) {
+    const Result r = Integrate(trial_loads, sorted, 1.0, Q, at_loads, &tangent);
+    residual.head<3>() = r.residual;
+    for (int k = 0; k < count; ++k)
+      residual.segment<2>(3 + 2 * k) =
+          (p[std::size_t(k)].head<2>() - pinned_xy_m[std::size_t(order[std::size_t(k)])]) / end;
+    return residual.allFinite() ? residual.squaredNorm() : std::numeric_limits<double>::infinity();
+  };
+  std::array<RodLoad, kMaxLoads> now{}, trial{};
+  std::copy(loads.begin(), loads.end(), now.begin());
+  const std::span<const RodLoad> now_span(now.data(), std::size_t(count));
+  const std::span<const RodLoad> trial_span(trial.data(), std::size_t(count));
+  const Eigen::Matrix3d start_R = Eigen::Quaterniond(start.end_R).normalized().toRotationMatrix();
+  Eigen::Matrix3d Q = start_R;
+  double merit = evaluate(now_span, Q);
+  Matrix J(unknowns, unknowns);
+  bool converged = false;
+  for (int it = 0; it < kMaxPinnedIterations && std::isfinite(merit); ++it) {
+    ++solution.iterations;
+    if (!(residual.lpNorm<Eigen::Infinity>() > 1e-10)) {
+      converged = true;
+      break;
+    }
+    // Columns: the end's turn (directions 0-2), then each load's x and y force (3 + 3 j + c); rows
+    // as the residuals.
+    for (int c = 0; c < unknowns; ++c) {
+      const int d = c < 3 ? c : 3 + 3 * ((c - 3) / 2) + (c - 3) % 2;
+      J.block<3, 1>(0, c) = tangent.residual[std::size_t(d)];
+      for (int k = 0; k < count; ++k)
+        J.block<2, 1>(3 + 2 * k, c) =
+            tangent.surface[std::size_t(k) * kMaxDirections + std::size_t(d)].head<2>() / end;
+    }
+    const Eigen::PartialPivLU<Matrix> lu(J);
+    Vector step = lu.solve(-residual);
+    if (!step.allFinite()) break;
+    // At most half a radian of the end's turn a step, as Newton's.
+    const double turn = step.head<3>().norm();
+    if (turn > 0.5) step *= 0.5 / turn;
+    bool improved = false;
+    const Vector last = residual;
+    for (double lambda = 1.0; lambda > 1.0 / 64.0 && !improved; lambda *= 0.5) {
+      std::copy(now.begin(), now.begin() + count, trial.begin());
+      for (int j = 0; j < count; ++j)
+        trial[std::size_t(j)].f_N.head<2>() += lambda * step.segment<2>(3 + 2 * j);
+      const Eigen::Matrix3d Q_trial = Rotation(lambda * step.head<3>()) * Q;
+      const double m = evaluate(trial_span, Q_trial);
+      if (m < merit) {
+        merit = m;
+        Q = Q_trial;
+        std::copy(trial.begin(), trial.begin() + count, now.begin());
+        improved = true;
+      }
+    }
+    if (!improved) {
+      residual = last;
+      break;
+    }
+  }
+  if (!converged) converged = residual.lpNorm<Eigen::Infinity>() <= 1e-10;
+  // As Solve's: a solution whose end turned more than half a radian from the start is another
+  // branch, not the one the start was on.
+  if (!converged || Eigen::AngleAxisd(Q * start_R.transpose()).angle() > 0.5) return solution;
+  std::copy(now.begin(), now.begin() + count, loads.begin());
+  // The shape at the samples, and the figures, from one plain integration at the solution.
+  const Result result = Integrate(now_span, sorted, 1.0, Q, shape);
+  solution.end_R = Q;
+  solution.converged = result.residual.allFinite();
+  solution.root_moment_Nm = result.root_moment;
+  solution.energy_J = result.energy_J;
+  solution.max_moment_Nm = result.max_moment_Nm;
+  solution.end_m = end;
+  solution.end_p_m = result.end_p;
   return solution;
 }
 

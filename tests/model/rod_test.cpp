@@ -160,6 +160,55 @@ TEST_CASE("Rod: tangent compliance of the tip under an axial load, against the b
   }
 }
 
+TEST_CASE("Rod: a tip held sideways under an eccentric push: the propped beam-column", "[rod]") {
+  // A cantilever pushed along its axis by P at an offset e (the moment M0 = P e) and held at its
+  // tip sideways: the lateral force that holds it is, by the beam-column (Timoshenko & Gere),
+  //   H = M0 (cos kl - 1) / (sin(kl) / k - l cos kl),  k = sqrt(P / (E I)),
+  // 3 M0 / (2 l) as P -> 0, singular at the propped column's buckling load tan(kl) = kl
+  // (20.19 E I / l^2, 8.2 times the free end's Euler load). Past the free end's load the
+  // dead-load solve has no straight branch to follow; held, the rod stays straight to there.
+  const double EI = 2.0, l = 0.5, e = 1e-4 * l;
+  const Rod rod(EI, l / 400.0);
+  const double euler_N = kPi * kPi * EI / (4.0 * l * l);
+  for (const double times : {0.5, 1.0, 1.5, 3.0, 6.0}) {
+    const double P = times * euler_N, k = std::sqrt(P / EI);
+    INFO("P = " << times << " times the free end's Euler load");
+    std::vector<RodLoad> loads{
+        RodLoad{l, Eigen::Vector3d(0.0, 0.0, -P), Eigen::Vector3d(0.0, e, 0.0)}};
+    const std::array<Eigen::Vector2d, 1> pinned{Eigen::Vector2d::Zero()};
+    std::array<double, 1> s{l};
+    std::array<Eigen::Vector3d, 1> tip;
+    RodSolution start;  // the straight rod
+    const RodSolution solution = rod.SolvePinned(loads, start, pinned, RodSamples{s, tip, {}});
+    REQUIRE(solution.converged);
+    // Held within the solve's tolerance (1e-10 of the end's arc position), the push unchanged.
+    CHECK(tip[0].head<2>().norm() <= 1e-10 * l);
+    CHECK(loads[0].f_N.z() == -P);
+    const double M0 = P * e;
+    const double expected =
+        M0 * (std::cos(k * l) - 1.0) / (std::sin(k * l) / k - l * std::cos(k * l));
+    // The discretisation's error is second order (~1e-5 at l/400, as the compliance's); the
+    // offset moment's nonlinearity is of the deflection squared, ~1e-8.
+    CHECK(std::abs(loads[0].f_N.y()) == Approx(std::abs(expected)).epsilon(1e-4));
+    CHECK(std::abs(loads[0].f_N.x()) <= 1e-9 * std::abs(expected));
+    // The held forces as dead loads, solved from the held solution's end: the same tip.
+    const RodSolution dead = rod.Solve(loads, solution);
+    REQUIRE(dead.converged);
+    std::array<Eigen::Vector3d, 1> tip_dead;
+    rod.Shape(loads, dead, RodSamples{s, tip_dead, {}});
+    CHECK((tip_dead[0] - tip[0]).norm() <= 1e-9 * l);
+  }
+  // Offered a target no shape reaches (the end held 1.5 l sideways: beyond the rod's length), it
+  // says so and leaves the loads as given.
+  std::vector<RodLoad> loads{At(l, Eigen::Vector3d(0.0, 0.0, -1e-3))};
+  const std::array<Eigen::Vector2d, 1> far{Eigen::Vector2d(1.5 * l, 0.0)};
+  std::array<double, 1> s{l};
+  std::array<Eigen::Vector3d, 1> tip;
+  const RodSolution refused = rod.SolvePinned(loads, RodSolution{}, far, RodSamples{s, tip, {}});
+  CHECK_FALSE(refused.converged);
+  CHECK(loads[0].f_N == Eigen::Vector3d(0.0, 0.0, -1e-3));
+}
+
 TEST_CASE("Rod: compliance equals differences of full solves, and is symmetric (Maxwell-Betti)",
           "[rod]") {
   // A bent rod under three loads in 3D, two with offsets (the surface points of a side contact and

@@ -94,6 +94,23 @@ class Rod {
   RodSolution Solve(std::span<const RodLoad> loads, const RodSolution& previous,
                     const RodSamples& shape) const;
 
+  /// Solves with each load's force across the clamp's axis (its x and y) unknown as well: the
+  /// forces that put the centre at each load's arc position at `pinned_xy_m` (x, y of the clamp
+  /// frame, one per load in the loads' order), the axial parts (z) as given. A rod whose load
+  /// points are held sideways by stiff contacts: pushed along its axis past the free end's
+  /// Euler load, the dead-load solve swings the end away by centimetres under a force that
+  /// rounding decides (the buckled branch), where held sideways it stays straight up to the
+  /// pinned column's own buckling load, four times as far. One Newton iteration solves for the
+  /// end's turn and the lateral forces together (their Jacobian from one integration, exact for
+  /// the discrete rod), from `start` (the last solution), each step halved until it brings the
+  /// residuals down; at most kMaxPinnedIterations. Converged (the clamp within 1e-10 rad, each
+  /// point within 1e-10 of the end's arc position), the loads' x, y are the solution's and the
+  /// shape is drawn at `shape`'s samples; otherwise `converged` is false and the loads are as
+  /// given.
+  RodSolution SolvePinned(std::span<RodLoad> loads, const RodSolution& start,
+                          std::span<const Eigen::Vector2d> pinned_xy_m,
+                          const RodSamples& shape) const;
+
   /// The shape of a solved rod at the samples' arc positions (within [0, end_m]).
   void Shape(std::span<const RodLoad> loads, const RodSolution& solution,
              const RodSamples& samples) const;
@@ -120,6 +137,7 @@ class Rod {
   /// Newton iterations one Solve may spend, continuation included (each one integration
   /// carrying its Jacobian, ~2.5 plain ones, and more if the step is damped).
   static constexpr int kMaxIterations = 320;
+  static constexpr int kMaxPinnedIterations = 12;
 
  private:
   struct Result {
