@@ -20,9 +20,9 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/model/tube.hpp>
-#include <tubeplan/study/stability.hpp>
 
 #include "../alloc_count.hpp"
+#include "../study/quick_case.hpp"
 
 using namespace tubeplan;
 
@@ -123,10 +123,7 @@ TEST_CASE("A tick allocates nothing where the rod's shape is held sideways", "[c
   // lands off the contacts it is held sideways (model::Rod::SolvePinned). Without the hold,
   // 3 of these 410 ticks are off their contacts (from tick 82): none being so, with 300 on the
   // rod, is the path run.
-  study::StabilityCase push;
-  for (const study::StabilityCase& c : study::StabilityCases(true))
-    if (c.name == "push into a wall off-plane=0.1mm") push = c;
-  REQUIRE(push.name == "push into a wall off-plane=0.1mm");
+  const study::StabilityCase push = testing::QuickCase("push into a wall off-plane=0.1mm");
   const scene::Scene& s = push.scene;
   core::Core c(s);
   const double dt = s.model.time_step_s;

@@ -13,15 +13,14 @@
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/study/stability.hpp>
 
+#include "quick_case.hpp"
+
 using namespace tubeplan;
 
 namespace {
 
 study::StabilityResult RunNamed(const std::string& name) {
-  for (const study::StabilityCase& c : study::StabilityCases(true))
-    if (c.name == name) return study::RunStabilityCase(c);
-  FAIL("no case named " << name);
-  return {};
+  return study::RunStabilityCase(testing::QuickCase(name));
 }
 
 }  // namespace
@@ -212,10 +211,7 @@ TEST_CASE("Stability: slide along a wall and back: the face takes the load over 
   // slack). Now the face continues the rim's load from the rim's point: the shape stays on its
   // contacts, the tube is never held back, and the normal force changes by less than 0.25 N a
   // tick (0.1 N at most, measured; the snap's was 0.93 N).
-  study::StabilityCase base;
-  for (const study::StabilityCase& c : study::StabilityCases(true))
-    if (c.name == "slide along a wall base") base = c;
-  REQUIRE(base.name == "slide along a wall base");
+  const study::StabilityCase base = testing::QuickCase("slide along a wall base");
   const scene::Scene& s = base.scene;
   core::Core core(s);
   const double gap = 2.0 * s.contact.threshold_m + 1e-3, dt = s.model.time_step_s;
