@@ -506,6 +506,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const double l = scene_.tube.length_m;
   const int N = capsule_count_;
 
+  // The end frame of the shape last tick sent, if the rod drew it, for the pin (step 8), which
+  // starts from it: taken now, because the tick's compliance (step 5) may solve the rod's segments
+  // again at other loads (the squeeze's four loads against the shape's three: 1.2 rad apart).
+  const Eigen::Matrix3d rod_start_end_R = m.rod_shape && m.rod_segment_count > 0
+                                              ? m.rod_segments[0].solution.end_R
+                                              : Eigen::Matrix3d::Identity();
+
   StepOutput& out = out_;
   out.t_s = t_s;
   out.X_W_hand = X_W_hand;
@@ -1766,10 +1773,6 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
   }
   // Where the elastica does not cover the loading, or is held off, the rod shapes the tube.
-  // Last tick's end frame, if the rod shaped it, for the pin below, which starts from it.
-  const Eigen::Matrix3d rod_start_end_R = m.rod_shape && m.rod_segment_count > 0
-                                              ? m.rod_segments[0].solution.end_R
-                                              : Eigen::Matrix3d::Identity();
   m.rod_shape = false;
   if (want_elastica && beam_count > 0 && !m.elastica_shape) {
     // The solve draws the nodes on its way (a converged chain's shape, as RodNodes would).
@@ -1806,11 +1809,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // small change reaches, such as the held column's own buckling.
     const auto worst_off = [&] {
       double off_m = 0.0;
-      for (int j = 0; j < beam_count; ++j)
-        off_m = std::max(off_m, (interpolate_node(m.beam_loads[std::size_t(j)].s_m) -
-                                 m.predicted_H[std::size_t(j)])
-                                    .head<2>()
-                                    .norm());
+      for (int j = 0; j < beam_count; ++j) {
+        const double here_m =
+            (interpolate_node(m.beam_loads[std::size_t(j)].s_m) - m.predicted_H[std::size_t(j)])
+                .head<2>()
+                .norm();
+        // NaN is off, not passed over (std::max would keep the finite one).
+        off_m = here_m <= off_m
+                    ? off_m
+                    : (std::isnan(here_m) ? std::numeric_limits<double>::infinity() : here_m);
+      }
       return off_m;
     };
     const double pin_tolerance_m = 0.1 * eps;

@@ -198,6 +198,31 @@ TEST_CASE("Rod: a tip held sideways under an eccentric push: the propped beam-co
     rod.Shape(loads, dead, RodSamples{s, tip_dead, {}});
     CHECK((tip_dead[0] - tip[0]).norm() <= 1e-9 * l);
   }
+  // Three loads given out of arc order, each held at its own (x, y): every centre lands on its
+  // own target (a mix-up of the caller's order and the arc order would put them on another's),
+  // and the held forces as dead loads give the same shape.
+  {
+    std::vector<RodLoad> three{At(l, Eigen::Vector3d(0.0, 0.0, -2.0 * euler_N)),
+                               At(0.3 * l, Eigen::Vector3d(0.0, 0.0, 0.0)),
+                               At(0.6 * l, Eigen::Vector3d(0.0, 0.0, -0.5 * euler_N))};
+    const std::array<Eigen::Vector2d, 3> at{Eigen::Vector2d(1e-3 * l, 0.0),
+                                            Eigen::Vector2d(0.0, 2e-4 * l),
+                                            Eigen::Vector2d(-3e-4 * l, 1e-4 * l)};
+    std::array<double, 3> s3{0.3 * l, 0.6 * l, l};
+    std::array<Eigen::Vector3d, 3> p3;
+    const RodSolution held = rod.SolvePinned(three, RodSolution{}, at, RodSamples{s3, p3, {}});
+    REQUIRE(held.converged);
+    // The drawn shape steps through its samples too: within the discretisation's error of the
+    // solve's own rod (~1e-7 l here), far below the core's eps / 10.
+    CHECK((p3[0].head<2>() - at[1]).norm() <= 1e-6 * l);
+    CHECK((p3[1].head<2>() - at[2]).norm() <= 1e-6 * l);
+    CHECK((p3[2].head<2>() - at[0]).norm() <= 1e-6 * l);
+    const RodSolution dead = rod.Solve(three, held);
+    REQUIRE(dead.converged);
+    std::array<Eigen::Vector3d, 3> q3;
+    rod.Shape(three, dead, RodSamples{s3, q3, {}});
+    for (int k = 0; k < 3; ++k) CHECK((q3[std::size_t(k)] - p3[std::size_t(k)]).norm() <= 1e-6 * l);
+  }
   // Offered a target no shape reaches (the end held 1.5 l sideways: beyond the rod's length), it
   // says so and leaves the loads as given.
   std::vector<RodLoad> loads{At(l, Eigen::Vector3d(0.0, 0.0, -1e-3))};

@@ -122,8 +122,8 @@ TEST_CASE("Stability: pushed 0.1 mm off its axis, the stuck tube stays straight 
   // shape, it stays on its contacts to the held column's own buckling load, 7.3 N at tick 415.
   const study::StabilityResult r = RunNamed("push into a wall off-plane=0.1mm");
   INFO(r.detail << " | " << r.warning);
-  CHECK(r.first_shape_off_tick > 400);
-  CHECK(r.first_failing_tick > 400);
+  CHECK((r.first_shape_off_tick < 0 || r.first_shape_off_tick > 400));
+  CHECK((r.pass || r.first_failing_tick > 400));
 }
 
 TEST_CASE(

@@ -100,13 +100,15 @@ class Rod {
   /// points are held sideways by stiff contacts: pushed along its axis past the free end's
   /// Euler load, the dead-load solve swings the end away by centimetres under a force that
   /// rounding decides (the buckled branch), where held sideways it stays straight up to the
-  /// pinned column's own buckling load, four times as far. One Newton iteration solves for the
+  /// pinned column's own buckling load, eight times as large. One Newton iteration solves for the
   /// end's turn and the lateral forces together (their Jacobian from one integration, exact for
-  /// the discrete rod), from `start` (the last solution), each step halved until it brings the
-  /// residuals down; at most kMaxPinnedIterations. Converged (the clamp within 1e-10 rad, each
-  /// point within 1e-10 of the end's arc position), the loads' x, y are the solution's and the
-  /// shape is drawn at `shape`'s samples; otherwise `converged` is false and the loads are as
-  /// given.
+  /// the discrete rod), from `start` (the last solution), each step halved (up to three times)
+  /// until it brings the residuals down; at most kMaxPinnedIterations, and given up at a second
+  /// step that does not halve them (it is not converging from this start). Converged (the
+  /// clamp within 1e-10 rad, each point within 1e-10 of the end's arc position, on the solve's
+  /// own steps) and within half a radian of the start, the loads' x, y are the solution's and
+  /// the shape is drawn at `shape`'s samples (positions only; a rod within its discretisation
+  /// error of the solve's); otherwise `converged` is false and neither is written.
   RodSolution SolvePinned(std::span<RodLoad> loads, const RodSolution& start,
                           std::span<const Eigen::Vector2d> pinned_xy_m,
                           const RodSamples& shape) const;
