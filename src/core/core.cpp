@@ -839,6 +839,20 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       ld.lin_clamp_m = before.clamp_m;
       if (before.active && ld.friction) ld.anchor_W = ld.x0_W + carried_stretch(before, ld);
       ld.f_lin_W = before.shape_force_W;
+      // A load that pressed last tick starts in the system if it lies within eps and the capsule
+      // chain's own tolerance, eps / 10 (ChainCapsuleCount). Only the system's release then lets
+      // it go. The point is found again on the drawn shape, which lies within the shape tolerance
+      // of where the system held it. Where the contact's depth N / K is smaller than that error, a
+      // pressing contact reads just beyond eps. An open load closes only if the tick's prediction
+      // brings it within eps. That prediction takes the load's whole force out along the beam's
+      // tangent, far beyond where the tangent holds. At K = 1e7 N/m the rim's point read
+      // 2.3 um beyond eps for 50 ticks, 3.1 N on it, and the old tangent closed it each tick.
+      // At tick 974 the rod's tangent was renewed. Its prediction of the unloaded tube moved away
+      // from the wall, so the load stayed open. The tube then sprang straight, 3.5 mm into the wall
+      // (`stability --only "slide along a wall K=1e+07N/m"`).
+      if (!ld.active && before.active && before.normal_W.dot(before.force_W) > 0.0 &&
+          ld.distance_m < 1.1 * eps)
+        ld.active = true;
       if (pass == 0 && !ld.pressure_centre) {
         // Keyed as the face it continues, so that the next tick's face finds it again and the
         // side beside it, in the band, does not.
