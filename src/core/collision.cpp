@@ -299,6 +299,59 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   return true;
 }
 
+void Collision::LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
+                         const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, double s0_m,
+                         RawContact& c) const {
+  // The face: the one bit of the mask, its axis and side.
+  int k = 0;
+  double side = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    if (c.face_mask & (1u << kPositiveFace[a])) k = a, side = 1.0;
+    if (c.face_mask & (1u << kNegativeFace[a])) k = a, side = -1.0;
+  }
+  // The stretch of the axis within the face's two other slabs.
+  const Eigen::Vector3d d_P = b_P - a_P;
+  double t_lo = 0.0, t_hi = 1.0;
+  for (int i = 0; i < 3; ++i) {
+    if (i == k) continue;
+    const double h = part.half_m[i];
+    if (d_P[i] == 0.0) {
+      if (std::abs(a_P[i]) > h) return;  // beside the face (the mask's tolerance): no stretch
+      continue;
+    }
+    const double t1 = (-h - a_P[i]) / d_P[i], t2 = (h - a_P[i]) / d_P[i];
+    t_lo = std::max(t_lo, std::min(t1, t2));
+    t_hi = std::min(t_hi, std::max(t1, t2));
+  }
+  if (!(t_hi > t_lo)) return;
+  // Parallel to the face, the piece spans its whole stretch; tilted, its nearest end. The ends
+  // move from the stretch's towards the nearest as the ends' distances to the face's plane come
+  // apart, there by eps / 10 (the capsule chain's tolerance): continuous in the tube's pose, and
+  // a piece crossing a face at an angle (a tube wrapped round an edge) keeps its nearest point,
+  // where it presses, for both ends (its region ending there as before).
+  const auto distance = [&](double t) {
+    return side * (a_P[k] + t * d_P[k]) - part.half_m[k] - radius_m_;
+  };
+  const double d_lo = distance(t_lo), d_hi = distance(t_hi);
+  const double t_near = d_lo <= d_hi ? t_lo : t_hi;
+  const double w = std::max(0.0, 1.0 - std::abs(d_hi - d_lo) / (0.1 * eps_m_));
+  const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
+  const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);
+  const double half_m = 0.5 * piece_m_;
+  const auto end = [&](double t, double& s_m, double& d_m, Eigen::Vector3d& p_W) {
+    Eigen::Vector3d p_P = a_P + t * d_P;
+    d_m = distance(t);
+    p_P[k] -= side * radius_m_;  // the surface point facing the face
+    p_W = part.ToWorld(p_P);
+    // The arc position as the nearest point's is taken (Query).
+    const double along = std::clamp((p_W - centre_W).dot(axis_W), -half_m, half_m);
+    s_m = std::max(0.0, s0_m + half_m + along);
+  };
+  end(t_near + w * (t_lo - t_near), c.s_lo_m, c.d_lo_m, c.p_lo_W_m);
+  end(t_near + w * (t_hi - t_near), c.s_hi_m, c.d_hi_m, c.p_hi_W_m);
+  c.line = true;
+}
+
 // Inlined for the same reason as CapsuleBoxDistance: once a contact.
 [[gnu::always_inline]] inline std::uint8_t Collision::FaceMask(const Part& part,
                                                                const Eigen::Vector3d& q_P) const {
@@ -808,6 +861,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       c.p_W_m = p_tube_W;
       c.face_mask = FaceMask(part, q_P);
       c.part_element = element_of_[part.index][c.face_mask];
+      if (!is_end && separated && IsFaceMask(c.face_mask))
+        LineEnds(part, a_P, b_P, a_W, b_W, piece_m_ * k, c);
 
       // The centreline point under the contact, and which element of the tube touches.
       const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);

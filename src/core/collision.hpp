@@ -37,6 +37,17 @@ struct RawContact {
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
   Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the tube
+  /// A capsule over a face (`line`): the ends of the stretch of its axis that lies over the face,
+  /// lo nearer the held end, each as the tube's surface point facing the face, its arc position
+  /// and its distance to the face's plane (signed as distance_m). The nearest point is one of
+  /// the two, which one by the sign of the piece's tilt to the face: a PC's region runs from the
+  /// lo end of its first piece to the hi end of its last, whatever that sign (core.cpp). Tilted,
+  /// both ends move towards the nearest point, reaching it where the stretch's ends are eps / 10
+  /// apart in distance (Collision::LineEnds).
+  bool line = false;
+  double s_lo_m = 0.0, s_hi_m = 0.0;
+  double d_lo_m = 0.0, d_hi_m = 0.0;
+  Eigen::Vector3d p_lo_W_m = Eigen::Vector3d::Zero(), p_hi_W_m = Eigen::Vector3d::Zero();
 };
 
 /// Whether a face mask names a face (one bit), not an edge or a vertex. Not std::popcount, which
@@ -218,6 +229,11 @@ class Collision {
   // part is left out by the kept distances of its pieces in the band).
   void Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
             double d_m) const;
+  // A capsule's contact on a face: the ends of the stretch of its axis over the face
+  // (RawContact::line); s0_m is the piece's first arc position.
+  void LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
+                const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, double s0_m,
+                RawContact& c) const;
   // Returns the contact's part point in the part's frame.
   Eigen::Vector3d Overlapping(const Part& part, const Eigen::Vector3d& a_W,
                               const Eigen::Vector3d& b_W, RawContact& c) const;

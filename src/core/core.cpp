@@ -642,11 +642,20 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<double, kMaxContacts> region_m{};
   // And the arc positions of its first and last raw contacts so far, kept beside them.
   std::array<double, kMaxContacts> first_s_m{}, last_s_m{};
+  // A capsule over a face spans the stretch of its axis over it (RawContact::line): the region
+  // runs from the lo end of its first piece to the hi end of its last. Its nearest point is one
+  // of those ends, which by the sign of its tilt to the face: a stiff tube pinched in a groove
+  // rocked between them from tick to tick, the region's end jumping 6.5 mm each time (the
+  // squeeze with E = 2e8 Pa, frictionless and linear too, made energy from tick 34).
+  const auto lo_s = [](const RawContact& r) { return r.line ? r.s_lo_m : r.s_m; };
+  const auto hi_s = [](const RawContact& r) { return r.line ? r.s_hi_m : r.s_m; };
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
     pc.first = pc.last = pc.deepest;
-    region_m[std::size_t(k)] = std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps);
-    first_s_m[std::size_t(k)] = last_s_m[std::size_t(k)] = m.raw[std::size_t(pc.deepest)].s_m;
+    const RawContact& deepest = m.raw[std::size_t(pc.deepest)];
+    region_m[std::size_t(k)] = std::max(2.0 * eps, deepest.distance_m + eps);
+    first_s_m[std::size_t(k)] = lo_s(deepest);
+    last_s_m[std::size_t(k)] = hi_s(deepest);
   }
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
@@ -654,8 +663,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const RawContact& r = m.raw[std::size_t(i)];
     PcFound& pc = found[std::size_t(k)];
     if (r.distance_m > region_m[std::size_t(k)]) continue;
-    if (r.s_m < first_s_m[std::size_t(k)]) pc.first = i, first_s_m[std::size_t(k)] = r.s_m;
-    if (r.s_m > last_s_m[std::size_t(k)]) pc.last = i, last_s_m[std::size_t(k)] = r.s_m;
+    if (lo_s(r) < first_s_m[std::size_t(k)]) pc.first = i, first_s_m[std::size_t(k)] = lo_s(r);
+    if (hi_s(r) > last_s_m[std::size_t(k)]) pc.last = i, last_s_m[std::size_t(k)] = hi_s(r);
   }
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
@@ -680,7 +689,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     return true;
   };
   int load_count = 0;
-  const auto add_load = [&](int pc, int end, const RawContact& r) {
+  // `at`: 0 the nearest point, -1 and 1 the lo and hi end of a capsule over a face.
+  const auto add_load = [&](int pc, int end, const RawContact& r, int at) {
     if (load_count == kMaxLoads) {
       truncated = true;
       return;
@@ -691,13 +701,15 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     ld.end = end;
     ld.tube = r.tube;
     ld.part_element = r.part_element;
-    ld.s_m = r.tube == states::TubeElement::kSide ? std::clamp(r.s_m, 0.0, l) : l;
-    ld.distance_m = r.distance_m;
+    const bool lo = r.line && at < 0, hi = r.line && at > 0;
+    const double s_m = lo ? r.s_lo_m : hi ? r.s_hi_m : r.s_m;
+    ld.s_m = r.tube == states::TubeElement::kSide ? std::clamp(s_m, 0.0, l) : l;
+    ld.distance_m = lo ? r.d_lo_m : hi ? r.d_hi_m : r.distance_m;
     ld.normal_W = r.normal_W;
     // An end face pressed on a face presses at its dome's lowest point (collision.cpp: the face's
     // centre when it lies flat, moving towards the rim as it tilts), wherever GJK put its
     // nearest point.
-    ld.x0_W = r.p_W_m;
+    ld.x0_W = lo ? r.p_lo_W_m : hi ? r.p_hi_W_m : r.p_W_m;
     ld.pressure_centre = r.pressure_centre;
     ld.overlap = r.overlap;
     const scene::Friction& friction =
@@ -705,18 +717,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     ld.friction = friction.IsFrictionless() ? nullptr : &friction;
     ld.anchor_W = ld.x0_W;
     // In the band but not within epsilon: in the system only if this tick's motion closes it.
-    ld.active = r.distance_m < eps;
+    ld.active = ld.distance_m < eps;
     if (r.overlap) out.flags |= kPenetration;
   };
   for (int k = 0; k < found_count; ++k) {
     const PcFound& pc = found[std::size_t(k)];
     const RawContact& first = m.raw[std::size_t(pc.first)];
     const RawContact& last = m.raw[std::size_t(pc.last)];
-    if (last.s_m - first.s_m > m.beam.group_tolerance_m()) {
-      add_load(k, 0, first);
-      add_load(k, 1, last);
+    if (hi_s(last) - lo_s(first) > m.beam.group_tolerance_m()) {
+      add_load(k, 0, first, -1);
+      add_load(k, 1, last, 1);
     } else {
-      add_load(k, 0, m.raw[std::size_t(pc.deepest)]);
+      add_load(k, 0, m.raw[std::size_t(pc.deepest)], 0);
     }
   }
   // Each load continues last tick's load of the same element pair and end; failing that, the
@@ -2062,12 +2074,23 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       pc.marker = states::Marker::kBent;
       continue;
     }
+    // Judged from the PC's far end: for a side along a face, carried at both ends of its region,
+    // midway between the two. From its deepest point, the lo end when the tube's held end lies
+    // lowest, the bend was read at the clamp, where it is the small difference of the loads'
+    // moments: the shipped insertion's side on the floor flipped between convex and concave
+    // there from tick to tick.
+    double end_m = pc.s_m;
+    for (int j = 0; j < load_count; ++j) {
+      const Load& ld = m.loads[std::size_t(j)];
+      if (ld.active && ld.tube == pc.tube && ld.part_element == pc.part_element)
+        end_m = std::max(end_m, ld.s_m);
+    }
     double before_m = 0.0;
     for (int j = 0; j < beam_count; ++j) {
       const double sj = m.beam_loads[std::size_t(j)].s_m;
-      if (sj < pc.s_m - m.beam.group_tolerance_m()) before_m = std::max(before_m, sj);
+      if (sj < end_m - m.beam.group_tolerance_m()) before_m = std::max(before_m, sj);
     }
-    const Eigen::Vector3d bend = bend_at(0.5 * (before_m + pc.s_m));
+    const Eigen::Vector3d bend = bend_at(0.5 * (before_m + end_m));
     const Eigen::Vector3d n_H = lateral * (R_WH.transpose() * pc.normal_W);
     const double side = bend.dot(n_H);
     // Curving along the normal (away from the part): the part touches the outside of the bend.

@@ -599,3 +599,105 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   // A step of 2e-9 t_switch moves the lowest point by r1 times that: 1e-12 m.
   CHECK(std::abs(after.distance_m - before.distance_m) < 1e-12);
 }
+
+TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever its tilt",
+          "[core][collision]") {
+  // The groove scene's tube lying along +y over a floor whose near edge is at y = 0, its axis
+  // 0.5 mm above the floor's plane plus r1, tilted about x; the first pieces begin before the
+  // edge. Each capsule over the floor's top face reports the stretch of its axis over the face,
+  // its ends moved towards its nearest point by 1 - w, w = 1 - |d_hi - d_lo| / (eps / 10) (the
+  // ends' distances; at least 0), and the distance there: computed here from the geometry as
+  // vectors. Its nearest point is one end of the stretch or the other, which one by the tilt's
+  // sign; the PC's region (the lo end of its first piece to the hi end of its last, the pieces on
+  // the face's edges joining it at their nearest points, as the core joins them) is not.
+  scene::Scene s = GrooveScene();
+  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
+  s.parts.clear();
+  scene::BoxPart floor;
+  floor.name = "floor";
+  floor.size_m = Eigen::Vector3d(0.2, 0.4, 0.02);
+  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.2, -0.01);  // top at z = 0, near edge y = 0
+  s.parts.push_back(floor);
+  const std::vector<std::uint32_t> parts{0};
+  const int capsules = 24;
+  const double piece_m = l / capsules;
+  const core::Collision collision(s, parts, capsules, MaskElements(1));
+  const Eigen::Vector3d start(0.0, -1.1 * piece_m, r1 + 0.5e-3);
+  const std::uint8_t top = 1u << 0;  // FaceMask's bit of the +z face (kPositiveFace[2])
+  struct Region {
+    double lo_m = 1e9, hi_m = -1e9;
+    int nearest_at_lo = 0, nearest_at_hi = 0, lines = 0, collapsed = 0;
+  };
+  const auto query = [&](double tilt) {
+    const Eigen::Vector3d u(0.0, std::cos(tilt), std::sin(tilt));
+    std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+    for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = start + (l * k / capsules) * u;
+    std::array<core::RawContact, core::kMaxRawContacts> out{};
+    const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
+    Region region;
+    for (int i = 0; i < count; ++i) {
+      const core::RawContact& c = out[std::size_t(i)];
+      if ((c.face_mask & top) == 0) continue;
+      region.lo_m = std::min(region.lo_m, c.line ? c.s_lo_m : c.s_m);
+      region.hi_m = std::max(region.hi_m, c.line ? c.s_hi_m : c.s_m);
+      if (!c.line) continue;
+      INFO("tilt " << tilt << " s " << c.s_m);
+      CHECK(c.face_mask == top);
+      ++region.lines;
+      // Which piece: the one (of those beside the nearest point's arc position) whose geometry
+      // gives what the contact says. Its axis from a to b, where it crosses the edge's plane
+      // y = 0, its ends' distances to the floor's plane z = 0, and the ends moved towards the
+      // nearer; 1e-15 m: rounding of coordinates of centimetres.
+      bool matched = false;
+      const int k0 = int(c.s_m / piece_m);
+      for (int k = std::max(0, k0 - 1); k <= std::min(capsules - 1, k0 + 1) && !matched; ++k) {
+        const Eigen::Vector3d a = nodes_W[std::size_t(k)], b = nodes_W[std::size_t(k) + 1];
+        const double t_lo = std::clamp(-a.y() / (b.y() - a.y()), 0.0, 1.0);
+        const auto surface = [&](double t) {
+          return Eigen::Vector3d(a + t * (b - a) - r1 * Eigen::Vector3d::UnitZ());
+        };
+        const double d_lo = surface(t_lo).z(), d_hi = surface(1.0).z();
+        const double t_near = d_lo <= d_hi ? t_lo : 1.0;
+        const double w = std::max(0.0, 1.0 - std::abs(d_hi - d_lo) / (0.1 * eps));
+        matched = std::abs(c.distance_m - std::min(d_lo, d_hi)) <= 1e-15;
+        for (const bool lo : {true, false}) {
+          const double t = t_near + w * ((lo ? t_lo : 1.0) - t_near);
+          const Eigen::Vector3d p = surface(t);
+          // The arc position of the surface point's foot on the chord, within the piece.
+          const double along =
+              std::clamp((p - 0.5 * (a + b)).dot(u), -0.5 * piece_m, 0.5 * piece_m);
+          matched = matched && std::abs((lo ? c.d_lo_m : c.d_hi_m) - p.z()) <= 1e-15 &&
+                    std::abs((lo ? c.s_lo_m : c.s_hi_m) - (piece_m * (k + 0.5) + along)) <= 1e-15 &&
+                    ((lo ? c.p_lo_W_m : c.p_hi_W_m) - p).norm() <= 1e-15;
+        }
+        if (!matched) continue;
+        // The nearest point is the nearer end of the stretch.
+        if ((c.p_W_m - surface(t_lo)).norm() <= 1e-15) ++region.nearest_at_lo;
+        if ((c.p_W_m - surface(1.0)).norm() <= 1e-15) ++region.nearest_at_hi;
+        if (w == 0.0) ++region.collapsed;
+      }
+      CHECK(matched);
+    }
+    return region;
+  };
+  // Nearly parallel (the far end 0.15 um higher, or lower): every piece spans its whole stretch,
+  // within (1 - w) of it, 6e-5 of a piece's 6.25 mm.
+  const double tilt = 1e-6;
+  const Region up = query(tilt), down = query(-tilt);
+  CHECK(up.lines > 10);
+  CHECK(down.lines > 10);
+  // Its nearest point is its lo end when the tube rises towards its tip, its hi end when it
+  // falls...
+  CHECK(up.nearest_at_lo == up.lines);
+  CHECK(down.nearest_at_hi == down.lines);
+  // ...and the region's ends move by at most 1e-6 m (tilt r1 = 8e-9 m, and twice the ends' pull
+  // towards the nearest point, 3.9e-7 m).
+  CHECK(std::abs(up.lo_m - down.lo_m) <= 1e-6);
+  CHECK(std::abs(up.hi_m - down.hi_m) <= 1e-6);
+  // Tilted by 0.02 rad, the stretch's ends are 0.125 mm apart in distance, beyond eps / 10: both
+  // ends are the nearest point, and a PC of such pieces is carried where it presses.
+  const Region steep = query(0.02);
+  CHECK(steep.lines > 10);
+  CHECK(steep.collapsed == steep.lines);
+  CHECK(up.collapsed == 0);
+}
