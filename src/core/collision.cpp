@@ -50,7 +50,8 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       // The end face counts as flat on a face, or the last piece's side as flat on it, when its
       // far side is within a tenth of epsilon of its near side.
       tube_tolerance_m_(0.1 * scene.contact.threshold_m),
-      eps_m_(scene.contact.threshold_m) {
+      eps_m_(scene.contact.threshold_m),
+      parallel_per_m_(10.0 / scene.contact.threshold_m) {
   {
     const double r1 = scene.tube.outer_radius_m;
     // The dome's height is the tube's geometric tolerance (the capsules' chord error has the
@@ -299,9 +300,11 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
   return true;
 }
 
-void Collision::LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
-                         const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, double s0_m,
-                         RawContact& c) const {
+void Collision::LineEnds(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const {
+  if (!c.over_face) return;
+  const Part& part = parts_[std::size_t(c.part_slot)];
+  const Eigen::Vector3d a_P = part.ToPart(nodes_W[std::size_t(c.piece)]);
+  const Eigen::Vector3d b_P = part.ToPart(nodes_W[std::size_t(c.piece) + 1]);
   // The face: the one bit of the mask, its axis and side.
   int k = 0;
   double side = 1.0;
@@ -309,16 +312,14 @@ void Collision::LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eig
     if (c.face_mask & (1u << kPositiveFace[a])) k = a, side = 1.0;
     if (c.face_mask & (1u << kNegativeFace[a])) k = a, side = -1.0;
   }
-  // The stretch of the axis within the face's two other slabs.
+  // The stretch of the axis within the face's two other slabs (the whole axis for a piece lying
+  // over the face, most of them).
   const Eigen::Vector3d d_P = b_P - a_P;
   double t_lo = 0.0, t_hi = 1.0;
   for (int i = 0; i < 3; ++i) {
-    if (i == k) continue;
     const double h = part.half_m[i];
-    if (d_P[i] == 0.0) {
-      if (std::abs(a_P[i]) > h) return;  // beside the face (the mask's tolerance): no stretch
-      continue;
-    }
+    if (i == k || (std::abs(a_P[i]) <= h && std::abs(b_P[i]) <= h)) continue;
+    if (d_P[i] == 0.0) return;  // beside the face (the mask's tolerance): no stretch
     const double t1 = (-h - a_P[i]) / d_P[i], t2 = (h - a_P[i]) / d_P[i];
     t_lo = std::max(t_lo, std::min(t1, t2));
     t_hi = std::min(t_hi, std::max(t1, t2));
@@ -329,27 +330,25 @@ void Collision::LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eig
   // apart, there by eps / 10 (the capsule chain's tolerance): continuous in the tube's pose, and
   // a piece crossing a face at an angle (a tube wrapped round an edge) keeps its nearest point,
   // where it presses, for both ends (its region ending there as before).
-  const auto distance = [&](double t) {
-    return side * (a_P[k] + t * d_P[k]) - part.half_m[k] - radius_m_;
-  };
-  const double d_lo = distance(t_lo), d_hi = distance(t_hi);
+  const double d0 = side * a_P[k] - part.half_m[k] - radius_m_, slope = side * d_P[k];
+  const double d_lo = d0 + t_lo * slope, d_hi = d0 + t_hi * slope;
   const double t_near = d_lo <= d_hi ? t_lo : t_hi;
-  const double w = std::max(0.0, 1.0 - std::abs(d_hi - d_lo) / (0.1 * eps_m_));
-  const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
-  const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);
-  const double half_m = 0.5 * piece_m_;
-  const auto end = [&](double t, double& s_m, double& d_m, Eigen::Vector3d& p_W) {
-    Eigen::Vector3d p_P = a_P + t * d_P;
-    d_m = distance(t);
-    p_P[k] -= side * radius_m_;  // the surface point facing the face
-    p_W = part.ToWorld(p_P);
-    // The arc position as the nearest point's is taken (Query).
-    const double along = std::clamp((p_W - centre_W).dot(axis_W), -half_m, half_m);
-    s_m = std::max(0.0, s0_m + half_m + along);
-  };
-  end(t_near + w * (t_lo - t_near), c.s_lo_m, c.d_lo_m, c.p_lo_W_m);
-  end(t_near + w * (t_hi - t_near), c.s_hi_m, c.d_hi_m, c.p_hi_W_m);
+  const double w = std::max(0.0, 1.0 - std::abs(d_hi - d_lo) * parallel_per_m_);
   c.line = true;
+  c.t_lo = t_near + w * (t_lo - t_near);
+  c.t_hi = t_near + w * (t_hi - t_near);
+  c.d_lo_m = d0 + c.t_lo * slope;
+  c.d_hi_m = d0 + c.t_hi * slope;
+  // The arc positions as the nearest point's is taken (Query): the surface point's foot on the
+  // chord, (t - 1/2) L less r1 times the axis's component along the face's normal.
+  const double length_m = d_P.norm();
+  const double half_m = 0.5 * piece_m_;
+  const double offset_m = radius_m_ * slope / length_m;
+  const double s0_m = piece_m_ * c.piece + half_m;
+  c.s_lo_m =
+      std::max(0.0, s0_m + std::clamp((c.t_lo - 0.5) * length_m - offset_m, -half_m, half_m));
+  c.s_hi_m =
+      std::max(0.0, s0_m + std::clamp((c.t_hi - 0.5) * length_m - offset_m, -half_m, half_m));
 }
 
 // Inlined for the same reason as CapsuleBoxDistance: once a contact.
@@ -861,8 +860,13 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       c.p_W_m = p_tube_W;
       c.face_mask = FaceMask(part, q_P);
       c.part_element = element_of_[part.index][c.face_mask];
-      if (!is_end && separated && IsFaceMask(c.face_mask))
-        LineEnds(part, a_P, b_P, a_W, b_W, piece_m_ * k, c);
+      // A capsule over a face: its stretch (LineEnds) is worked out only for the pieces that
+      // end a PC's region (core.cpp), two of the hundred of a tube lying in the groove.
+      if (!is_end && separated && IsFaceMask(c.face_mask)) {
+        c.over_face = true;
+        c.piece = k;
+        c.part_slot = static_cast<int>(part_i);
+      }
 
       // The centreline point under the contact, and which element of the tube touches.
       const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);

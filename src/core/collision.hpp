@@ -44,11 +44,27 @@ struct RawContact {
   /// lo end of its first piece to the hi end of its last, whatever that sign (core.cpp). Tilted,
   /// both ends move towards the nearest point, reaching it where the stretch's ends are eps / 10
   /// apart in distance (Collision::LineEnds).
+  /// The ends are at parameters t_lo, t_hi of the piece's axis, from node `piece` (t = 0) to
+  /// the next (t = 1) of the nodes given to Query: the surface point is that axis point less r1
+  /// times normal_W (LineSurfacePoint). Query marks such a contact `over_face`; the stretch is
+  /// worked out by Collision::LineEnds when asked (`line` then set).
+  bool over_face = false;
   bool line = false;
+  int piece = 0;
+  int part_slot = 0;  ///< the part among the Collision's
+  double t_lo = 0.0, t_hi = 0.0;
   double s_lo_m = 0.0, s_hi_m = 0.0;
   double d_lo_m = 0.0, d_hi_m = 0.0;
-  Eigen::Vector3d p_lo_W_m = Eigen::Vector3d::Zero(), p_hi_W_m = Eigen::Vector3d::Zero();
 };
+
+/// The surface point at parameter t of a line contact's piece (RawContact::line), the nodes being
+/// those Query was given, r1 the tube's radius.
+inline Eigen::Vector3d LineSurfacePoint(const RawContact& c, double t,
+                                        std::span<const Eigen::Vector3d> nodes_W, double r1_m) {
+  const Eigen::Vector3d& a_W = nodes_W[std::size_t(c.piece)];
+  const Eigen::Vector3d& b_W = nodes_W[std::size_t(c.piece) + 1];
+  return a_W + t * (b_W - a_W) - r1_m * c.normal_W;
+}
 
 /// Whether a face mask names a face (one bit), not an edge or a vertex. Not std::popcount, which
 /// without -mpopcnt is a library call (2 % of a tick in the profile).
@@ -158,6 +174,11 @@ class Collision {
   bool AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eigen::Matrix3d& R_WH,
                    const Eigen::Vector3d& p_WH, double depth_m, double spacing_m = 0.0) const;
 
+  /// For a contact Query marked `over_face` (a capsule over a face), the ends of the stretch of
+  /// its axis over the face, drawn towards its nearest point as the piece tilts to the face
+  /// (RawContact::line); `nodes_W` are the nodes Query was given. Nothing for other contacts.
+  void LineEnds(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const;
+
   /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
   /// its narrow-phase count does: the core forgets them when it is reset or restored, so that
   /// its figures depend on the ticks since then alone.
@@ -229,11 +250,6 @@ class Collision {
   // part is left out by the kept distances of its pieces in the band).
   void Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
             double d_m) const;
-  // A capsule's contact on a face: the ends of the stretch of its axis over the face
-  // (RawContact::line); s0_m is the piece's first arc position.
-  void LineEnds(const Part& part, const Eigen::Vector3d& a_P, const Eigen::Vector3d& b_P,
-                const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W, double s0_m,
-                RawContact& c) const;
   // Returns the contact's part point in the part's frame.
   Eigen::Vector3d Overlapping(const Part& part, const Eigen::Vector3d& a_W,
                               const Eigen::Vector3d& b_W, RawContact& c) const;
@@ -250,7 +266,8 @@ class Collision {
   double end_m_ = 0.0;    // its length, end_pieces_ * piece_m_ >= r1
   double part_tolerance_m_ = 0.0;
   double tube_tolerance_m_ = 0.0;
-  double eps_m_ = 0.0;  // the contact threshold epsilon
+  double eps_m_ = 0.0;           // the contact threshold epsilon
+  double parallel_per_m_ = 0.0;  // 1 / (eps / 10): LineEnds' tilt scale
   // The end face on a part's face is a spherical cap over the rim, of height dome_height_m_ and
   // radius dome_radius_m_; it is the lowest point while sin(tilt) < dome_sin_max_ = r1 / R.
   double dome_height_m_ = 0.0;

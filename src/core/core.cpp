@@ -640,32 +640,34 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // opened the PC may lie outside it.
   // Per PC, the largest distance of a piece in its region: made once, not once a raw contact.
   std::array<double, kMaxContacts> region_m{};
-  // And the arc positions of its first and last raw contacts so far, kept beside them.
-  std::array<double, kMaxContacts> first_s_m{}, last_s_m{};
   // A capsule over a face spans the stretch of its axis over it (RawContact::line): the region
   // runs from the lo end of its first piece to the hi end of its last. Its nearest point is one
   // of those ends, which by the sign of its tilt to the face: a stiff tube pinched in a groove
   // rocked between them from tick to tick, the region's end jumping 6.5 mm each time (the
-  // squeeze with E = 2e8 Pa, frictionless and linear too, made energy from tick 34).
-  const auto lo_s = [](const RawContact& r) { return r.line ? r.s_lo_m : r.s_m; };
-  const auto hi_s = [](const RawContact& r) { return r.line ? r.s_hi_m : r.s_m; };
+  // squeeze with E = 2e8 Pa, frictionless and linear too, made energy from tick 34). Query gives
+  // a part's pieces in order along the tube, and a PC is one part's: its first and last raw
+  // contacts within the region are its first and last pieces, whose stretches alone are worked
+  // out (a tube lying in the groove has a hundred pieces over the walls and the floor).
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
-    pc.first = pc.last = pc.deepest;
-    const RawContact& deepest = m.raw[std::size_t(pc.deepest)];
-    region_m[std::size_t(k)] = std::max(2.0 * eps, deepest.distance_m + eps);
-    first_s_m[std::size_t(k)] = lo_s(deepest);
-    last_s_m[std::size_t(k)] = hi_s(deepest);
+    pc.first = pc.last = -1;
+    region_m[std::size_t(k)] = std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps);
   }
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
-    if (k < 0) continue;
-    const RawContact& r = m.raw[std::size_t(i)];
+    if (k < 0 || m.raw[std::size_t(i)].distance_m > region_m[std::size_t(k)]) continue;
     PcFound& pc = found[std::size_t(k)];
-    if (r.distance_m > region_m[std::size_t(k)]) continue;
-    if (lo_s(r) < first_s_m[std::size_t(k)]) pc.first = i, first_s_m[std::size_t(k)] = lo_s(r);
-    if (hi_s(r) > last_s_m[std::size_t(k)]) pc.last = i, last_s_m[std::size_t(k)] = hi_s(r);
+    if (pc.first < 0) pc.first = i;
+    pc.last = i;
   }
+  const std::span<const Eigen::Vector3d> query_nodes_W(m.nodes_W.data(), std::size_t(N) + 1);
+  for (int k = 0; k < found_count; ++k) {
+    const PcFound& pc = found[std::size_t(k)];
+    m.collision.LineEnds(m.raw[std::size_t(pc.first)], query_nodes_W);
+    if (pc.last != pc.first) m.collision.LineEnds(m.raw[std::size_t(pc.last)], query_nodes_W);
+  }
+  const auto lo_s = [](const RawContact& r) { return r.line ? r.s_lo_m : r.s_m; };
+  const auto hi_s = [](const RawContact& r) { return r.line ? r.s_hi_m : r.s_m; };
 
   // 4. Load points: one per PC, or two at the ends of a region longer than a tube radius.
   // How far a shape may draw a load point from where the tick's system put it: the contact
@@ -709,7 +711,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // An end face pressed on a face presses at its dome's lowest point (collision.cpp: the face's
     // centre when it lies flat, moving towards the rim as it tilts), wherever GJK put its
     // nearest point.
-    ld.x0_W = lo ? r.p_lo_W_m : hi ? r.p_hi_W_m : r.p_W_m;
+    ld.x0_W = lo   ? LineSurfacePoint(r, r.t_lo, m.nodes_W, scene_.tube.outer_radius_m)
+              : hi ? LineSurfacePoint(r, r.t_hi, m.nodes_W, scene_.tube.outer_radius_m)
+                   : r.p_W_m;
     ld.pressure_centre = r.pressure_centre;
     ld.overlap = r.overlap;
     const scene::Friction& friction =

@@ -636,8 +636,10 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
     const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
     Region region;
     for (int i = 0; i < count; ++i) {
-      const core::RawContact& c = out[std::size_t(i)];
+      core::RawContact& c = out[std::size_t(i)];
       if ((c.face_mask & top) == 0) continue;
+      collision.LineEnds(c, nodes_W);
+      CHECK((!c.over_face || c.face_mask == top));  // a capsule over the face, no other
       region.lo_m = std::min(region.lo_m, c.line ? c.s_lo_m : c.s_m);
       region.hi_m = std::max(region.hi_m, c.line ? c.s_hi_m : c.s_m);
       if (!c.line) continue;
@@ -647,7 +649,8 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
       // Which piece: the one (of those beside the nearest point's arc position) whose geometry
       // gives what the contact says. Its axis from a to b, where it crosses the edge's plane
       // y = 0, its ends' distances to the floor's plane z = 0, and the ends moved towards the
-      // nearer; 1e-15 m: rounding of coordinates of centimetres.
+      // nearer; 1e-15 m: rounding of coordinates of centimetres (1e-12 in t: a division by the
+      // piece's extent across the edge's plane).
       bool matched = false;
       const int k0 = int(c.s_m / piece_m);
       for (int k = std::max(0, k0 - 1); k <= std::min(capsules - 1, k0 + 1) && !matched; ++k) {
@@ -666,9 +669,11 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
           // The arc position of the surface point's foot on the chord, within the piece.
           const double along =
               std::clamp((p - 0.5 * (a + b)).dot(u), -0.5 * piece_m, 0.5 * piece_m);
-          matched = matched && std::abs((lo ? c.d_lo_m : c.d_hi_m) - p.z()) <= 1e-15 &&
-                    std::abs((lo ? c.s_lo_m : c.s_hi_m) - (piece_m * (k + 0.5) + along)) <= 1e-15 &&
-                    ((lo ? c.p_lo_W_m : c.p_hi_W_m) - p).norm() <= 1e-15;
+          matched =
+              matched && c.piece == k && std::abs((lo ? c.t_lo : c.t_hi) - t) <= 1e-12 &&
+              std::abs((lo ? c.d_lo_m : c.d_hi_m) - p.z()) <= 1e-15 &&
+              std::abs((lo ? c.s_lo_m : c.s_hi_m) - (piece_m * (k + 0.5) + along)) <= 1e-15 &&
+              (core::LineSurfacePoint(c, lo ? c.t_lo : c.t_hi, nodes_W, r1) - p).norm() <= 1e-15;
         }
         if (!matched) continue;
         // The nearest point is the nearer end of the stretch.
