@@ -37,17 +37,14 @@ struct RawContact {
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d q_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the part
   Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();      ///< nearest point on the tube
-  /// A capsule over a face (`line`): the ends of the stretch of its axis that lies over the face,
-  /// lo nearer the held end, each as the tube's surface point facing the face, its arc position
-  /// and its distance to the face's plane (signed as distance_m). The nearest point is one of
-  /// the two, which one by the sign of the piece's tilt to the face: a PC's region runs from the
-  /// lo end of its first piece to the hi end of its last, whatever that sign (core.cpp). Tilted,
-  /// both ends move towards the nearest point, reaching it where the stretch's ends are eps / 10
-  /// apart in distance (Collision::LineEnds).
-  /// The ends are at parameters t_lo, t_hi of the piece's axis, from node `piece` (t = 0) to
-  /// the next (t = 1) of the nodes given to Query: the surface point is that axis point less r1
-  /// times normal_W (LineSurfacePoint). Query marks such a contact `over_face`; the stretch is
-  /// worked out by Collision::LineEnds when asked (`line` then set).
+  /// A capsule over a face: Query marks it `over_face` (its piece and part); Collision::LineEnds,
+  /// when asked, sets `line` and the ends of the stretch of its axis over the face, lo nearer the
+  /// held end: each a parameter t of the piece's axis (node `piece` at t = 0, the next at 1), the
+  /// arc position of the surface point facing the face there (LineSurfacePoint) and its distance
+  /// to the face's plane (signed as distance_m). The nearest point is one of the two ends, which
+  /// one by the sign of the piece's tilt to the face, so a PC's region runs from the lo end of its
+  /// first piece to the hi end of its last (core.cpp); tilted, both ends move towards the nearest
+  /// point, reaching it where their distances are eps / 10 apart.
   bool over_face = false;
   bool line = false;
   int piece = 0;
