@@ -1408,15 +1408,24 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       // The group's normals n (unit): P projects onto their span; |n . dp| <= |P dp|, and
       // |n . (omega x r)| = |r . (n x omega)| <= |r| |Q omega|, Q taking out omega's part along
       // n when n is one direction.
+      // The projections are made from the axis in the held frame, a_H a_H^T, not turned there as
+      // R^T P R: two 3x3 products a group and a pass fewer (sliding's tick, 3 % of it). Their
+      // last bits may differ, which can only move a bound's last bits: a pass judged otherwise
+      // at the margin is solved again with every part in, to the same bits.
       const IdleParts::Group& group = idle.groups[std::size_t(g)];
-      const Eigen::Matrix3d aa = group.axis_W * group.axis_W.transpose();
-      const Eigen::Matrix3d P_W = group.dims == 1   ? aa
-                                  : group.dims == 2 ? Eigen::Matrix3d(I - aa)
+      const Eigen::Vector3d a_H = R_WH.transpose() * group.axis_W;
+      const Eigen::Matrix3d aa_H = a_H * a_H.transpose();
+      const Eigen::Matrix3d P_H = group.dims == 1   ? aa_H
+                                  : group.dims == 2 ? Eigen::Matrix3d(I - aa_H)
                                                     : I;
-      const Eigen::Matrix3d Q_W = group.dims == 1 ? Eigen::Matrix3d(I - aa) : I;
-      const Eigen::Matrix3d P_H = R_WH.transpose() * P_W * R_WH;
-      const Eigen::Matrix3d Q_H = R_WH.transpose() * Q_W * R_WH;
-      double moved_m = (P_W * dp_W).norm() + (Q_W * omega_W).norm() * reach_m;
+      const Eigen::Matrix3d Q_H = group.dims == 1 ? Eigen::Matrix3d(I - aa_H) : I;
+      const auto projected_norm = [&](const Eigen::Vector3d& v_W, bool onto_axis) {
+        const double along = group.axis_W.dot(v_W);
+        return onto_axis ? std::abs(along) : (v_W - along * group.axis_W).norm();
+      };
+      const double dp_m = group.dims == 3 ? dp_W.norm() : projected_norm(dp_W, group.dims == 1);
+      const double omega_n = group.dims == 1 ? projected_norm(omega_W, false) : omega_W.norm();
+      double moved_m = dp_m + omega_n * reach_m;
       // The linear model (build_compliance) takes last tick's shape out where its loads were:
       // W(i, now) F - W(i, then) F_lin is W(i, now) (F - F_lin) plus, where the load moved,
       // (W(i, now) - W(i, then)) F_lin; a load out of contact adds -W(i, then) F_lin.
