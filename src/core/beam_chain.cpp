@@ -181,6 +181,29 @@ Eigen::Vector3d BeamChain::SectionRotation(double s_m, const BeamLoad& j) const 
   return c.thF * (kZ * j.f_H_N) + c.thM * (kLateral * M);
 }
 
+Eigen::Matrix3d BeamChain::MomentCompliance(const BeamLoad& i, const BeamLoad& at) const {
+  // Compliance's moment terms: a moment M moves the centre by -uM z x M and turns the section
+  // by thM M (its lateral part), which moves the surface point by -r_i x that.
+  const Coefficients c = Coeffs(i.s_m - at.clamp_m, at.s_m - at.clamp_m, EI_);
+  return -c.uM * kZ - c.thM * Skew(i.r_H_m) * kLateral;
+}
+
+Eigen::Matrix3d BeamChain::TurnCompliance(double s_m, const BeamLoad& j) const {
+  const Coefficients c = Coeffs(s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
+  return c.thF * kZ + c.thM * kLateral * Skew(j.r_H_m);
+}
+
+double BeamChain::TurnPerMoment(const BeamLoad& at) const {
+  return Coeffs(at.s_m - at.clamp_m, at.s_m - at.clamp_m, EI_).thM;
+}
+
+double BeamChain::MomentDisplacementBound(const BeamLoad& at, double moment_Nm, double r_max_m,
+                                          double s_max_m) const {
+  // Each coefficient grows with the point's arc position (Coeffs): its value at s_max bounds it.
+  const Coefficients c = Coeffs(s_max_m - at.clamp_m, at.s_m - at.clamp_m, EI_);
+  return (c.uM + r_max_m * c.thM) * std::abs(moment_Nm);
+}
+
 bool BeamChain::ElasticaCovers(const std::array<BeamLoad, kMaxLoads>& loads,
                                const std::array<int, kMaxLoads>& order, int count,
                                int groups) const {

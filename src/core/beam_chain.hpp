@@ -125,6 +125,20 @@ class BeamChain {
   Eigen::Vector3d CentreDisplacement(double s_m, const BeamLoad& j) const;
   Eigen::Vector3d SectionRotation(double s_m, const BeamLoad& j) const;
 
+  /// The linear model's response to a moment at a section (an end face's dome, docs/core.md):
+  /// displacement [m/(N m)] of load i's surface point per moment [N m] on the section of
+  /// `at` (its arc position and clamp), frame H; the section's turn [rad/N] at s_m per force of
+  /// load j (force and the moment of its offset), frame H; and the section's own turn per moment
+  /// about a lateral axis [rad/(N m)]. The first is the second's transpose where i's clamp is
+  /// at's (Maxwell-Betti).
+  Eigen::Matrix3d MomentCompliance(const BeamLoad& i, const BeamLoad& at) const;
+  Eigen::Matrix3d TurnCompliance(double s_m, const BeamLoad& j) const;
+  double TurnPerMoment(const BeamLoad& at) const;
+  /// An upper bound [m] of |MomentCompliance(i, at) M| over every point i as in
+  /// DisplacementBound (arc position up to s_max_m, offset at most r_max_m).
+  double MomentDisplacementBound(const BeamLoad& at, double moment_Nm, double r_max_m,
+                                 double s_max_m) const;
+
   /// Whether the elastica can carry these loads: one group per cantilever (segmented), or a
   /// single group (coupled), and every segment's load parameter within the solver's range.
   /// `order` and `count` as Assign left them.

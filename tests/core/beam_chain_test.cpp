@@ -242,3 +242,81 @@ TEST_CASE("DisplacementChangeBound bounds a force's moved compliance at every po
   // Not loose where the clamp stays: some points reach it to within 5 %.
   CHECK(tightest > 0.95);
 }
+
+TEST_CASE("The moment's compliances are Compliance's moment terms, transposed by Maxwell-Betti",
+          "[core][beam]") {
+  // The dome's spring (core.cpp) needs the linear beam's response to a moment on the end
+  // section: MomentCompliance, TurnCompliance and TurnPerMoment. Each is checked against what
+  // Compliance and SectionRotation already give for a load's offset moment (an independent
+  // assembly of the same coefficients): a force F at offset r is the force at the centre plus
+  // the moment r x F, so Compliance(i, j) - Compliance(i, j at the centre) is
+  // MomentCompliance(i, j) [r_j]x; TurnCompliance(s, j) F is SectionRotation(s, j); and the turn
+  // per moment is the section's turn under the moment r x F of a force along the axis.
+  const scene::Scene s = RubberTube();
+  const core::BeamChain chain(s);
+  const double l = s.tube.length_m;
+  std::mt19937_64 rng(20261128);
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  const auto skew = [](const Eigen::Vector3d& v) {
+    Eigen::Matrix3d m;
+    m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+    return m;
+  };
+  for (int trial = 0; trial < 2000; ++trial) {
+    const core::BeamLoad j = RandomLoad(trial, l, rng);
+    core::BeamLoad i = RandomLoad(trial, l, rng);
+    i.clamp_m = j.clamp_m;
+    core::BeamLoad j_centre = j;
+    j_centre.r_H_m.setZero();
+    const Eigen::Matrix3d scale = chain.Compliance(i, j).cwiseAbs();
+    const double tol = 1e-12 * scale.maxCoeff() + 1e-18;
+    INFO("trial " << trial);
+    CHECK((chain.Compliance(i, j) - chain.Compliance(i, j_centre) -
+           chain.MomentCompliance(i, j) * skew(j.r_H_m))
+              .cwiseAbs()
+              .maxCoeff() <= tol);
+    const Eigen::Vector3d F(fraction(rng) - 0.5, fraction(rng) - 0.5, fraction(rng) - 0.5);
+    core::BeamLoad j_loaded = j;
+    j_loaded.f_H_N = F;
+    const Eigen::Vector3d turn = chain.SectionRotation(i.s_m, j_loaded);
+    CHECK((chain.TurnCompliance(i.s_m, j) * F - turn).norm() <= 1e-12 * turn.norm() + 1e-18);
+    // Maxwell-Betti: i's displacement per moment at j's section is the transpose of j's
+    // section's turn per force at i (one clamp), in the lateral directions the model bends in.
+    const Eigen::Matrix3d lateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
+    CHECK((chain.MomentCompliance(i, j) * lateral -
+           chain.TurnCompliance(j.s_m, i).transpose() * lateral)
+              .cwiseAbs()
+              .maxCoeff() <= tol);
+    // The turn per moment: a unit axial force at offset x gives the moment y (x cross z = -y).
+    core::BeamLoad axial = j;
+    axial.r_H_m = Eigen::Vector3d::UnitX();
+    axial.f_H_N = Eigen::Vector3d::UnitZ();
+    CHECK(chain.TurnPerMoment(j) ==
+          Approx(-chain.SectionRotation(j.s_m, axial).y()).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("MomentDisplacementBound bounds a moment's displacement of every point up to s_max",
+          "[core][beam]") {
+  const scene::Scene s = RubberTube();
+  const core::BeamChain chain(s);
+  const double l = s.tube.length_m, r_max = 0.03;
+  std::mt19937_64 rng(20261129);
+  std::uniform_real_distribution<double> fraction(0.0, 1.0);
+  double tightest = 0.0;
+  for (int trial = 0; trial < 5000; ++trial) {
+    const core::BeamLoad at = RandomLoad(trial, l, rng);
+    const Eigen::Vector3d M = 0.05 * fraction(rng) * RandomUnit(rng);
+    const double s_max = l * fraction(rng);
+    const double bound = chain.MomentDisplacementBound(at, M.norm(), r_max, s_max);
+    for (int k = 0; k < 8; ++k) {
+      const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
+      const double moved = (chain.MomentCompliance(i, at) * M).norm();
+      INFO("trial " << trial << " k " << k);
+      CHECK(moved <= bound * (1.0 + 1e-12) + 1e-18);
+      if (bound > 0.0) tightest = std::max(tightest, moved / bound);
+    }
+  }
+  // Not loose: a moment's bend and turn at s_max add up for an offset along the axis (2 %).
+  CHECK(tightest > 0.98);
+}
