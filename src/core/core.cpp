@@ -122,6 +122,8 @@ struct Core::State {
     // its offset from the face's centre (frame H), relaxed from tick to tick (below).
     bool pressure_centre = false;
     Eigen::Vector3d cop_H_m = Eigen::Vector3d::Zero();
+    // Its dome's resistance to tilting is in the tick's system (the linear model; step 5).
+    bool dome_spring = false;
     // Whether the collision found the tube's surface inside the part here.
     bool overlap = false;
     bool SameKey(const Load& o) const {
@@ -830,6 +832,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<bool, kMaxLoads> taken{};
   // Loads that continue a face's point with the rim as its target (pass 0, above).
   std::array<bool, kMaxLoads> on_rim{};
+  // Faces whose point starts from a rim's (pass 0, below; not from a face lying flat).
+  std::array<bool, kMaxLoads> from_rim{};
   for (int pass = 0; pass < 3; ++pass) {
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
@@ -877,6 +881,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         on_rim[std::size_t(i)] = true;
       } else if (pass == 0) {
         ld.cop_H_m = before.r_H_m;  // a face continuing the rim: from the rim's point
+        from_rim[std::size_t(i)] = before.tube != states::TubeElement::kEndFace;
       }
       if (ld.pressure_centre && before.pressure_centre) ld.cop_H_m = before.cop_H_m;
     }
@@ -890,6 +895,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // way from last tick's offset to this tick's target is the Newton step of that linear loop:
   // it settles in one tick when g is right, and stays stable for any true gain up to 1 + 2 g.
   // N is the force the shape was drawn under (none for a new contact: it starts at its target).
+  // The linear model instead puts the dome's resistance in the tick's system (step 5, "the
+  // dome's spring"): the point starts at its target, and moves with the end's turn within the
+  // tick. Not for a point continuing a rim's, or a rim continuing a face's: the dome's law does
+  // not hold over that way, and the relaxation stays.
+  const bool linear_beam = scene_.model.beam == model::BeamModel::kLinear;
   {
     const double tilt_compliance = m.collision.dome_radius_m() * l / m.beam.bending_stiffness_Nm2();
     const double half_by_radius = 0.5 / m.collision.dome_radius_m();
@@ -898,8 +908,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       if (!ld.pressure_centre || ld.ghost) continue;
+      ld.dome_spring = linear_beam && !on_rim[std::size_t(i)] && !from_rim[std::size_t(i)];
       const double relax =
-          1.0 / (1.0 + std::max(0.0, ld.f_lin_W.dot(ld.normal_W)) * tilt_compliance);
+          ld.dome_spring
+              ? 1.0
+              : 1.0 / (1.0 + std::max(0.0, ld.f_lin_W.dot(ld.normal_W)) * tilt_compliance);
       const Eigen::Vector3d target_H = R_WH.transpose() * (ld.x0_W - tip_W);
       const Eigen::Vector3d step_H = relax * (target_H - ld.cop_H_m);
       ld.cop_H_m += step_H;
@@ -983,6 +996,39 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     return !(then_j.s_m == now_j.s_m && then_j.r_H_m == now_j.r_H_m &&
              then_j.clamp_m == now_j.clamp_m);
   };
+  // The dome's spring (the linear model; docs/core.md). An end face pressed on a face carries its
+  // load at its dome's lowest point, e = R sin(tilt) off its centre: as the end turns by theta
+  // (lateral, frame H) the point moves by -R theta x z, and the load N's moment by -N R theta, a
+  // rotational spring k_r = N R on the end section. Left to the next tick, that spring is a loop
+  // of gain N R l / (E I) (the relaxation above; a stuck tip stepped sideways reached its force
+  // over ten ticks). In the system it is condensed into the compliance: with T_j the end's turn
+  // per force of load j, C_i load i's displacement per moment on the end and t_M the end's turn
+  // per moment, the moment is M = -kappa L (sum_j T_j F_j - theta_0), kappa = k_r / (1 + k_r t_M),
+  // L the lateral projection and theta_0 the end's turn in last tick's shape, and
+  //     x_i += C_i M:  W_ij -= kappa C_i L T_j,  base_i += kappa C_i L theta_0
+  // (Q in place of L below)
+  // (C_i = T_i^T where the clamps agree: W stays symmetric, and a stuck spring on it conservative).
+  // k_r is taken at the force last tick's shape was drawn under, N's change within the tick
+  // being second order in the moment. The held end's own turn within the tick is left to the
+  // next tick's point.
+  //
+  // The rim pressed on a face, beyond the dome's range, has such a spring too, about one axis:
+  // its point is the rim's lowest, r1 u with u the direction the face tilts to, and a turn about
+  // u moves it round the rim by r1 / sin(tilt) times the turn (R itself where the dome meets the
+  // rim), a turn across u not at all. Left out, that loop made the linear model's slide off the
+  // plane (stability sweep, `slide along a wall off-plane=0.1mm`) buzz at 500 Hz once its dome
+  // had reached the rim: the rim's point swung 3 mm round it and back each tick. So the spring
+  // is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 / sin(tilt), and
+  // kappa = k_r / (1 + k_r t_M) along Q.
+  const Eigen::Vector3d tip_axis_W = tangent_at(l);
+  struct DomeSpring {
+    int load = -1;  // the end face's load, or none
+    double kappa = 0.0, radius_m = 0.0, k_r = 0.0, turn_per_moment = 0.0;
+    Eigen::Matrix3d Q_H = Eigen::Matrix3d::Zero();  // the turns it resists
+    Eigen::Vector3d theta0_H = Eigen::Vector3d::Zero();
+    std::array<Eigen::Matrix3d, kMaxLoads> T_H;  // the end's turn per force of each member
+  } dome;
+  const Eigen::Matrix3d lateral_H = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
   const auto build_compliance = [&] {
     // The cantilever's members. The nonlinear models' tangents are taken about last tick's
     // forces, so a load that carried force then is one (its force is taken out through its
@@ -1189,6 +1235,53 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
                          (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N));
       }
     }
+    dome.load = -1;
+    for (int e = 0; e < load_count && !want_elastica; ++e) {
+      const Load& ld = m.loads[std::size_t(e)];
+      const double N0 = ld.f_lin_W.dot(ld.normal_W);
+      if (!member[std::size_t(e)] || !(N0 > 0.0)) continue;
+      const BeamLoad& at = m.beam_loads[std::size_t(e)];
+      const double R = m.collision.dome_radius_m();
+      if (ld.dome_spring) {
+        dome.radius_m = R;
+        dome.Q_H = lateral_H;
+      } else {
+        // The rim on a face: the load at the end, on the rim circle, not overlapping.
+        const Eigen::Vector3d u_H = lateral_H * at.r_H_m;
+        const double sin_tilt = tip_axis_W.cross(ld.normal_W).norm();
+        const double r1 = scene_.tube.outer_radius_m;
+        if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
+            !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
+            !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1))
+          continue;
+        dome.radius_m = r1 / sin_tilt;
+        dome.Q_H = u_H * u_H.transpose() / u_H.squaredNorm();
+      }
+      dome.load = e;
+      dome.k_r = N0 * dome.radius_m;
+      dome.turn_per_moment = m.beam.TurnPerMoment(at);
+      dome.kappa = dome.k_r / (1.0 + dome.k_r * dome.turn_per_moment);
+      dome.theta0_H.setZero();
+      BeamLoad then_j;
+      for (int j = 0; j < load_count; ++j) {
+        if (reference_of(j, then_j))
+          dome.theta0_H += m.beam.TurnCompliance(at.s_m, then_j) * then_j.f_H_N;
+        dome.T_H[std::size_t(j)] = member[std::size_t(j)]
+                                       ? m.beam.TurnCompliance(at.s_m, m.beam_loads[std::size_t(j)])
+                                       : Eigen::Matrix3d::Zero();
+      }
+      for (int i = 0; i < load_count; ++i) {
+        Load& li = m.loads[std::size_t(i)];
+        const Eigen::Matrix3d CL =
+            dome.kappa * m.beam.MomentCompliance(m.beam_loads[std::size_t(i)], at) * dome.Q_H;
+        li.base_W += R_WH * (CL * dome.theta0_H);
+        for (int j = 0; j < load_count; ++j)
+          if (member[std::size_t(j)])
+            m.W[std::size_t(i)][std::size_t(j)] -=
+                R_WH * (CL * dome.T_H[std::size_t(j)]) * R_WH.transpose();
+      }
+      break;  // one end face
+    }
   };
   // What a stuck contact's tangential spring sees of the compliance.
   //
@@ -1394,8 +1487,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // group (IdleParts::Group); computed from the pass's solve, judged after its decisions.
   std::array<Eigen::Vector3d, kMaxLoads> df_H;
   std::array<double, IdleParts::kMaxGroups> idle_moved_m{};
+  // The end's turn, frame H, under this pass's forces (slot, z), less last tick's: what the
+  // dome's spring resists.
+  const auto dome_turn = [&] {
+    Eigen::Vector3d turn_H = -dome.theta0_H;
+    for (int j = 0; j < load_count; ++j) {
+      const int sj = slot[std::size_t(j)];
+      if (sj >= 0 && member[std::size_t(j)])
+        turn_H += dome.T_H[std::size_t(j)] * (R_WH.transpose() * m.z.segment<3>(3 * sj));
+    }
+    return Eigen::Vector3d(dome.Q_H * turn_H);
+  };
   const auto bound_idle_motion = [&] {
     if (idle.group_count == 0) return;
+    // The dome's moment moves every point of the tube by C M (build_compliance).
+    const double dome_moment_Nm = dome.load >= 0 ? dome.kappa * dome_turn().norm() : 0.0;
     for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
       const Eigen::Vector3d F =
@@ -1445,6 +1551,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           moved_m += m.beam.DisplacementChangeBound(now_j, then_j, then_j.f_H_N, true, offset_m,
                                                     group.s_max_m, P_H, Q_H);
       }
+      if (dome.load >= 0)
+        moved_m += m.beam.MomentDisplacementBound(m.beam_loads[std::size_t(dome.load)],
+                                                  dome_moment_Nm, offset_m, group.s_max_m);
       idle_moved_m[std::size_t(g)] = moved_m;
     }
   };
@@ -1698,6 +1807,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
 
   // 7. Results per load; a sliding load's anchor follows it (the spring then carries f_k).
   Eigen::Vector3d force_W = Eigen::Vector3d::Zero(), torque_W = Eigen::Vector3d::Zero();
+  // The dome's point moves with the end's turn under its spring, -R turn x z (build_compliance),
+  // kept on the face (within r1 of its centre, where the dome meets the rim).
+  Eigen::Vector3d dome_shift_H = Eigen::Vector3d::Zero();
+  if (dome.load >= 0 && m.loads[std::size_t(dome.load)].active) {
+    // The end's turn along Q under the spring (its turn across Q is not resisted, and does not
+    // move the point: the rim's radial direction).
+    const Eigen::Vector3d turn_H = dome_turn() / (1.0 + dome.k_r * dome.turn_per_moment);
+    const Load& ld = m.loads[std::size_t(dome.load)];
+    const Eigen::Vector3d from_H = lateral_H * ld.r_H_m;
+    Eigen::Vector3d to_H = from_H - dome.radius_m * turn_H.cross(Eigen::Vector3d::UnitZ());
+    const double r1 = scene_.tube.outer_radius_m;
+    const double to_m = to_H.norm();
+    if (to_m > r1 || (ld.tube != states::TubeElement::kEndFace && to_m > 0.0)) to_H *= r1 / to_m;
+    dome_shift_H = to_H - from_H;
+  }
   int beam_count = 0;
   for (int i = 0; i < load_count; ++i) {
     Load& ld = m.loads[std::size_t(i)];
@@ -1712,6 +1836,17 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const int sj = slot[std::size_t(j)];
       if (sj >= 0)
         ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+    }
+    if (i == dome.load) {
+      // The pressure moves over the face, the material does not slip: the point, where it
+      // started and its anchor move together, and the stretch stays.
+      const Eigen::Vector3d shift_W = R_WH * dome_shift_H;
+      ld.cop_H_m += dome_shift_H;
+      ld.r_H_m += dome_shift_H;
+      ld.x0_W += shift_W;
+      ld.x_W += shift_W;
+      ld.stick_x_W += shift_W;
+      ld.anchor_W += shift_W;
     }
     ld.force_W = f_load_W[std::size_t(i)];
     ld.shape_force_W = ld.force_W;
