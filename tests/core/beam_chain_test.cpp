@@ -49,6 +49,22 @@ core::BeamLoad BoundPoint(int k, double s_max, double r_max, std::mt19937_64& rn
                      : fraction(rng) * r_max * RandomUnit(rng);
   return i;
 }
+// Checks a displacement bound at a trial's eight points (BoundPoint): moved_at(i) <= bound, up to
+// rounding (the bound is a sum of a few products of the same magnitudes). Returns the largest
+// moved / bound, to show the bound is not loose.
+template <class Moved>
+double CheckAtBoundPoints(double bound, double s_max, double r_max, std::mt19937_64& rng,
+                          const Moved& moved_at) {
+  double tightest = 0.0;
+  for (int k = 0; k < 8; ++k) {
+    const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
+    const double moved = moved_at(i);
+    INFO("point " << k);
+    CHECK(moved <= bound * (1.0 + 1e-12) + 1e-18);
+    if (bound > 0.0) tightest = std::max(tightest, moved / bound);
+  }
+  return tightest;
+}
 }  // namespace
 
 TEST_CASE("Elastica nodes by Hermite interpolation stay within 2 um of the exact shape",
@@ -182,15 +198,11 @@ TEST_CASE("DisplacementBound bounds the compliance of every point up to s_max, a
     Eigen::Matrix3d P, Q;
     GroupSpan(RandomUnit(rng), dims, P, Q);
     const double bound = chain.DisplacementBound(j, df_H, moments, r_max, s_max, P, Q);
+    INFO("trial " << trial << " dims " << dims);
     // The largest |n . v| over unit n in P's range is |P v|.
-    for (int k = 0; k < 8; ++k) {
-      const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
-      const double moved = (P * (chain.Compliance(i, j, moments) * df_H)).norm();
-      INFO("trial " << trial << " dims " << dims << " k " << k);
-      // Rounding: the bound is a sum of a few products of the same magnitudes.
-      CHECK(moved <= bound * (1.0 + 1e-12) + 1e-18);
-      if (bound > 0.0) tightest = std::max(tightest, moved / bound);
-    }
+    tightest = std::max(tightest, CheckAtBoundPoints(bound, s_max, r_max, rng, [&](const auto& i) {
+                          return (P * (chain.Compliance(i, j, moments) * df_H)).norm();
+                        }));
   }
   // And it is not loose: some points reach it to within 2 % (a lateral force's bend and turn
   // at s_max, with the offset along the axis, add up along the force).
@@ -309,13 +321,10 @@ TEST_CASE("MomentDisplacementBound bounds a moment's displacement of every point
     const Eigen::Vector3d M = 0.05 * fraction(rng) * RandomUnit(rng);
     const double s_max = l * fraction(rng);
     const double bound = chain.MomentDisplacementBound(at, M.norm(), r_max, s_max);
-    for (int k = 0; k < 8; ++k) {
-      const core::BeamLoad i = BoundPoint(k, s_max, r_max, rng);
-      const double moved = (chain.MomentCompliance(i, at) * M).norm();
-      INFO("trial " << trial << " k " << k);
-      CHECK(moved <= bound * (1.0 + 1e-12) + 1e-18);
-      if (bound > 0.0) tightest = std::max(tightest, moved / bound);
-    }
+    INFO("trial " << trial);
+    tightest = std::max(tightest, CheckAtBoundPoints(bound, s_max, r_max, rng, [&](const auto& i) {
+                          return (chain.MomentCompliance(i, at) * M).norm();
+                        }));
   }
   // Not loose: a moment's bend and turn at s_max add up for an offset along the axis (2 %).
   CHECK(tightest > 0.98);

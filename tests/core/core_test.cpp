@@ -141,15 +141,23 @@ TEST_CASE("Tip stuck on a wall, the hand moves sideways: 3EI/l^3 in series, then
   CHECK(slid);
 }
 
+namespace {
+// The rubber tube (linear model), stuck on a wall 0.5 mm beyond its tip (the dome's tests).
+scene::Scene SoftTubeAtWall() {
+  scene::Scene s = TubeScene(3e6, 8e-3, 5e-3, 0.15);
+  s.friction = {2.0, 2.0, 1.0, 1.0};  // stuck throughout
+  s.parts.push_back(Box("wall", {0.1, 0.1, 0.02}, {0.0, 0.0, s.tube.length_m + 0.5e-3 + 0.01}));
+  return s;
+}
+}  // namespace
+
 TEST_CASE("A soft tube's end face pressed on a wall resists its tilt: N R, the dome's", "[core]") {
   // The rubber tube of scenes/groove.yaml (linear model), its end face pressed on a wall with
   // 0.58 N: the face's dome (R = 320 mm) resists the end's tilt with N R = 0.18 N m, 3.4 times
   // the tube's rotational stiffness at its end (x = N R l / (E I)), so the stuck tip is 2.3
   // times as stiff sideways as 3EI/l^3; a point contact (the paper's) would give 3EI/l^3.
-  scene::Scene s = TubeScene(3e6, 8e-3, 5e-3, 0.15);
+  const scene::Scene s = SoftTubeAtWall();
   const double l = s.tube.length_m;
-  s.friction = {2.0, 2.0, 1.0, 1.0};  // stuck throughout
-  s.parts.push_back(Box("wall", {0.1, 0.1, 0.02}, {0.0, 0.0, l + 0.5e-3 + 0.01}));
   core::Core c(s);
   const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
   const double k_point = 1.0 / (1.0 / 400.0 + l * l * l / (3.0 * EI) + 1.0 / 1e4);
@@ -183,10 +191,8 @@ TEST_CASE(
   // force is the closed form's. When the load point was moved between ticks instead, relaxed by
   // the free cantilever's 1 / (1 + N R l / (E I)), the stuck tip's force crept up over ten ticks:
   // 3.6, 5.6, 6.8, 7.4 ... of 8.27 mN.
-  scene::Scene s = TubeScene(3e6, 8e-3, 5e-3, 0.15);
+  const scene::Scene s = SoftTubeAtWall();
   const double l = s.tube.length_m;
-  s.friction = {2.0, 2.0, 1.0, 1.0};  // stuck throughout
-  s.parts.push_back(Box("wall", {0.1, 0.1, 0.02}, {0.0, 0.0, l + 0.5e-3 + 0.01}));
   core::Core c(s);
   const double EI = model::ComputeSection(s.tube).bending_stiffness_Nm2;
   double t = 0.0;
