@@ -1020,7 +1020,6 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // had reached the rim: the rim's point swung 3 mm round it and back each tick. So the spring
   // is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 / sin(tilt), and
   // kappa = k_r / (1 + k_r t_M) along Q.
-  const Eigen::Vector3d tip_axis_W = tangent_at(l);
   struct DomeSpring {
     int load = -1;  // the end face's load, or none
     double kappa = 0.0, radius_m = 0.0, k_r = 0.0, turn_per_moment = 0.0;
@@ -1028,7 +1027,6 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     Eigen::Vector3d theta0_H = Eigen::Vector3d::Zero();
     std::array<Eigen::Matrix3d, kMaxLoads> T_H;  // the end's turn per force of each member
   } dome;
-  const Eigen::Matrix3d lateral_H = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
   const auto build_compliance = [&] {
     // The cantilever's members. The nonlinear models' tangents are taken about last tick's
     // forces, so a load that carried force then is one (its force is taken out through its
@@ -1244,11 +1242,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const double R = m.collision.dome_radius_m();
       if (ld.dome_spring) {
         dome.radius_m = R;
-        dome.Q_H = lateral_H;
+        dome.Q_H = lateral;
       } else {
         // The rim on a face: the load at the end, on the rim circle, not overlapping.
-        const Eigen::Vector3d u_H = lateral_H * at.r_H_m;
-        const double sin_tilt = tip_axis_W.cross(ld.normal_W).norm();
+        const Eigen::Vector3d u_H = lateral * at.r_H_m;
+        const double sin_tilt = tangent_at(l).cross(ld.normal_W).norm();
         const double r1 = scene_.tube.outer_radius_m;
         if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
             !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
@@ -1815,7 +1813,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // move the point: the rim's radial direction).
     const Eigen::Vector3d turn_H = dome_turn() / (1.0 + dome.k_r * dome.turn_per_moment);
     const Load& ld = m.loads[std::size_t(dome.load)];
-    const Eigen::Vector3d from_H = lateral_H * ld.r_H_m;
+    const Eigen::Vector3d from_H = lateral * ld.r_H_m;
     Eigen::Vector3d to_H = from_H - dome.radius_m * turn_H.cross(Eigen::Vector3d::UnitZ());
     const double r1 = scene_.tube.outer_radius_m;
     const double to_m = to_H.norm();
