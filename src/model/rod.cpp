@@ -159,17 +159,23 @@ Rod::Result Rod::Integrate(std::span<const RodLoad> loads, std::span<const int> 
   };
   if constexpr (kTangent) {
     directions = tangent->directions;
-    assert(directions <= kMaxDirections && (directions == 3 || directions == 3 + 3 * count));
+    assert(directions <= kMaxDirections &&
+           (directions == 3 || directions == 3 + 3 * count || directions == 6 + 3 * count));
     force_directions = directions > 3;
+    // Directions 3 + 3 count + c (when asked for) add a unit moment about axis c to the end
+    // section: active from the start, like the end's turn.
+    const int first_moment = directions == 6 + 3 * count ? 3 + 3 * count : directions;
     for (int c = 0; c < directions; ++c) {
       const std::size_t cc = std::size_t(c);
       tangent->turn[cc] =
           c < 3 ? Eigen::Vector3d(Eigen::Vector3d::Unit(c)) : Eigen::Vector3d::Zero();
-      tangent->m[cc].setZero();
+      tangent->m[cc] = c >= first_moment ? Eigen::Vector3d(Eigen::Vector3d::Unit(c - first_moment))
+                                         : Eigen::Vector3d::Zero();
       tangent->n[cc].setZero();
       tangent->x[cc].setZero();
     }
     for (int c = 0; c < 3; ++c) add_slot(c);
+    for (int c = first_moment; c < directions; ++c) add_slot(c);
   }
   const std::size_t sample_count = samples.s_m.size();
   std::size_t beyond = sample_count;  // samples at s > end: straight, set at the end
@@ -749,7 +755,8 @@ void Rod::Shape(std::span<const RodLoad> loads, const RodSolution& solution,
 }
 
 bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
-                     std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn) const {
+                     std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn,
+                     RodEndMoment* end_moment) const {
   Order order{};
   const int count = SortedOrder(loads, order);
   const std::span<const int> sorted(order.data(), std::size_t(count));
@@ -764,11 +771,13 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
   }
   std::array<Eigen::Vector3d, kMaxLoads> p;
   const std::span<const double> s_span(s_sorted.data(), std::size_t(count));
-  // One integration carries the derivatives along the end's turn q and every force F_j: the
-  // surface points S and the clamp residual e move by dS/dq, dS/dF, de/dq, de/dF.
-  constexpr int kMaxDirections = 3 + 3 * kMaxLoads;
+  // One integration carries the derivatives along the end's turn q, every force F_j and, if
+  // asked for, a moment M on the end section: the surface points S and the clamp residual e
+  // move by dS/dq, dS/dF, dS/dM, de/dq, de/dF, de/dM.
+  constexpr int kMaxDirections = 6 + 3 * kMaxLoads;
   Tangent<kMaxDirections> tangent;
-  tangent.directions = 3 + 3 * count;
+  const int first_moment = 3 + 3 * count;
+  tangent.directions = first_moment + (end_moment != nullptr ? 3 : 0);
   tangent.surface_r_m = std::span<const Eigen::Vector3d>(r_sorted.data(), std::size_t(count));
   Integrate(loads, sorted, 1.0, solution.end_R,
             {s_span, std::span(p.data(), std::size_t(count)), {}}, &tangent);
@@ -777,24 +786,42 @@ bool Rod::Compliance(std::span<const RodLoad> loads, const RodSolution& solution
   const double det = E_u.determinant();
   if (!(std::abs(det) > 1e-12) || !E_u.allFinite()) return false;
   const Eigen::Matrix3d E_u_inv = E_u.inverse();
+  // Direction d's response with the root kept clamped: the end's turn u = -E_u^-1 de/dd, and
+  // each surface point's dS/dd + dS/dq u.
+  const auto respond = [&](std::size_t d, Eigen::Vector3d& u, const auto& surface_column) {
+    u = -E_u_inv * tangent.residual[d];
+    for (int ki = 0; ki < count; ++ki) {
+      const std::size_t at = std::size_t(ki) * kMaxDirections;
+      surface_column(
+          order[std::size_t(ki)],
+          Eigen::Vector3d(tangent.surface[at + d] + tangent.surface[at + 0] * u.x() +
+                          tangent.surface[at + 1] * u.y() + tangent.surface[at + 2] * u.z()));
+    }
+  };
   for (int j = 0; j < count; ++j)
     for (int c = 0; c < 3; ++c) {
-      const std::size_t d = std::size_t(3 + 3 * j + c);
       // The end's turn that keeps the root clamped as F_j moves.
-      const Eigen::Vector3d u_F = -E_u_inv * tangent.residual[d];
+      Eigen::Vector3d u_F;
+      respond(std::size_t(3 + 3 * j + c), u_F,
+              [&](int i, const Eigen::Vector3d& dS) { w[std::size_t(i * count + j)].col(c) = dS; });
       if (!end_turn.empty()) end_turn[std::size_t(j)].col(c) = u_F;
-      for (int ki = 0; ki < count; ++ki) {
-        const std::size_t at = std::size_t(ki) * kMaxDirections;
-        const int i = order[std::size_t(ki)];
-        w[std::size_t(i * count + j)].col(c) =
-            tangent.surface[at + d] + tangent.surface[at + 0] * u_F.x() +
-            tangent.surface[at + 1] * u_F.y() + tangent.surface[at + 2] * u_F.z();
-      }
     }
   for (int k = 0; k < count * count; ++k)
     if (!w[std::size_t(k)].allFinite()) return false;
   for (std::size_t j = 0; j < end_turn.size() && j < std::size_t(count); ++j)
     if (!end_turn[j].allFinite()) return false;
+  if (end_moment != nullptr) {
+    for (int c = 0; c < 3; ++c) {
+      Eigen::Vector3d u_M;
+      respond(std::size_t(first_moment + c), u_M, [&](int i, const Eigen::Vector3d& dS) {
+        end_moment->w_per_Nm[std::size_t(i)].col(c) = dS;
+      });
+      end_moment->turn_per_Nm.col(c) = u_M;
+    }
+    if (!end_moment->turn_per_Nm.allFinite()) return false;
+    for (int i = 0; i < count; ++i)
+      if (!end_moment->w_per_Nm[std::size_t(i)].allFinite()) return false;
+  }
   return true;
 }
 

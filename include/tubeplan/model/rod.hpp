@@ -26,6 +26,7 @@
 //
 // Everything here is in the clamp's frame, SI. No heap allocation.
 
+#include <array>
 #include <span>
 
 #include <Eigen/Core>
@@ -66,6 +67,14 @@ struct RodSamples {
   std::span<const double> s_m;
   std::span<Eigen::Vector3d> p_m;
   std::span<Eigen::Matrix3d> R;  ///< may be empty
+};
+
+/// A moment on a solved rod's end section, linearised (Rod::Compliance), clamp frame.
+struct RodEndMoment {
+  Eigen::Matrix3d turn_per_Nm = Eigen::Matrix3d::Zero();  ///< the end section's turn [rad/(N m)]
+  /// Each load's surface point's displacement [m/(N m)], by the loads' index in the caller's
+  /// span (at most Rod::kMaxLoads of them).
+  std::array<Eigen::Matrix3d, 16> w_per_Nm{};
 };
 
 class Rod {
@@ -128,8 +137,15 @@ class Rod {
   /// the end section (clamp frame, rad per N of load j's force, a column per force axis) that
   /// keeps the root clamped: with it a caller predicts the next solve's end from a change of
   /// the forces (BeamChain::SolveRodChain).
+  /// If `end_moment` is given, it is written too: what a moment on the end section (the section
+  /// at the last load, clamp frame) does with the root kept clamped, from three more directions
+  /// of the same integration. Its end turn per moment and each load's surface point's
+  /// displacement per moment; the latter is the transpose of `end_turn` (Maxwell-Betti, to the
+  /// discrete rod's asymmetry: its chain is in equilibrium at its nodes, not derived from an
+  /// energy).
   bool Compliance(std::span<const RodLoad> loads, const RodSolution& solution,
-                  std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn = {}) const;
+                  std::span<Eigen::Matrix3d> w, std::span<Eigen::Matrix3d> end_turn = {},
+                  RodEndMoment* end_moment = nullptr) const;
 
   double bending_stiffness_Nm2() const { return EI_; }
   double max_step_m() const { return max_step_m_; }
@@ -175,5 +191,6 @@ class Rod {
   double EI_ = 0.0;
   double max_step_m_ = 0.0;
 };
+static_assert(std::tuple_size_v<decltype(RodEndMoment::w_per_Nm)> == Rod::kMaxLoads);
 
 }  // namespace tubeplan::model
