@@ -573,20 +573,30 @@ bool BeamChain::SolveRodPinned(std::array<BeamLoad, kMaxLoads>& loads, int count
   return true;
 }
 
-bool BeamChain::RodCompliance(
-    RodSegment& segment, std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const {
+bool BeamChain::RodCompliance(RodSegment& segment,
+                              std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w,
+                              model::RodEndMoment* moment) const {
   const int n = segment.load_count;
   std::array<Eigen::Matrix3d, kMaxLoads * kMaxLoads> w_S;
+  model::RodEndMoment moment_S;
   segment.end_turn_count = 0;
   if (!rod_.Compliance(std::span<const model::RodLoad>(segment.loads_S.data(), std::size_t(n)),
                        segment.solution, std::span<Eigen::Matrix3d>(w_S.data(), std::size_t(n * n)),
-                       std::span<Eigen::Matrix3d>(segment.end_turn_per_N.data(), std::size_t(n))))
+                       std::span<Eigen::Matrix3d>(segment.end_turn_per_N.data(), std::size_t(n)),
+                       moment != nullptr ? &moment_S : nullptr))
     return false;
   segment.end_turn_count = n;
+  const Eigen::Matrix3d& R = segment.R_HS;
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b)
       w[std::size_t(segment.index[std::size_t(a)])][std::size_t(segment.index[std::size_t(b)])] =
-          segment.R_HS * w_S[std::size_t(a * n + b)] * segment.R_HS.transpose();
+          R * w_S[std::size_t(a * n + b)] * R.transpose();
+  if (moment != nullptr) {
+    moment->turn_per_Nm = R * moment_S.turn_per_Nm * R.transpose();
+    for (int a = 0; a < n; ++a)
+      moment->w_per_Nm[std::size_t(segment.index[std::size_t(a)])] =
+          R * moment_S.w_per_Nm[std::size_t(a)] * R.transpose();
+  }
   return true;
 }
 

@@ -201,9 +201,12 @@ class BeamChain {
                       const std::array<Eigen::Vector3d, kMaxLoads>& pinned_H,
                       std::span<Eigen::Vector3d> nodes) const;
   /// Tangent compliance of a solved segment's loads to each other, frame H, written to
-  /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular.
+  /// w[i][j] for the BeamLoad indices i, j of the segment. False if singular. With `moment`,
+  /// also what a moment on the segment's end section (at its last load) does, frame H: the end's
+  /// turn per moment, and moment->w_per_Nm[i] for the segment's BeamLoad indices i.
   bool RodCompliance(RodSegment& segment,
-                     std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w) const;
+                     std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads>& w,
+                     model::RodEndMoment* moment = nullptr) const;
   /// The centreline of a solved rod chain at s = k l / (nodes.size() - 1), frame H (straight
   /// beyond the last segment), and its tangent at the free end. The tick draws its nodes with
   /// the solve (SolveRodChain given the nodes), which spares this integration; this one is

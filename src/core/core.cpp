@@ -162,6 +162,16 @@ struct Core::State {
   std::array<double, kMaxLoads> rod_tangent_s{};
   std::array<int, kMaxLoads> rod_tangent_segment{};
   int rod_tangent_members = 0, rod_tangent_age = 0;
+  // With that tangent, where its last load is at the tube's end: what a moment on the end
+  // section does (the dome's spring, build_compliance), frame H, for the members of the end's
+  // segment by their place in arc order: the end's turn per force of each, each one's
+  // displacement per moment, and the end's turn per moment.
+  struct RodEndResponse {
+    bool valid = false;
+    int segment = 0;  // the end's segment
+    Eigen::Matrix3d turn_per_moment = Eigen::Matrix3d::Zero();
+    std::array<Eigen::Matrix3d, kMaxLoads> turn_per_force{}, moved_per_moment{};
+  } rod_end;
   double held_off_load_N = 0.0;
   std::array<Eigen::Vector3d, kMaxLoads> predicted_H{};  // where the solve put each load's centre
   // The shape already went through a part (Collision::AxisThrough; a scene or a reset that
@@ -243,6 +253,7 @@ struct Core::Impl : Core::State {
     std::array<double, kMaxLoads> rod_tangent_s{};
     std::array<int, kMaxLoads> rod_tangent_segment{};
     int rod_tangent_members = 0, rod_tangent_age = 0;
+    RodEndResponse rod_end;
   } beam_cache;
   bool tangent_choice_saved = false, elastica_cache_saved = false, rod_cache_saved = false;
   // What a tick changes of the last tick's shape and output, copied before it first changes
@@ -345,6 +356,7 @@ struct Core::Impl : Core::State {
     to.rod_tangent_segment = from.rod_tangent_segment;
     to.rod_tangent_members = from.rod_tangent_members;
     to.rod_tangent_age = from.rod_tangent_age;
+    to.rod_end = from.rod_end;
   }
 };
 
@@ -463,6 +475,7 @@ void Core::Reset(const Eigen::Isometry3d& X_WH) {
   m.rod_segment_count = 0;
   m.rod_shape = false;
   m.rod_tangent_members = 0;
+  m.rod_end.valid = false;
   m.collision.ForgetDistances();
   m.shape_flags = 0;
   m.axis_inside = m.collision.AxisThrough(
@@ -895,10 +908,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // way from last tick's offset to this tick's target is the Newton step of that linear loop:
   // it settles in one tick when g is right, and stays stable for any true gain up to 1 + 2 g.
   // N is the force the shape was drawn under (none for a new contact: it starts at its target).
-  // The linear model instead puts the dome's resistance in the tick's system (step 5, "the
-  // dome's spring"): the point starts at its target, and moves with the end's turn within the
-  // tick. Not for a point continuing a rim's, or a rim continuing a face's: the dome's law does
-  // not hold over that way, and the relaxation stays.
+  // The linear model and the rod instead put the dome's resistance in the tick's system (step 5,
+  // "the dome's spring"): the point starts at its target, and moves with the end's turn within
+  // the tick. Which model this tick's compliance comes from is decided there, after the loads
+  // are set: the rod's is expected where it drew last tick's shape (where the elastica or the
+  // linear fallback takes the tick after all, the point went to its target unrelaxed, once).
+  // Not for a point continuing a rim's, or a rim continuing a face's: the dome's law does not
+  // hold over that way, and the relaxation stays.
   const bool linear_beam = scene_.model.beam == model::BeamModel::kLinear;
   {
     const double tilt_compliance = m.collision.dome_radius_m() * l / m.beam.bending_stiffness_Nm2();
@@ -908,7 +924,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       if (!ld.pressure_centre || ld.ghost) continue;
-      ld.dome_spring = linear_beam && !on_rim[std::size_t(i)] && !from_rim[std::size_t(i)];
+      ld.dome_spring =
+          (linear_beam || m.rod_shape) && !on_rim[std::size_t(i)] && !from_rim[std::size_t(i)];
       const double relax =
           ld.dome_spring
               ? 1.0
@@ -996,15 +1013,15 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     return !(then_j.s_m == now_j.s_m && then_j.r_H_m == now_j.r_H_m &&
              then_j.clamp_m == now_j.clamp_m);
   };
-  // The dome's spring (the linear model; docs/core.md). An end face pressed on a face carries its
-  // load at its dome's lowest point, e = R sin(tilt) off its centre: as the end turns by theta
-  // (lateral, frame H) the point moves by -R theta x z, and the load N's moment by -N R theta, a
-  // rotational spring k_r = N R on the end section. Left to the next tick, that spring is a loop
-  // of gain N R l / (E I) (the relaxation above; a stuck tip stepped sideways reached its force
-  // over ten ticks). In the system it is condensed into the compliance: with T_j the end's turn
-  // per force of load j, C_i load i's displacement per moment on the end and t_M the end's turn
-  // per moment, the moment is M = -kappa L (sum_j T_j F_j - theta_0), kappa = k_r / (1 + k_r t_M),
-  // L the lateral projection and theta_0 the end's turn in last tick's shape, and
+  // The dome's spring (the linear model and the rod; docs/core.md). An end face pressed on a face
+  // carries its load at its dome's lowest point, e = R sin(tilt) off its centre: as the end turns
+  // by theta (lateral, frame H) the point moves by -R theta x z, and the load N's moment by -N R
+  // theta, a rotational spring k_r = N R on the end section. Left to the next tick, that spring is
+  // a loop of gain N R l / (E I) (the relaxation above; a stuck tip stepped sideways reached its
+  // force over ten ticks). In the system it is condensed into the compliance: with T_j the end's
+  // turn per force of load j, C_i load i's displacement per moment on the end and t_M the end's
+  // turn per moment, the moment is M = -kappa L (sum_j T_j F_j - theta_0), kappa = k_r / (1 + k_r
+  // t_M), L the lateral projection and theta_0 the end's turn in last tick's shape, and
   //     x_i += C_i M:  W_ij -= kappa C_i L T_j,  base_i += kappa C_i L theta_0
   // (Q in place of L below)
   // (C_i = T_i^T where the clamps agree: W stays symmetric, and a stuck spring on it conservative).
@@ -1015,17 +1032,21 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // The rim pressed on a face, beyond the dome's range, has such a spring too, about one axis:
   // its point is the rim's lowest, r1 u with u the direction the face tilts to, and a turn about
   // u moves it round the rim by r1 / sin(tilt) times the turn (R itself where the dome meets the
-  // rim), a turn across u not at all. Left out, that loop made the linear model's slide off the
-  // plane (stability sweep, `slide along a wall off-plane=0.1mm`) buzz at 500 Hz once its dome
-  // had reached the rim: the rim's point swung 3 mm round it and back each tick. So the spring
-  // is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 / sin(tilt), and
-  // kappa = k_r / (1 + k_r t_M) along Q.
+  // rim), a turn across u not at all. Left out, that loop made the linear model's
+  // slide off the plane (stability sweep, `slide along a wall off-plane=0.1mm`) buzz at 500 Hz once
+  // its dome had reached the rim: the rim's point swung 3 mm round it and back each tick. So the
+  // spring is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 / sin(tilt),
+  // and kappa = k_r / (1 + k_r t_M) along Q. The rod's t_M is a matrix (build_compliance).
   struct DomeSpring {
     int load = -1;  // the end face's load, or none
     double kappa = 0.0, radius_m = 0.0, k_r = 0.0, turn_per_moment = 0.0;
-    Eigen::Matrix3d Q_H = Eigen::Matrix3d::Zero();  // the turns it resists
+    // The turns it resists (the rod: the moment per turn, K, with kappa 1).
+    Eigen::Matrix3d Q_H = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d turn_of_turn_H = Eigen::Matrix3d::Zero();  // the rod: Q (I - t_M K)
+    Eigen::Vector3d axis_H = Eigen::Vector3d::UnitZ();         // the end's
     Eigen::Vector3d theta0_H = Eigen::Vector3d::Zero();
     std::array<Eigen::Matrix3d, kMaxLoads> T_H;  // the end's turn per force of each member
+    std::array<Eigen::Matrix3d, kMaxLoads> C_H;  // kappa times each load's motion per moment
   } dome;
   const auto build_compliance = [&] {
     // The cantilever's members. The nonlinear models' tangents are taken about last tick's
@@ -1050,6 +1071,46 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
                   : Eigen::Matrix3d::Zero();
     };
     linear_compliance();
+    bool rod_end_spring = false;  // the rod's tangent, with the end's response to a moment
+    // The rod's segment of the k-th member in arc order: one for the coupled rule.
+    const bool coupled = scene_.model.multi_contact == scene::MultiContactRule::kCoupled;
+    const auto segment_of = [&](int k) {
+      return coupled ? 0 : m.beam_loads[std::size_t(m.order[std::size_t(k)])].group;
+    };
+    // The dome's spring, or the rim's (below): the load it is on, chosen before the rod's
+    // tangent, which then also gives the end's response to a moment. None for the elastica.
+    dome.load = -1;
+    for (int e = 0; e < load_count && (!want_elastica || (!use_elastica && members > 0)); ++e) {
+      const Load& ld = m.loads[std::size_t(e)];
+      const double N0 = ld.f_lin_W.dot(ld.normal_W);
+      if (!member[std::size_t(e)] || !(N0 > 0.0)) continue;
+      const BeamLoad& at = m.beam_loads[std::size_t(e)];
+      const double R = m.collision.dome_radius_m();
+      // The end's axis: the linear model's is the held frame's z, to its order; the rod's,
+      // bent, is its shape's.
+      dome.axis_H = want_elastica ? Eigen::Vector3d(R_WH.transpose() * tangent_at(l))
+                                  : Eigen::Vector3d::UnitZ();
+      const Eigen::Matrix3d across_H =
+          Eigen::Matrix3d::Identity() - dome.axis_H * dome.axis_H.transpose();
+      if (ld.dome_spring) {
+        dome.radius_m = R;
+        dome.Q_H = across_H;
+      } else {
+        // The rim on a face: the load at the end, on the rim circle, not overlapping.
+        const Eigen::Vector3d u_H = across_H * at.r_H_m;
+        const Eigen::Vector3d axis_W = tangent_at(l);
+        const double sin_tilt = axis_W.cross(ld.normal_W).norm();
+        const double r1 = scene_.tube.outer_radius_m;
+        if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
+            !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
+            !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1))
+          continue;
+        dome.radius_m = r1 / sin_tilt;
+        dome.Q_H = u_H * u_H.transpose() / u_H.squaredNorm();
+      }
+      dome.load = e;
+      break;  // one end face
+    }
     if (want_elastica && !use_elastica && members > 0) {
       // The elastica does not cover these loads: the rod's tangent, at last tick's forces,
       // replaces the linear compliance between the loads of each of its segments (a load moves
@@ -1058,12 +1119,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       // steers the tick's Newton step, like the elastica's: one computed for loads within 10 %
       // and arc positions within 1 % of l of these, on the same segments, in the last 50 ticks,
       // is used again (it costs 4 + 3 n integrations of the rod).
-      const bool coupled = scene_.model.multi_contact == scene::MultiContactRule::kCoupled;
-      const auto segment_of = [&](int k) {
-        return coupled ? 0 : m.beam_loads[std::size_t(m.order[std::size_t(k)])].group;
-      };
       const double scale_N = m.beam.bending_stiffness_Nm2() / (l * l);
-      bool reuse = m.rod_tangent_members == members && m.rod_tangent_age < kTangentReuseTicks;
+      // With the dome's or the rim's spring (above) the rod's tangent also gives the end's
+      // response to a moment there (three more directions of the compliance's integration).
+      const bool end_loaded = dome.load >= 0;
+      bool reuse = m.rod_tangent_members == members && m.rod_tangent_age < kTangentReuseTicks &&
+                   (!end_loaded || m.rod_end.valid);
       for (int k = 0; k < members && reuse; ++k) {
         const BeamLoad& b = m.beam_loads[std::size_t(m.order[std::size_t(k)])];
         const std::size_t kk = std::size_t(k);
@@ -1105,9 +1166,27 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
             last_shape ? m.rod_segment_count
                        : m.beam.SolveRodChain(m.beam_loads, members, m.order, m.rod_segments);
         ok = segments > 0;
+        model::RodEndMoment end_moment;
         for (int g = 0; g < segments && ok; ++g)
-          ok = m.beam.RodCompliance(m.rod_segments[std::size_t(g)], m.W);
+          ok = m.beam.RodCompliance(m.rod_segments[std::size_t(g)], m.W,
+                                    end_loaded && g + 1 == segments ? &end_moment : nullptr);
         m.rod_tangent_members = 0;
+        m.rod_end.valid = false;
+        if (ok && end_loaded) {
+          // The end's segment is the last; its loads by their place in arc order.
+          const RodSegment& seg = m.rod_segments[std::size_t(segments - 1)];
+          m.rod_end.valid = true;
+          m.rod_end.segment = segment_of(members - 1);
+          m.rod_end.turn_per_moment = end_moment.turn_per_Nm;
+          for (int q = 0; q < seg.load_count; ++q) {
+            const int i = seg.index[std::size_t(q)];
+            int a = members - 1;
+            while (a > 0 && m.order[std::size_t(a)] != i) --a;
+            m.rod_end.turn_per_force[std::size_t(a)] =
+                seg.R_HS * seg.end_turn_per_N[std::size_t(q)] * seg.R_HS.transpose();
+            m.rod_end.moved_per_moment[std::size_t(a)] = end_moment.w_per_Nm[std::size_t(i)];
+          }
+        }
         if (ok) {
           m.rod_tangent_members = members;
           m.rod_tangent_age = 0;
@@ -1122,6 +1201,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           }
         }
       }
+      rod_end_spring = ok && end_loaded && m.rod_end.valid;
       if (ok) {
         for (int a = 0; a < members; ++a)
           for (int c = 0; c < members; ++c)
@@ -1233,52 +1313,80 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
                          (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N));
       }
     }
-    dome.load = -1;
-    for (int e = 0; e < load_count && !want_elastica; ++e) {
+    if (dome.load >= 0 && want_elastica && !rod_end_spring) dome.load = -1;
+    if (dome.load >= 0) {
+      const int e = dome.load;
       const Load& ld = m.loads[std::size_t(e)];
       const double N0 = ld.f_lin_W.dot(ld.normal_W);
-      if (!member[std::size_t(e)] || !(N0 > 0.0)) continue;
       const BeamLoad& at = m.beam_loads[std::size_t(e)];
-      const double R = m.collision.dome_radius_m();
-      if (ld.dome_spring) {
-        dome.radius_m = R;
-        dome.Q_H = lateral;
-      } else {
-        // The rim on a face: the load at the end, on the rim circle, not overlapping.
-        const Eigen::Vector3d u_H = lateral * at.r_H_m;
-        const double sin_tilt = tangent_at(l).cross(ld.normal_W).norm();
-        const double r1 = scene_.tube.outer_radius_m;
-        if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
-            !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
-            !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1))
-          continue;
-        dome.radius_m = r1 / sin_tilt;
-        dome.Q_H = u_H * u_H.transpose() / u_H.squaredNorm();
-      }
-      dome.load = e;
       dome.k_r = N0 * dome.radius_m;
-      dome.turn_per_moment = m.beam.TurnPerMoment(at);
-      dome.kappa = dome.k_r / (1.0 + dome.k_r * dome.turn_per_moment);
       dome.theta0_H.setZero();
-      BeamLoad then_j;
-      for (int j = 0; j < load_count; ++j) {
-        if (reference_of(j, then_j))
-          dome.theta0_H += m.beam.TurnCompliance(at.s_m, then_j) * then_j.f_H_N;
-        dome.T_H[std::size_t(j)] = member[std::size_t(j)]
-                                       ? m.beam.TurnCompliance(at.s_m, m.beam_loads[std::size_t(j)])
-                                       : Eigen::Matrix3d::Zero();
+      if (!want_elastica) {
+        dome.turn_per_moment = m.beam.TurnPerMoment(at);
+        dome.kappa = dome.k_r / (1.0 + dome.k_r * dome.turn_per_moment);
+        BeamLoad then_j;
+        for (int j = 0; j < load_count; ++j) {
+          if (reference_of(j, then_j))
+            dome.theta0_H += m.beam.TurnCompliance(at.s_m, then_j) * then_j.f_H_N;
+          dome.T_H[std::size_t(j)] =
+              member[std::size_t(j)] ? m.beam.TurnCompliance(at.s_m, m.beam_loads[std::size_t(j)])
+                                     : Eigen::Matrix3d::Zero();
+        }
+        for (int i = 0; i < load_count; ++i)
+          dome.C_H[std::size_t(i)] =
+              dome.kappa * m.beam.MomentCompliance(m.beam_loads[std::size_t(i)], at);
+      } else {
+        // The rod's end turns by t_M M under a moment, a matrix (it is bent): the spring's
+        // moment is M = -K (turn), K = (I + k_r Q t_M)^-1 k_r Q, and the end then turns by
+        // Q (I - t_M K) of the forces' turn. Within the end's segment the rod's own responses
+        // (its tangent's, reused with it); a load of an earlier segment moves the end's clamp, as
+        // in its compliance, linearly. The rod's shape is incremental (x = x0 + W (F - F_lin)), so
+        // the turn resisted is the forces' change's: theta_0 = sum_j T_j F_lin,j.
+        const Eigen::Matrix3d& t_M = m.rod_end.turn_per_moment;
+        const Eigen::Matrix3d kQ = dome.k_r * dome.Q_H;
+        const Eigen::Matrix3d K_spring =
+            (Eigen::Matrix3d::Identity() + kQ * t_M).partialPivLu().solve(kQ);
+        dome.turn_of_turn_H = dome.Q_H * (Eigen::Matrix3d::Identity() - t_M * K_spring);
+        dome.kappa = 1.0;
+        dome.Q_H = K_spring;
+        std::array<int, kMaxLoads> place{};
+        place.fill(-1);
+        for (int a = 0; a < members; ++a)
+          if (segment_of(a) == m.rod_end.segment) place[std::size_t(m.order[std::size_t(a)])] = a;
+        for (int j = 0; j < load_count; ++j) {
+          const int a = place[std::size_t(j)];
+          const BeamLoad& bj = m.beam_loads[std::size_t(j)];
+          dome.T_H[std::size_t(j)] = !member[std::size_t(j)] ? Eigen::Matrix3d::Zero()
+                                     : a >= 0 ? m.rod_end.turn_per_force[std::size_t(a)]
+                                              : m.beam.TurnCompliance(at.s_m, bj);
+          if (member[std::size_t(j)]) dome.theta0_H += dome.T_H[std::size_t(j)] * bj.f_H_N;
+          dome.C_H[std::size_t(j)] =
+              a >= 0 ? m.rod_end.moved_per_moment[std::size_t(a)]
+                     : m.beam.MomentCompliance(m.beam_loads[std::size_t(j)], at);
+        }
+        // The dome's point itself moved since last tick's shape (to its target, above): its
+        // force F_lin's moment about the end changed by (r - r_then) x F_lin, which the
+        // incremental form does not see (the linear model's reference does). It moves the loads
+        // by C and turns the end by t_M, which the spring then resists as any turn. (Not the
+        // rim's: its point is the rim's lowest, not relaxed towards it, and a jump there from the
+        // face's centre stays out of the system, as before the spring.)
+        BeamLoad then_e;
+        if (ld.dome_spring && reference_of(e, then_e) && then_e.s_m == at.s_m) {
+          const Eigen::Vector3d moved_H = (at.r_H_m - then_e.r_H_m).cross(then_e.f_H_N);
+          dome.theta0_H -= t_M * moved_H;
+          for (int i = 0; i < load_count; ++i)
+            m.loads[std::size_t(i)].base_W += R_WH * (dome.C_H[std::size_t(i)] * moved_H);
+        }
       }
       for (int i = 0; i < load_count; ++i) {
         Load& li = m.loads[std::size_t(i)];
-        const Eigen::Matrix3d CL =
-            dome.kappa * m.beam.MomentCompliance(m.beam_loads[std::size_t(i)], at) * dome.Q_H;
+        const Eigen::Matrix3d CL = dome.C_H[std::size_t(i)] * dome.Q_H;
         li.base_W += R_WH * (CL * dome.theta0_H);
         for (int j = 0; j < load_count; ++j)
           if (member[std::size_t(j)])
             m.W[std::size_t(i)][std::size_t(j)] -=
                 R_WH * (CL * dome.T_H[std::size_t(j)]) * R_WH.transpose();
       }
-      break;  // one end face
     }
   };
   // What a stuck contact's tangential spring sees of the compliance.
@@ -1487,15 +1595,17 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<double, IdleParts::kMaxGroups> idle_moved_m{};
   // The end's turn, frame H, under this pass's forces (slot, z), less last tick's: what the
   // dome's spring resists.
-  const auto dome_turn = [&] {
+  const auto forces_turn = [&] {
     Eigen::Vector3d turn_H = -dome.theta0_H;
     for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
       if (sj >= 0 && member[std::size_t(j)])
         turn_H += dome.T_H[std::size_t(j)] * (R_WH.transpose() * m.z.segment<3>(3 * sj));
     }
-    return Eigen::Vector3d(dome.Q_H * turn_H);
+    return turn_H;
   };
+  // Along Q (the rod: the spring's moment, less).
+  const auto dome_turn = [&] { return Eigen::Vector3d(dome.Q_H * forces_turn()); };
   const auto bound_idle_motion = [&] {
     if (idle.group_count == 0) return;
     // The dome's moment moves every point of the tube by C M (build_compliance).
@@ -1811,10 +1921,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   if (dome.load >= 0 && m.loads[std::size_t(dome.load)].active) {
     // The end's turn along Q under the spring (its turn across Q is not resisted, and does not
     // move the point: the rim's radial direction).
-    const Eigen::Vector3d turn_H = dome_turn() / (1.0 + dome.k_r * dome.turn_per_moment);
+    const Eigen::Vector3d turn_H =
+        want_elastica ? Eigen::Vector3d(dome.turn_of_turn_H * forces_turn())
+                      : Eigen::Vector3d(dome_turn() / (1.0 + dome.k_r * dome.turn_per_moment));
     const Load& ld = m.loads[std::size_t(dome.load)];
-    const Eigen::Vector3d from_H = lateral * ld.r_H_m;
-    Eigen::Vector3d to_H = from_H - dome.radius_m * turn_H.cross(Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d from_H = ld.r_H_m - dome.axis_H.dot(ld.r_H_m) * dome.axis_H;
+    Eigen::Vector3d to_H = from_H - dome.radius_m * turn_H.cross(dome.axis_H);
     const double r1 = scene_.tube.outer_radius_m;
     const double to_m = to_H.norm();
     if (to_m > r1 || (ld.tube != states::TubeElement::kEndFace && to_m > 0.0)) to_H *= r1 / to_m;
