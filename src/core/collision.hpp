@@ -150,6 +150,7 @@ class Collision {
   double end_length_m() const { return end_m_; }
   /// The radius of the dome that stands for the end face on a part's face (collision.cpp).
   double dome_radius_m() const { return dome_radius_m_; }
+  double dome_height_m() const { return dome_height_m_; }
 
   /// Narrow-phase evaluations (closed form or GJK) of the last Query, for the benchmarks'
   /// figures; pairs settled by an earlier query's distance (below) are not among them.

@@ -1031,12 +1031,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   //
   // The rim pressed on a face, beyond the dome's range, has such a spring too, about one axis:
   // its point is the rim's lowest, r1 u with u the direction the face tilts to, and a turn about
-  // u moves it round the rim by r1 / sin(tilt) times the turn (R itself where the dome meets the
-  // rim), a turn across u not at all. Left out, that loop made the linear model's
+  // u moves it round the rim by r1 cot(tilt) times the turn (R, to the dome's height, where the
+  // dome meets the rim), a turn across u not at all. Left out, that loop made the linear model's
   // slide off the plane (stability sweep, `slide along a wall off-plane=0.1mm`) buzz at 500 Hz once
   // its dome had reached the rim: the rim's point swung 3 mm round it and back each tick. So the
-  // spring is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 / sin(tilt),
-  // and kappa = k_r / (1 + k_r t_M) along Q. The rod's t_M is a matrix (build_compliance).
+  // spring is k_r Q with Q = L for the dome and Q = u u^T for the rim, R_e = R or r1 cot(tilt), and
+  // kappa = k_r / (1 + k_r t_M) along Q. The rod's t_M is a matrix (build_compliance).
   struct DomeSpring {
     int load = -1;  // the end face's load, or none
     double kappa = 0.0, radius_m = 0.0, k_r = 0.0, turn_per_moment = 0.0;
@@ -1100,12 +1100,20 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         const Eigen::Vector3d u_H = across_H * at.r_H_m;
         const Eigen::Vector3d axis_W = tangent_at(l);
         const double sin_tilt = axis_W.cross(ld.normal_W).norm();
+        const double cos_tilt = std::abs(axis_W.dot(ld.normal_W));
         const double r1 = scene_.tube.outer_radius_m;
+        // A turn theta about u moves the rim circle's lowest point along u x axis by
+        // r1 cot(tilt) theta (stop 40 had r1 / sin(tilt): the same where the dome meets the rim,
+        // but a spring r1 N on a side lying along the face, whose point a turn about u does not
+        // move). Where that is within the dome's height h (the tube's geometric tolerance) for a
+        // turn of a radian, the point does not move: no spring (the tube lying in the groove,
+        // its end's side on the floor).
         if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
             !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
-            !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1))
+            !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1) ||
+            !(r1 * cos_tilt > m.collision.dome_height_m() * sin_tilt))
           continue;
-        dome.radius_m = r1 / sin_tilt;
+        dome.radius_m = r1 * cos_tilt / sin_tilt;
         dome.Q_H = u_H * u_H.transpose() / u_H.squaredNorm();
       }
       dome.load = e;
