@@ -351,6 +351,30 @@ void Collision::LineEnds(RawContact& c, std::span<const Eigen::Vector3d> nodes_W
       std::max(0.0, s0_m + std::clamp((c.t_hi - 0.5) * length_m - offset_m, -half_m, half_m));
 }
 
+void Collision::Complete(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const {
+  if (!c.deferred) return;
+  // Query's steps for a capsule apart from the part, on the same nodes: the same bits.
+  const Part& part = parts_[std::size_t(c.part_slot)];
+  const Eigen::Vector3d& a_W = nodes_W[std::size_t(c.piece)];
+  const Eigen::Vector3d& b_W = nodes_W[std::size_t(c.piece) + 1];
+  double d = 0.0, axis_m = 0.0;
+  // (Set only so that the compiler sees them set: Query found the pair apart, so
+  // CapsuleBoxDistance sets them all again.)
+  Eigen::Vector3d p_P = Eigen::Vector3d::Zero(), q_P = p_P, c_P = p_P;
+  CapsuleBoxDistance(part, part.ToPart(a_W), part.ToPart(b_W), d, p_P, q_P, c_P, axis_m);
+  const Eigen::Vector3d p_tube_W = part.ToWorld(p_P);
+  const Eigen::Vector3d q_part_W = part.ToWorld(q_P);
+  c.q_W_m = q_part_W;
+  c.normal_W = (p_tube_W - q_part_W) / d;
+  c.p_W_m = p_tube_W;
+  const Eigen::Vector3d axis_W = (b_W - a_W).normalized();
+  const Eigen::Vector3d centre_W = 0.5 * (a_W + b_W);
+  const double half_m = 0.5 * piece_m_;
+  const double along = std::clamp((p_tube_W - centre_W).dot(axis_W), -half_m, half_m);
+  c.s_m = std::max(0.0, piece_m_ * c.piece + half_m + along);
+  c.deferred = false;
+}
+
 // Inlined for the same reason as CapsuleBoxDistance: once a contact.
 [[gnu::always_inline]] inline std::uint8_t Collision::FaceMask(const Part& part,
                                                                const Eigen::Vector3d& q_P) const {
@@ -808,6 +832,25 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         signed_depth = separated && d <= 0.0;
         if (separated) Keep(kept_k, a_W, b_W, d);
         if (separated && d >= band_m) continue;
+        if (separated && !signed_depth) {
+          // Apart, within the band: what forms the PCs now, the points only if it becomes a
+          // load (Complete; made here, they were a third of the query's instructions for a tube
+          // lying in the groove, a hundred contacts of which six become loads).
+          RawContact& c = out[std::size_t(count++)];
+          c.tube = states::TubeElement::kSide;
+          c.part = part.index;
+          c.distance_m = d;
+          c.overlap = false;
+          c.pressure_centre = false;
+          c.face_mask = FaceMask(part, q_P);
+          c.part_element = element_of_[part.index][c.face_mask];
+          c.over_face = IsFaceMask(c.face_mask);
+          c.line = false;
+          c.piece = k;
+          c.part_slot = static_cast<int>(part_i);
+          c.deferred = true;
+          continue;
+        }
         // The normal from the box to the axis, read only with a signed depth (a pair apart
         // takes its normal in the world frame, below).
         if (signed_depth) n_P = (c_P - q_P) / axis_m;

@@ -47,6 +47,11 @@ struct RawContact {
   /// point, reaching it where their distances are eps / 10 apart.
   bool over_face = false;
   bool line = false;
+  /// A capsule apart from the part within the band (most contacts: a tube lying in the groove
+  /// has a hundred): Query gives its part, elements, piece and distance, enough to form the PCs,
+  /// and leaves its points, normal and arc position (normal_W, q_W_m, p_W_m, s_m) to
+  /// Collision::Complete, which the core calls only for the few that become loads.
+  bool deferred = false;
   int piece = 0;
   int part_slot = 0;  ///< the part among the Collision's
   double t_lo = 0.0, t_hi = 0.0;
@@ -176,6 +181,11 @@ class Collision {
   /// its axis over the face, drawn towards its nearest point as the piece tilts to the face
   /// (RawContact::line); `nodes_W` are the nodes Query was given. Nothing for other contacts.
   void LineEnds(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const;
+
+  /// Makes a `deferred` contact whole: its nearest points, normal and arc position, the same bits
+  /// Query would have given (the same closed form on the same nodes); `nodes_W` are the nodes
+  /// Query was given. Nothing for a contact that is not deferred.
+  void Complete(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const;
 
   /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
   /// its narrow-phase count does: the core forgets them when it is reset or restored, so that

@@ -678,6 +678,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const std::span<const Eigen::Vector3d> query_nodes_W(m.nodes_W.data(), std::size_t(N) + 1);
   for (int k = 0; k < found_count; ++k) {
     const PcFound& pc = found[std::size_t(k)];
+    // Query leaves most contacts' points to be made for those that become loads (step 4).
+    for (const int i : {pc.deepest, pc.first, pc.last})
+      m.collision.Complete(m.raw[std::size_t(i)], query_nodes_W);
     m.collision.LineEnds(m.raw[std::size_t(pc.first)], query_nodes_W);
     if (pc.last != pc.first) m.collision.LineEnds(m.raw[std::size_t(pc.last)], query_nodes_W);
   }

@@ -218,6 +218,51 @@ std::vector<std::array<int, 64>> MaskElements(std::size_t parts) {
   return element_of;
 }
 
+// Makes a query's contacts whole (Collision::Complete, as the core does for those that become
+// loads). With `check`, each contact Query deferred (a capsule apart from its part) is held
+// against FCL's GJK on the same capsule and box, an independent method: its distance, and its
+// points on the shapes, d apart along its normal, under an arc position within its piece.
+// Returns how many were checked.
+int Complete(const core::Collision& collision, const scene::Scene& s, int capsules,
+             std::span<core::RawContact> out, int count, std::span<const Eigen::Vector3d> nodes_W,
+             bool check) {
+  int checked = 0;
+  const double r1 = s.tube.outer_radius_m, piece_m = s.tube.length_m / capsules;
+  for (int i = 0; i < count; ++i) {
+    core::RawContact& c = out[std::size_t(i)];
+    const bool deferred = c.deferred;
+    collision.Complete(c, nodes_W);
+    CHECK_FALSE(c.deferred);
+    if (!deferred || !check) continue;
+    ++checked;
+    const Eigen::Vector3d a = nodes_W[std::size_t(c.piece)], b = nodes_W[std::size_t(c.piece) + 1];
+    const scene::BoxPart& part = s.parts[c.part];
+    fcl::detail::GJKSolver_indep<double> gjk = TightGjk();
+    double d_gjk = 0.0;
+    Eigen::Vector3d p_gjk, q_gjk;
+    const bool separated =
+        gjk.shapeDistance(fcl::Capsuled(r1, (b - a).norm()), SegmentPose(a, b),
+                          fcl::Boxd(part.size_m), part.X_WP, &d_gjk, &p_gjk, &q_gjk);
+    INFO("contact " << i << " piece " << c.piece << " part " << c.part << " d " << c.distance_m);
+    REQUIRE(separated);
+    // GJK at 1e-12 on a curved shape: ~1e-9 m (as for the end cylinder above).
+    CHECK(c.distance_m == Approx(d_gjk).margin(1e-8));
+    // The points: rounding of coordinates of decimetres, 1e-15 m, with a margin. The normal is
+    // their difference over d: its length is off by 1e-15 m / d, checked where d >= 1 nm.
+    CHECK((c.p_W_m - c.q_W_m - c.distance_m * c.normal_W).norm() <= 1e-12);
+    if (c.distance_m >= 1e-9) CHECK(c.normal_W.norm() == Approx(1.0).margin(1e-5));
+    const Eigen::Vector3d q_P = part.X_WP.inverse() * c.q_W_m;
+    CHECK((q_P.cwiseAbs() - 0.5 * part.size_m).maxCoeff() <= 1e-12);
+    // p on the capsule: r1 from its axis segment.
+    const Eigen::Vector3d u = (b - a).normalized();
+    const double along = std::clamp((c.p_W_m - a).dot(u), 0.0, (b - a).norm());
+    CHECK((c.p_W_m - a - along * u).norm() == Approx(r1).margin(1e-12));
+    CHECK(c.s_m >= piece_m * c.piece - 1e-12);
+    CHECK(c.s_m <= piece_m * (c.piece + 1) + 1e-12);
+  }
+  return checked;
+}
+
 }  // namespace
 
 TEST_CASE("Distances kept from earlier queries change no contact, and leave out only idle parts",
@@ -282,7 +327,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   std::array<core::RawContact, core::kMaxRawContacts> got{}, want{};
   TubePose pose = random_pose();
   std::vector<TubePose> visited;
-  int skipped = 0, at_band_edge = 0, contacts = 0;
+  int skipped = 0, at_band_edge = 0, contacts = 0, completed_checked = 0;
   double band_m = 2.0 * s.contact.threshold_m;
   for (int query = 0; query < 20000; ++query) {
     const double roll = 0.5 * (unit(rng) + 1.0);
@@ -313,6 +358,8 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
     const int n = kept.Query(nodes_W, tip_tangent_W, band_m, got);
     const core::Collision fresh(s, parts, capsules, element_of);
     const int m = fresh.Query(nodes_W, tip_tangent_W, band_m, want);
+    Complete(kept, s, capsules, got, n, nodes_W, false);
+    completed_checked += Complete(fresh, s, capsules, want, m, nodes_W, query % 10 == 0);
     INFO("query " << query << " band " << band_m);
     REQUIRE(n == m);
     for (int i = 0; i < n; ++i) {
@@ -324,6 +371,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
     groups.may_leave_out = may_leave_out;
     groups.floor_m = s.contact.threshold_m;
     const int n_idle = idle.Query(nodes_W, tip_tangent_W, band_m, got_idle, &groups);
+    Complete(idle, s, capsules, got_idle, n_idle, nodes_W, false);
     left_out += groups.left_out;
     int j = 0;  // the idle query's contacts are the full one's, less whole parts
     for (int i = 0; i < m; ++i) {
@@ -361,6 +409,9 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
                   << at_band_edge);
   CHECK(skipped > 20000);
   CHECK(at_band_edge > 2000);
+  // And the contacts whose points are made later (Collision::Complete) were held against GJK.
+  INFO("deferred contacts checked against GJK " << completed_checked);
+  CHECK(completed_checked > 1000);
   // Parts were left out, and some of them had contacts in the band, which the checks above saw.
   INFO("parts left out " << left_out << ", their contacts " << covered);
   CHECK(left_out > 1000);
@@ -552,6 +603,7 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
     for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = F - (l - l * k / capsules) * u;
     std::array<core::RawContact, core::kMaxRawContacts> out{};
     const int count = collision.Query(nodes_W, u, 2.0 * s.contact.threshold_m, out);
+    Complete(collision, s, capsules, out, count, nodes_W, true);
     End end{states::TubeElement::kSide, 0.0, -1.0};
     for (int i = 0; i < count; ++i) {
       const core::RawContact& c = out[std::size_t(i)];
@@ -634,6 +686,7 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
     for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = start + (l * k / capsules) * u;
     std::array<core::RawContact, core::kMaxRawContacts> out{};
     const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
+    Complete(collision, s, capsules, out, count, nodes_W, true);
     Region region;
     for (int i = 0; i < count; ++i) {
       core::RawContact& c = out[std::size_t(i)];
