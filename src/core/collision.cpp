@@ -849,6 +849,15 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           c.piece = k;
           c.part_slot = static_cast<int>(part_i);
           c.deferred = true;
+#ifndef NDEBUG
+          // Unmade until Complete: NaN in the debug (sanitizer) build, where a read before it
+          // reaches the core's checks of its outputs instead of last tick's values.
+          constexpr double kUnmade = std::numeric_limits<double>::quiet_NaN();
+          c.normal_W.setConstant(kUnmade);
+          c.q_W_m.setConstant(kUnmade);
+          c.p_W_m.setConstant(kUnmade);
+          c.s_m = kUnmade;
+#endif
           continue;
         }
         // The normal from the box to the axis, read only with a signed depth (a pair apart
