@@ -759,3 +759,45 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
   CHECK(steep.collapsed == steep.lines);
   CHECK(up.collapsed == 0);
 }
+
+TEST_CASE("The last capsule's cap inside the end cylinder is no contact", "[core][collision]") {
+  // The last capsule ends where the end cylinder starts, and its round cap reaches r1 into the
+  // cylinder: not the tube's surface. The groove scene's tube straight along +z, its end pressed
+  // 3 mm into a wall (past the 2 mm the cap's pole keeps from the face less the band: the pole
+  // lies end - r1 behind the tip). The end face is the wall's contact; no side contact lies inside
+  // the end cylinder. A cap that bulges outside the cylinder (a bend) is another matter, kept.
+  scene::Scene s = GrooveScene();
+  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
+  s.parts.clear();
+  scene::BoxPart wall;
+  wall.name = "wall";
+  wall.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
+  wall.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, l + 0.01);  // its face at z = l
+  s.parts.push_back(wall);
+  const int capsules = 24;
+  const std::vector<std::uint32_t> parts{0};
+  const core::Collision collision(s, parts, capsules, MaskElements(1));
+  const double end_m = collision.end_length_m(), press_m = 3e-3;
+  // The cap's pole is within the band of the wall: the case the filter is for.
+  REQUIRE(end_m - r1 - press_m < 2.0 * eps);
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitZ();
+  std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+  for (int k = 0; k <= capsules; ++k)
+    nodes_W[std::size_t(k)] = (press_m + l * double(k) / capsules) * u;
+  std::array<core::RawContact, core::kMaxRawContacts> out{};
+  const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
+  Complete(collision, s, capsules, out, count, nodes_W, false);
+  const Eigen::Vector3d end_start_W = nodes_W.back() - end_m * u;
+  int end_face = 0;
+  for (int i = 0; i < count; ++i) {
+    const core::RawContact& c = out[std::size_t(i)];
+    INFO("contact " << i << " tube " << int(c.tube) << " s " << c.s_m << " d " << c.distance_m);
+    if (c.tube == states::TubeElement::kEndFace) ++end_face;
+    if (c.tube != states::TubeElement::kSide) continue;
+    const Eigen::Vector3d from_end = c.p_W_m - end_start_W;
+    const double along = from_end.dot(u);
+    const bool inside = along > 0.0 && along < end_m && (from_end - along * u).norm() < 0.999 * r1;
+    CHECK_FALSE(inside);
+  }
+  CHECK(end_face == 1);
+}
