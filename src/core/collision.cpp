@@ -898,13 +898,17 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       // pressed 0.4 mm in (13.8 N, a coupling's pull before the device's limit): a second PC
       // whose cut, l / 16 from the end, took the end's segment off the rest of the tube (the
       // segmented rule) for the tick, and the fast pass 0.1 mm off its plane snapped
-      // (`stability --only "fast pass off-plane"`).
+      // (`stability --only "fast pass off-plane"`). Only the cap's part within r1 / 2 of the axis,
+      // which faces where the end face does: a part reaching it reaches into the end first. Taken
+      // out up to the cylinder's side too, a side contact at the end's start went to the end
+      // cylinder's generator, and a soft two-PC run of `tubeplan accuracy` (K = 1e4 N/m, eps =
+      // 0.1 mm) drew its tip 1e27 lengths away (docs/accuracy.md).
       // (A capsule whose axis is inside the part has no point here yet: Overlapping's, below.)
       if (!is_end && separated && k == pieces - 2) {
         const Eigen::Vector3d from_end_W = p_tube_W - end_start_W;
         const double along_end_m = from_end_W.dot(tip_tangent_W);
         if (along_end_m > tube_tolerance_m_ && along_end_m < end_m_ &&
-            (from_end_W - along_end_m * tip_tangent_W).norm() < radius_m_ - tube_tolerance_m_)
+            (from_end_W - along_end_m * tip_tangent_W).norm() < 0.5 * radius_m_)
           continue;
       }
       // Made in place, not copied there (out has room: checked above); a pair that yields no

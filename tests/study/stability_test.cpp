@@ -306,9 +306,7 @@ TEST_CASE(
   // release trusts the beam's tangent, and the rod's unloaded shape is far from it. The tube's
   // axis stays outside the wall, so nothing holds the tick back, and the shape is off its
   // contacts from tick 81. Until stop 38 the energy held stayed under the hand's work by
-  // chance. Since contacts that pressed stay in the system, it exceeded it at tick 108. Since
-  // stop 41 (no contact from the last capsule's cap inside the end cylinder) it passes, its shape
-  // still off its contacts from tick 89: the defect is not gone, and the tag stays.
+  // chance. Since contacts that pressed stay in the system, it exceeds it at tick 108.
   const study::StabilityResult r = RunNamed("squeeze between walls eps=1e-05m");
   INFO(r.detail << " | " << r.warning);
   CHECK(r.pass);
