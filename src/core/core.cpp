@@ -1897,6 +1897,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       solved = solve_system();
     }
   }
+  // A solve that carries the held end farther in one tick than the coupling alone would (the
+  // sweep, step 2) plus the tube's length describes no motion of the tube: its system was near
+  // singular. Seen with three PCs, the rod's shape off its contacts and a soft penalty (the
+  // accuracy study's two PCs at K = 1e3 N/m): the held end went to 1.6e23 m, finite, and every
+  // later tick started from there. Treated as singular.
+  if (solved && !((p_W - p_start_W).norm() <= sweep_m + scene_.tube.length_m)) solved = false;
   if (saturated) out.flags |= kProxySeparated;
   if (!solved) {
     // Singular, not finite or undecided: nothing moves and nothing is sent this tick.
