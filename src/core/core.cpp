@@ -1801,8 +1801,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         ld.released = true;  // once released in a tick it stays open: no cycling
         changed = true;
         changed_load = i;
-        if (!want_elastica) {
-          build_compliance();  // the linear model's cuts are the loads in contact
+        // The linear model's cuts are the loads in contact; the nonlinear models' are those that
+        // carried force last tick too, so only a load that joined this tick leaves them.
+        if (!want_elastica || ld.f_lin_W.isZero(0.0)) {
+          build_compliance();
           build_stick_compliance();
         }
         break;

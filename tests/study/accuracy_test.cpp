@@ -59,8 +59,9 @@ TEST_CASE("Accuracy: the linear model's error against the exact elastica", "[acc
   CHECK(elastica_alpha100);
   // The core flags the segmented rule out of its range there (core::kSegmentationOff: the end's
   // load moves the side contact, which the rule does not see), never the coupled rule; and the
-  // reference agrees that the segmented rule is the one far off: measured 1.56 against 0.062
-  // (linear) and 2.74 against 0.383 (elastica), so at least twice the coupled rule's error.
+  // reference agrees that the segmented rule is the farther off: measured 1.56 against 0.062
+  // (linear) and 0.576 against 0.380 (elastica; 2.74 until stop 42, when a load released in the
+  // tick it closed still cut the elastica's chain).
   for (const char* beam : {"linear", "elastica"}) {
     const std::string segmented = std::string(beam) + " segmented";
     const std::string coupled = std::string(beam) + " coupled";
@@ -69,7 +70,7 @@ TEST_CASE("Accuracy: the linear model's error against the exact elastica", "[acc
     INFO(two_pcs[segmented]->detail << " | " << two_pcs[coupled]->detail);
     CHECK(two_pcs[segmented]->detail.find("SEGMENTED RULE OUT OF RANGE") != std::string::npos);
     CHECK(two_pcs[coupled]->detail.find("SEGMENTED RULE OUT OF RANGE") == std::string::npos);
-    CHECK(two_pcs[segmented]->error > 2.0 * two_pcs[coupled]->error);
+    CHECK(two_pcs[segmented]->error > two_pcs[coupled]->error);
   }
   // Four contact scenarios x (4 beam/rule settings, 1 finer step, 6 contact K/eps settings, and
   // 8, 16 and 32 capsules: fewer than the 48 the core chooses for this soft tube).
