@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,6 +13,10 @@
 #include <CLI/CLI.hpp>
 
 #include <tubeplan/io/units.hpp>
+
+namespace tubeplan::study {
+struct StabilityResult;
+}
 
 namespace tubeplan::cli {
 
@@ -37,6 +42,10 @@ Command AddMergeCommand(CLI::App& app, Streams streams);
 Command AddLiveCommand(CLI::App& app, Streams streams);
 Command AddAccuracyCommand(CLI::App& app, Streams streams);
 Command AddStabilityCommand(CLI::App& app, Streams streams);
+
+/// `tubeplan stability`'s report of its results: the pass/fail matrix, a line per failure and the
+/// warnings (or, with json, one document); returns 1 if any case failed, else 0.
+int ReportStability(std::span<const study::StabilityResult> results, bool json, Streams io);
 
 /// Parses "a,b,c" of quantities of one dimension (each a plain SI number or with a unit) with
 /// between min_count and max_count items. On failure returns nullopt and sets `error` to a

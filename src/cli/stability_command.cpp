@@ -27,9 +27,15 @@ int RunStability(const StabilityOptions& o, Streams io) {
     if (!o.filter.empty() && c.name.find(o.filter) == std::string::npos) continue;
     results.push_back(study::RunStabilityCase(c));
   }
+  return ReportStability(results, o.json, io);
+}
+
+}  // namespace
+
+int ReportStability(std::span<const study::StabilityResult> results, bool json, Streams io) {
   bool all = true;
   for (const study::StabilityResult& r : results) all = all && r.pass;
-  if (o.json) {
+  if (json) {
     nlohmann::json cases = nlohmann::json::array();
     for (const study::StabilityResult& r : results) {
       nlohmann::json j = {{"name", r.name},
@@ -106,8 +112,6 @@ int RunStability(const StabilityOptions& o, Streams io) {
   }
   return all ? kExitOk : kExitNegative;
 }
-
-}  // namespace
 
 Command AddStabilityCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<StabilityOptions>();

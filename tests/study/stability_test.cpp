@@ -14,6 +14,7 @@
 #include <tubeplan/scene/scene.hpp>
 #include <tubeplan/study/stability.hpp>
 
+#include "cli/commands.hpp"
 #include "quick_case.hpp"
 
 using namespace tubeplan;
@@ -441,4 +442,47 @@ TEST_CASE("tubeplan stability --json: one document, a failing case exits 1", "[s
   const nlohmann::json squeeze = nlohmann::json::parse(text);
   CHECK(squeeze["cases"][0]["judged_with"] == "coupled");
   CHECK(squeeze["cases"][0]["first_segmentation_off_tick"].get<int>() > 0);
+}
+
+TEST_CASE("tubeplan stability's report: a failing case is named with its tick, and exits 1",
+          "[stability][cli]") {
+  // The failure path driven with results made here, independent of which cases the core fails:
+  // one pass, one failure at tick 223, one pass outside the model's validity.
+  std::vector<study::StabilityResult> results(3);
+  results[0].name = "slide along a wall base";
+  results[0].motion = "slide along a wall";
+  results[0].parameter = "base";
+  results[1].name = "slide along a wall eps=1e-05m";
+  results[1].motion = "slide along a wall";
+  results[1].parameter = "eps=1e-05m";
+  results[1].pass = false;
+  results[1].first_failing_tick = 223;
+  results[1].detail = "passivity at tick 223";
+  results[2].name = "push into a wall l/r1=2";
+  results[2].motion = "push into a wall";
+  results[2].parameter = "l/r1=2";
+  results[2].outside = true;
+  results[2].warning = "outside the model's validity (l/r1 = 2 < 10: not a slender beam)";
+  std::ostringstream out, err;
+  CHECK(cli::ReportStability(results, false, {out, err}) == 1);
+  CHECK(out.str().find("FAIL @223") != std::string::npos);
+  CHECK(out.str().find("FAIL slide along a wall eps=1e-05m: passivity at tick 223") !=
+        std::string::npos);
+  CHECK(out.str().find("pass (outside)") != std::string::npos);
+  CHECK(out.str().find("2 of 3 cases pass") != std::string::npos);
+  CHECK(err.str().find("warning: push into a wall l/r1=2: outside") != std::string::npos);
+  std::ostringstream json_out, json_err;
+  CHECK(cli::ReportStability(results, true, {json_out, json_err}) == 1);
+  const nlohmann::json j = nlohmann::json::parse(json_out.str());
+  CHECK(j["pass"] == false);
+  REQUIRE(j["cases"].size() == 3);
+  CHECK(j["cases"][1]["pass"] == false);
+  CHECK(j["cases"][1]["first_failing_tick"] == 223);
+  CHECK(j["cases"][0]["first_failing_tick"].is_null());
+  // And all passing: 0.
+  results[1].pass = true;
+  results[1].first_failing_tick = -1;
+  std::ostringstream ok_out, ok_err;
+  CHECK(cli::ReportStability(results, false, {ok_out, ok_err}) == 0);
+  CHECK(ok_out.str().find("3 of 3 cases pass") != std::string::npos);
 }
