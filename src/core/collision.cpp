@@ -57,10 +57,10 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
     // The dome's height is the tube's geometric tolerance (the capsules' chord error has the
     // same bound, ChainCapsuleCount): the cap over the rim circle with it has
     // R = (r1^2 + h^2) / (2 h).
-    dome_height_m_ = std::min(tube_tolerance_m_, 0.5 * r1);
-    dome_radius_m_ = (r1 * r1 + dome_height_m_ * dome_height_m_) / (2.0 * dome_height_m_);
-    dome_sin_max_ = r1 / dome_radius_m_;
-    facing_axis_sq_ = 1.0 - dome_sin_max_ * dome_sin_max_;
+    const double h = std::min(tube_tolerance_m_, 0.5 * r1);
+    tolerance_dome_height_m_ = h;
+    tolerance_dome_radius_m_ = (r1 * r1 + h * h) / (2.0 * h);
+    set_dome_radius_m(tolerance_dome_radius_m_);
   }
   // FCL's default 1e-6 leaves micrometres of error in d, i.e. 1e-2 N at K = 1e4 N/m.
   solver_.gjk_tolerance = 1e-12;
@@ -88,6 +88,19 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
   kept_.resize(parts_.size() * std::size_t(kMaxCapsules));
   summaries_.resize(parts_.size());
   anchors_.resize(parts_.size() * std::size_t(kMaxCapsules + 2));
+}
+
+void Collision::set_dome_radius_m(double radius_m) {
+  // At least 1.25 r1: a cap of height r1 / 2 at most, as the tolerance's is (the constructor).
+  // At the tolerance's radius its own height, bit for bit: the shipped scenes' faces never press
+  // through, and their outputs stay the same bits.
+  const double r1 = radius_m_;
+  const double R = std::clamp(radius_m, 1.25 * r1, tolerance_dome_radius_m_);
+  dome_radius_m_ = R;
+  dome_height_m_ =
+      R < tolerance_dome_radius_m_ ? R - std::sqrt(R * R - r1 * r1) : tolerance_dome_height_m_;
+  dome_sin_max_ = r1 / R;
+  facing_axis_sq_ = 1.0 - dome_sin_max_ * dome_sin_max_;
 }
 
 void Collision::ForgetDistances() {
@@ -471,6 +484,7 @@ bool Collision::StillLeftOut(std::size_t part_i, std::span<const Eigen::Vector3d
     // A part turned to the world: its own axes see at most delta.
     const Eigen::Vector3d along_P = part.aligned ? along_W : Eigen::Vector3d::Constant(delta_m);
     bool holds = band_m + delta_m <= summary.band_m && delta_m < summary.slack_m &&
+                 facing_axis_sq_ >= summary.facing_axis_sq &&
                  (along_P.array() < summary.slab_slack_m.array()).all();
     for (int g = 0; g < summary.group_count && holds; ++g)
       holds = summary.groups[std::size_t(g)].gap_m - delta_m > idle.floor_m;
@@ -598,6 +612,7 @@ bool Collision::LeaveOut(std::size_t part_i, const KeptDistance* kept,
   summary.valid = true;
   summary.band_m = wide_band_m;
   summary.slack_m = slack_m;
+  summary.facing_axis_sq = facing_axis_sq_;
   summary.slab_slack_m = slab_slack_m;
   for (std::size_t i = 0; i < node_count; ++i) anchor[i] = nodes_W[i];
   anchor[node_count] = end_start_W;
@@ -963,10 +978,14 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // moves continuously from the centre to the rim, where it meets the rim's point (its
         // distance d_rim + h cos(tilt)) at sin(tilt) = r1 / R with the same distance and
         // normal. K (eps - d)^2 / 2 of the lowest point is then a potential of the end's pose.
+        // R is set for the tick (set_dome_radius_m): the tolerance's, or, for a face pressed
+        // through the part's surface, the bed of springs' radius at that depth (core.cpp), the
+        // overlapping face included: it took no dome until stop 43, and its flat law's range
+        // (2 r1 sin(tilt) < eps / 10) was passed in one tick of a slide with eps = 1e-5 m.
         const double radial_m = radial_W.norm();
         const double cos_tilt = std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
         const double centre_m = c.distance_m + radius_m_ * tilt;
-        const bool on_face = !side_flat && IsFaceMask(c.face_mask) && !c.overlap;
+        const bool on_face = !side_flat && IsFaceMask(c.face_mask);
         bool at_pressure_centre = false;
         if (radial_m < radius_m_ - tube_tolerance_m_) {
           c.tube = states::TubeElement::kEndFace;

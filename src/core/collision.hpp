@@ -156,6 +156,10 @@ class Collision {
   /// The radius of the dome that stands for the end face on a part's face (collision.cpp).
   double dome_radius_m() const { return dome_radius_m_; }
   double dome_height_m() const { return dome_height_m_; }
+  /// The tolerance's dome (the constructor's): the largest radius set_dome_radius_m takes.
+  double tolerance_dome_radius_m() const { return tolerance_dome_radius_m_; }
+  /// Sets the dome's radius for the next queries, within [1.25 r1, the tolerance's dome].
+  void set_dome_radius_m(double radius_m);
 
   /// Narrow-phase evaluations (closed form or GJK) of the last Query, for the benchmarks'
   /// figures; pairs settled by an earlier query's distance (below) are not among them.
@@ -280,6 +284,8 @@ class Collision {
   // radius dome_radius_m_; it is the lowest point while sin(tilt) < dome_sin_max_ = r1 / R.
   double dome_height_m_ = 0.0;
   double dome_radius_m_ = 0.0;
+  double tolerance_dome_radius_m_ = 0.0;
+  double tolerance_dome_height_m_ = 0.0;
   double dome_sin_max_ = 0.0;
   // An end face presses at its dome's lowest point only while sin(tilt) < dome_sin_max_ from a
   // face (collision.cpp): 1 - that squared, the least square of the end's axis component along a
@@ -311,6 +317,9 @@ class Collision {
     bool valid = false;
     double band_m = 0.0;
     double slack_m = 0.0;  // how far the end may move before it could face a face
+    // The dome's range it was made with (facing_axis_sq_): a wider range since (a smaller dome
+    // radius) may let the end face a face sooner than slack_m says.
+    double facing_axis_sq = 0.0;
     Eigen::Vector3d slab_slack_m = Eigen::Vector3d::Zero();  // per axis: before a slab is crossed
     std::array<IdleParts::Group, IdleParts::kMaxGroups> groups{};
     int group_count = 0;

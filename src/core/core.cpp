@@ -585,6 +585,31 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     idle.may_leave_out = m.may_leave_out;
     idle.floor_m = eps + sweep_m;
   }
+  // The end face's dome (collision.cpp) for this tick. Within the band a face is the paper's
+  // point law, and its dome has the tolerance's height. Pressed through the part's surface, by
+  // p = N / K - eps at the force its end pressed with last tick, the face is a bed of springs
+  // over the depth p + tilt x across it, whose centre of pressure moves I / (A p) =
+  // (r1^2 + r2^2) / (4 p) per radian of tilt: the dome with that radius has its lowest point
+  // there (the force on it stays the paper's K (eps - d), so the face resists its tilt by
+  // N R = K I / A (1 + eps / p), the bed's stiffness where eps << p). The
+  // tolerance's dome (32 m at eps = 1e-5 m) reached the rim at a tilt of 1.25e-4 rad, which a
+  // stuck tip passes in one tick of a slide: the load point jumped 8 mm to the rim and the tube
+  // took 4.6 mJ of bending in that tick (`stability --only "slide along a wall eps=1e-05m"`,
+  // the face pressed 0.38 mm in). Its radius at 0.38 mm is 59 mm. It is taken at last tick's
+  // force, as the dome's spring is (step 5): the face is a convex body within the tick, and its
+  // radius changes with the force from tick to tick, never beyond the tolerance's.
+  {
+    double pressed_N = 0.0;
+    for (int q = 0; q < m.prev_count; ++q) {
+      const Load& before = m.prev[std::size_t(q)];
+      if (before.active && before.s_m >= l && before.tube != states::TubeElement::kSide)
+        pressed_N = std::max(pressed_N, before.shape_force_W.dot(before.normal_W));
+    }
+    const double r1 = scene_.tube.outer_radius_m, r2 = scene_.tube.inner_radius_m;
+    const double through_m = pressed_N / K - eps;
+    m.collision.set_dome_radius_m(through_m > 0.0 ? (r1 * r1 + r2 * r2) / (4.0 * through_m)
+                                                  : m.collision.tolerance_dome_radius_m());
+  }
   const int raw_count = m.collision.Query(
       std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
       2.0 * eps + sweep_m, std::span<RawContact>(m.raw.data(), m.raw.size()), &idle);
@@ -815,8 +840,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // behind it, and the load point jumped to the rim, turning the end by the moment's jump in one
   // tick (the rubber tube slid along a wall, ticks 604-605: the point jumped 1.1 mm at 3.9 N,
   // matched as the side the lateral force fell from 0.105 to 0.036 N, and the next tick's shape was
-  // 14 mm off its contact). Such a rim, on a face and not overlapping it (where the collision's
-  // dome applies), continues the active relaxed point before any other load, and the point goes on
+  // 14 mm off its contact). Such a rim, on a face and not overlapping it, continues the active
+  // relaxed point before any other load, and the point goes on
   // relaxing towards the rim (below) until the last step to it changes the load's force by at most
   // 1 %: within min(eps/10, 0.01 N / K) of it (within eps/10, a K = 1e7 N/m slide's continuation
   // ended with its distance stepping by 0.093 mm, 930 N of penalty; the contact opened and the tube

@@ -572,16 +572,19 @@ TEST_CASE("A centreline through a sheet is found: from beyond one face to beyond
 TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into the rim's",
           "[core][collision]") {
   // The groove scene's tube (r1 = 8 mm, eps = 1 mm) straight, its end face tilted by t towards a
-  // wall whose face is d_c from the face's centre F. The face is a spherical cap of height
-  // h = eps / 10 over the rim circle, the end moved back along its axis by h (its apex at F): a
-  // sphere of radius R with centre C = F - R u, R^2 = (R - h)^2 + r1^2. Its lowest point towards
-  // the wall is C + R n (n the wall's normal into it) while that lies in the cap, the rim's
-  // lowest point (moved back by h) beyond: computed here as vectors, not by the collision's
-  // scalar formulas.
+  // wall whose face is d_c from the face's centre F. The face is a spherical cap of height h over
+  // the rim circle, the end moved back along its axis by h (its apex at F): a sphere of radius R
+  // with centre C = F - R u, R^2 = (R - h)^2 + r1^2. Its lowest point towards the wall is C + R n
+  // (n the wall's normal into it) while that lies in the cap, the rim's lowest point (moved back
+  // by h) beyond: computed here as vectors, not by the collision's scalar formulas. Three domes:
+  //  - the tolerance's, h = eps / 10, the face clear of the wall (d_c = 0.6 mm);
+  //  - the bed of springs' of a face pressed 0.38 mm through the surface (R = (r1^2 + r2^2) /
+  //    (4 p), 59 mm), the radius the core sets for such a face (the dome's range is then 0.14 rad);
+  //  - that one with the face's centre 0.38 mm inside the wall: an overlapping end (the slide
+  //    with a 10 um band) takes the same dome and the rim beyond it, not a flat face.
   scene::Scene s = GrooveScene();
-  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m;
-  const double h = 0.1 * s.contact.threshold_m, R = (r1 * r1 + h * h) / (2.0 * h);
-  const double d_c = 0.6e-3, wall_z = 0.5;  // the rim stays out of the wall to 0.07 rad
+  const double r1 = s.tube.outer_radius_m, r2 = s.tube.inner_radius_m, l = s.tube.length_m;
+  const double wall_z = 0.5;
   s.parts.clear();
   scene::BoxPart wall;
   wall.name = "wall";
@@ -590,66 +593,89 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   s.parts.push_back(wall);
   const std::vector<std::uint32_t> parts{0};
   const int capsules = 24;
-  const core::Collision collision(s, parts, capsules, MaskElements(1));
-  CHECK(collision.dome_radius_m() == Approx(R).epsilon(1e-12));
-  const Eigen::Vector3d F(0.0, 0.0, wall_z - d_c), n = Eigen::Vector3d::UnitZ();
-  struct End {
-    states::TubeElement tube;
-    double distance_m, offset_m;
+  core::Collision collision(s, parts, capsules, MaskElements(1));
+  const double h_tol = 0.1 * s.contact.threshold_m;
+  const double R_tol = (r1 * r1 + h_tol * h_tol) / (2.0 * h_tol);
+  CHECK(collision.dome_radius_m() == Approx(R_tol).epsilon(1e-12));
+  CHECK(collision.dome_height_m() == h_tol);
+  const double R_bed = (r1 * r1 + r2 * r2) / (4.0 * 0.38e-3);
+  struct Dome {
+    double radius_m, d_c;
   };
-  const auto query = [&](double t) {
-    const Eigen::Vector3d u(std::sin(t), 0.0, std::cos(t));
-    std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
-    for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = F - (l - l * k / capsules) * u;
-    std::array<core::RawContact, core::kMaxRawContacts> out{};
-    const int count = collision.Query(nodes_W, u, 2.0 * s.contact.threshold_m, out);
-    Complete(collision, s, capsules, out, count, nodes_W, true);
-    End end{states::TubeElement::kSide, 0.0, -1.0};
-    for (int i = 0; i < count; ++i) {
-      const core::RawContact& c = out[std::size_t(i)];
-      if (c.s_m < l) continue;
-      const Eigen::Vector3d r = c.p_W_m - F;
-      end = {c.tube, c.distance_m, (r - u * u.dot(r)).norm()};
+  for (const Dome dome : {Dome{R_tol, 0.6e-3}, Dome{R_bed, 0.6e-3}, Dome{R_bed, -0.38e-3}}) {
+    collision.set_dome_radius_m(dome.radius_m);
+    const double R = dome.radius_m, d_c = dome.d_c;
+    const double h = R - std::sqrt(R * R - r1 * r1);
+    INFO("dome radius " << R << " m, height " << h << " m, face centre " << d_c << " m off");
+    CHECK(collision.dome_radius_m() == R);
+    CHECK(collision.dome_height_m() == Approx(h).epsilon(1e-9));
+    const Eigen::Vector3d F(0.0, 0.0, wall_z - d_c), n = Eigen::Vector3d::UnitZ();
+    struct End {
+      states::TubeElement tube;
+      double distance_m, offset_m;
+    };
+    const auto query = [&](double t) {
+      const Eigen::Vector3d u(std::sin(t), 0.0, std::cos(t));
+      std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+      for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = F - (l - l * k / capsules) * u;
+      std::array<core::RawContact, core::kMaxRawContacts> out{};
+      const int count = collision.Query(nodes_W, u, 2.0 * s.contact.threshold_m, out);
+      Complete(collision, s, capsules, out, count, nodes_W, true);
+      End end{states::TubeElement::kSide, 0.0, -1.0};
+      for (int i = 0; i < count; ++i) {
+        const core::RawContact& c = out[std::size_t(i)];
+        if (c.s_m < l) continue;
+        const Eigen::Vector3d r = c.p_W_m - F;
+        end = {c.tube, c.distance_m, (r - u * u.dot(r)).norm()};
+      }
+      return end;
+    };
+    const double t_switch = std::asin(r1 / R);
+    for (const double t :
+         {1e-4, 0.3 * t_switch, 0.9 * t_switch, 1.1 * t_switch, 2.0 * t_switch, 0.07}) {
+      INFO("tilt " << t << " rad (the rim's from " << t_switch << ")");
+      const Eigen::Vector3d u(std::sin(t), 0.0, std::cos(t));
+      const Eigen::Vector3d C = F - R * u;
+      const Eigen::Vector3d low = C + R * n;
+      Eigen::Vector3d expected = low;
+      if ((low - C).dot(u) < R - h) {  // beyond the cap: the rim's lowest point
+        const Eigen::Vector3d radial = (n - n.dot(u) * u).normalized();
+        expected = F - h * u + r1 * radial;
+      }
+      const End end = query(t);
+      const Eigen::Vector3d rel = expected - F;
+      // 1e-12 m: the closed forms' rounding at 0.5 m from the origin.
+      CHECK(end.distance_m == Approx(wall_z - expected.z()).margin(1e-12));
+      if (t < t_switch) {
+        CHECK(end.tube == states::TubeElement::kEndFace);
+        CHECK(end.offset_m == Approx((rel - u * u.dot(rel)).norm()).margin(1e-12));
+      } else {
+        CHECK(end.tube == states::TubeElement::kEndRim);
+      }
     }
-    return end;
-  };
-  const double t_switch = std::asin(r1 / R);
-  for (const double t :
-       {1e-4, 0.3 * t_switch, 0.9 * t_switch, 1.1 * t_switch, 2.0 * t_switch, 0.07}) {
-    INFO("tilt " << t << " rad (the rim's from " << t_switch << ")");
-    const Eigen::Vector3d u(std::sin(t), 0.0, std::cos(t));
-    const Eigen::Vector3d C = F - R * u;
-    const Eigen::Vector3d low = C + R * n;
-    Eigen::Vector3d expected = low;
-    if ((low - C).dot(u) < R - h) {  // beyond the cap: the rim's lowest point
-      const Eigen::Vector3d radial = (n - n.dot(u) * u).normalized();
-      expected = F - h * u + r1 * radial;
+    // A potential: the penalty K (eps - d) at the load point is the gradient of K (eps - d)^2 / 2
+    // when d's derivative in the tilt about F is the point's lever arm, -e (central differences,
+    // dt = 1e-6 rad: an error of R sin(t) dt^2 / 6 < 1e-14 m in the slope for both radii,
+    // rounding 1e-16 m / dt), and d has no jump where the rim takes over.
+    for (const double t : {0.2 * t_switch, 0.5 * t_switch, 0.95 * t_switch}) {
+      const double dt = 1e-6;
+      const double slope = (query(t + dt).distance_m - query(t - dt).distance_m) / (2.0 * dt);
+      CHECK(slope == Approx(-query(t).offset_m).margin(1e-9));
     }
-    const End end = query(t);
-    const Eigen::Vector3d rel = expected - F;
-    // 1e-12 m: the closed forms' rounding at 0.5 m from the origin.
-    CHECK(end.distance_m == Approx(wall_z - expected.z()).margin(1e-12));
-    if (t < t_switch) {
-      CHECK(end.tube == states::TubeElement::kEndFace);
-      CHECK(end.offset_m == Approx((rel - u * u.dot(rel)).norm()).margin(1e-12));
-    } else {
-      CHECK(end.tube == states::TubeElement::kEndRim);
-    }
+    const End before = query(t_switch * (1.0 - 1e-9)), after = query(t_switch * (1.0 + 1e-9));
+    CHECK(before.tube == states::TubeElement::kEndFace);
+    CHECK(after.tube == states::TubeElement::kEndRim);
+    // A step of 2e-9 t_switch moves the lowest point by r1 times that (4e-15 m at R = 32 m,
+    // 2.2e-12 m at 59 mm), and the closed forms round at 1e-12 m.
+    CHECK(std::abs(after.distance_m - before.distance_m) < r1 * 2e-9 * t_switch + 1e-12);
   }
-  // A potential: the penalty K (eps - d) at the load point is the gradient of K (eps - d)^2 / 2
-  // when d's derivative in the tilt about F is the point's lever arm, -e (central differences,
-  // dt = 1e-6 rad: an error of R dt^2 / 6 ~ 1e-13 m in the slope, rounding 1e-16 m / dt), and d
-  // has no jump where the rim takes over.
-  for (const double t : {0.2 * t_switch, 0.5 * t_switch, 0.95 * t_switch}) {
-    const double dt = 1e-6;
-    const double slope = (query(t + dt).distance_m - query(t - dt).distance_m) / (2.0 * dt);
-    CHECK(slope == Approx(-query(t).offset_m).margin(1e-9));
-  }
-  const End before = query(t_switch * (1.0 - 1e-9)), after = query(t_switch * (1.0 + 1e-9));
-  CHECK(before.tube == states::TubeElement::kEndFace);
-  CHECK(after.tube == states::TubeElement::kEndRim);
-  // A step of 2e-9 t_switch moves the lowest point by r1 times that: 1e-12 m.
-  CHECK(std::abs(after.distance_m - before.distance_m) < 1e-12);
+  // Out of its range, the radius is held to [1.25 r1, the tolerance's]: a dome no higher than
+  // the tolerance, and no more than a cap flatter than a hemisphere.
+  collision.set_dome_radius_m(1e9);
+  CHECK(collision.dome_radius_m() == R_tol);
+  CHECK(collision.dome_height_m() == h_tol);
+  collision.set_dome_radius_m(0.0);
+  CHECK(collision.dome_radius_m() == 1.25 * r1);
 }
 
 TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever its tilt",

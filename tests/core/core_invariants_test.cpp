@@ -414,7 +414,7 @@ double DeepestInside(const scene::Scene& s, std::span<const Eigen::Vector3d> poi
 }
 
 TEST_CASE("The core holds the tube back instead of carrying it through a part", "[core][through]") {
-  // Random states as below, on the rubber groove: a third of them bend the tube so hard against
+  // Random states as below, on the rubber groove: some of them bend the tube so hard against
   // the floor that the tick's solution, taken, puts its axis more than r1/2 into the floor or a
   // wall. The same path with the guard off shows it; with it on, no tick does, and a held tick
   // keeps the tube, its held end and its CF, while the operator feels the coupling's spring and
@@ -427,9 +427,13 @@ TEST_CASE("The core holds the tube back instead of carrying it through a part", 
   std::array<Eigen::Vector3d, core::kMaxCapsules + 1> centre;
   const std::span<Eigen::Vector3d> points(centre.data(), std::size_t(on.capsule_count()) + 1);
   std::mt19937_64 rng(20261125);
+  // Enough trials for at least three to go through with the guard off: 3 of the first 20 did
+  // until stop 43, 2 since the end face pressed into a part became a bed of springs (one trial
+  // pressed its end 10 N into the floor and no longer goes through).
+  constexpr int kTrials = 30;
   int held_ticks = 0, trials_held = 0, trials_through_off = 0, switched_inside = 0;
   double deepest_on = -1.0, deepest_off = -1.0;
-  for (int trial = 0; trial < 20; ++trial) {
+  for (int trial = 0; trial < kTrials; ++trial) {
     const Eigen::Isometry3d X = RandomGroovePose(s, rng);
     on.Reset(s.X_WH_start);
     off.Reset(s.X_WH_start);
@@ -492,9 +496,10 @@ TEST_CASE("The core holds the tube back instead of carrying it through a part", 
     trials_through_off += deepest_off_trial > 0.5 * r1 ? 1 : 0;
     deepest_off = std::max(deepest_off, deepest_off_trial);
   }
-  INFO(held_ticks << " held ticks in " << trials_held << " of 20 trials; without the guard "
-                  << trials_through_off << " trials went deeper than r1/2, deepest "
-                  << deepest_off * 1e3 << " mm; with it " << deepest_on * 1e3 << " mm");
+  INFO(held_ticks << " held ticks in " << trials_held << " of " << kTrials
+                  << " trials; without the guard " << trials_through_off
+                  << " trials went deeper than r1/2, deepest " << deepest_off * 1e3
+                  << " mm; with it " << deepest_on * 1e3 << " mm");
   CHECK(trials_held >= 3);
   CHECK(trials_through_off >= 3);
   CHECK(switched_inside >= 1);

@@ -207,6 +207,24 @@ TEST_CASE("Stability: slide along a wall with a stiff penalty (K = 1e7 N/m): the
   CHECK(r.held_ticks == 0);
 }
 
+TEST_CASE("Stability: slide along a wall with a 10 um band: the pressed face is a bed of springs",
+          "[stability]") {
+  // The base slide with eps = 1e-5 m: ~3.9 N presses the end face 0.38 mm (38 eps) into the
+  // wall. Until stop 43 such an overlapping face took no dome and its flat law's range was
+  // 2 r1 sin(tilt) < eps / 10 (6e-5 rad): at tick 223, 0.1 mm into the slide, the stuck tip's
+  // tilt passed it, the load point jumped 8 mm from the face's centre to the rim, the tube took
+  // 4.6 mJ of bending in that tick and the energy held passed the hand's work. The dome now
+  // serves a face pressed in too, and its radius is the bed of springs' (r1^2 + r2^2) / (4 p) at
+  // the depth p = N / K - eps that last tick's force pressed it through the wall's surface (59 mm
+  // here, against the tolerance's 32 m), so its point moves from the centre by 59 mm per radian
+  // of tilt: the case passes, on its contacts.
+  const study::StabilityResult r = RunNamed("slide along a wall eps=1e-05m");
+  INFO(r.detail << " | " << r.warning);
+  CHECK(r.pass);
+  CHECK(r.first_shape_off_tick == -1);
+  CHECK(r.held_ticks == 0);
+}
+
 TEST_CASE("Stability: slide along a wall and back: the face takes the load over from the rim",
           "[stability]") {
   // The base slide's motion driven back to where it started (the sweep slides one way only): the
@@ -419,7 +437,7 @@ TEST_CASE("Stability: the core holds the tube back where it went through a wall"
   }
 }
 
-TEST_CASE("tubeplan stability --json: one document, a failing case exits 1", "[stability][cli]") {
+TEST_CASE("tubeplan stability --json: one document, passing cases exit 0", "[stability][cli]") {
   const auto run = [](std::vector<std::string> args, std::string& out_text) {
     std::ostringstream out, err;
     const int code = cli::Run(args, out, err);
@@ -432,9 +450,6 @@ TEST_CASE("tubeplan stability --json: one document, a failing case exits 1", "[s
   REQUIRE(j["cases"].size() == 1);
   CHECK(j["cases"][0]["name"] == "push into a wall E=2e+11Pa");
   CHECK(j["cases"][0]["pass"] == true);
-  // The slide with a 10 um band fails today (passivity at tick 223: docs/accuracy.md): exit 1.
-  CHECK(run({"stability", "--quick", "--only", "slide along a wall eps=1e-05m"}, text) == 1);
-  CHECK(text.find("FAIL @") != std::string::npos);
   // A case judged with the coupled rule says so, in the matrix and in the document.
   CHECK(run({"stability", "--quick", "--only", "squeeze between walls mu=0"}, text) == 0);
   CHECK(text.find("pass (coupled") != std::string::npos);
