@@ -92,13 +92,14 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
 
 void Collision::set_dome_radius_m(double radius_m) {
   // At least 1.25 r1: a cap of height r1 / 2 at most, as the tolerance's is (the constructor).
-  // At the tolerance's radius its own height, bit for bit: the shipped scenes' faces never press
-  // through, and their outputs stay the same bits.
+  // At the tolerance's radius its own height, bit for bit: a tick whose end pressed no face
+  // through (N <= K eps, no overlapping face) is the same bits as before the bed of springs.
+  // h = r1^2 / (R + sqrt(R^2 - r1^2)), not R - sqrt(R^2 - r1^2), which cancels at large R.
   const double r1 = radius_m_;
   const double R = std::clamp(radius_m, 1.25 * r1, tolerance_dome_radius_m_);
   dome_radius_m_ = R;
-  dome_height_m_ =
-      R < tolerance_dome_radius_m_ ? R - std::sqrt(R * R - r1 * r1) : tolerance_dome_height_m_;
+  dome_height_m_ = R < tolerance_dome_radius_m_ ? r1 * r1 / (R + std::sqrt(R * R - r1 * r1))
+                                                : tolerance_dome_height_m_;
   dome_sin_max_ = r1 / R;
   facing_axis_sq_ = 1.0 - dome_sin_max_ * dome_sin_max_;
 }
@@ -968,24 +969,29 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const double tilt = axis_W.cross(c.normal_W).norm();  // sin of end face to contact plane
         const bool side_flat = std::abs(axis_W.dot(c.normal_W)) * end_m_ < tube_tolerance_m_;
         // The end face pressed on a face of the part, slightly tilted. A flat disc's contact
-        // point jumps by r1 as the tilt changes sign, and the penalty's bed of springs (a centre
-        // of pressure at tilt (r1^2 + r2^2) / (4 (eps - d_centre)) from the centre) is not the
-        // gradient of any energy: a tilting face made energy (docs/accuracy.md). The face is a
-        // spherical cap over the rim circle instead, of height h (the tube's geometric
-        // tolerance) and radius R, and the whole end is moved back along its axis by h, so that
-        // its apex is the face's centre: a convex body, whose lowest point
+        // point jumps by r1 as the tilt changes sign; the centre of pressure the core used before
+        // stop 36 (the force of the centre's distance, placed (r1^2 + r2^2) / (4 (eps -
+        // d_centre)) per radian from the centre) is not the gradient of any energy: a tilting
+        // face made energy (docs/accuracy.md). The face is a spherical cap over the rim circle
+        // instead, of height h and radius R, and the whole end is moved back along its axis by
+        // h, so that its apex is the face's centre: a convex body, whose lowest point
         //     e = R sin(tilt) from the centre,  d = d_centre - R (1 - cos(tilt))
         // moves continuously from the centre to the rim, where it meets the rim's point (its
         // distance d_rim + h cos(tilt)) at sin(tilt) = r1 / R with the same distance and
-        // normal. K (eps - d)^2 / 2 of the lowest point is then a potential of the end's pose.
-        // R is set for the tick (set_dome_radius_m): the tolerance's, or, for a face pressed
-        // through the part's surface, the bed of springs' radius at that depth (core.cpp), the
-        // overlapping face included: it took no dome until stop 43, and its flat law's range
-        // (2 r1 sin(tilt) < eps / 10) was passed in one tick of a slide with eps = 1e-5 m.
+        // normal. K (eps - d)^2 / 2 of the lowest point is then a potential of the end's pose
+        // for the tick's R (set_dome_radius_m): the tolerance's (h the tube's geometric
+        // tolerance), or, for a face pressed through the part's surface, the bed of springs'
+        // radius at last tick's depth (core.cpp), which changes from tick to tick with the force
+        // (conservative within a tick; across ticks the stability sweep's passivity check is
+        // the evidence). The overlapping face takes it too: it took no dome until stop 43, and
+        // its flat law's range (2 r1 sin(tilt) < eps / 10) was passed in one tick of a slide with
+        // eps = 1e-5 m.
         const double radial_m = radial_W.norm();
         const double cos_tilt = std::sqrt(std::max(0.0, 1.0 - tilt * tilt));
         const double centre_m = c.distance_m + radius_m_ * tilt;
-        const bool on_face = !side_flat && IsFaceMask(c.face_mask);
+        // Overlapping, only with the exact depth of a face pressed in (CylinderBoxPenetration):
+        // Overlapping()'s point, for an axis inside the part, is not the rim's lowest.
+        const bool on_face = !side_flat && IsFaceMask(c.face_mask) && (!c.overlap || signed_depth);
         bool at_pressure_centre = false;
         if (radial_m < radius_m_ - tube_tolerance_m_) {
           c.tube = states::TubeElement::kEndFace;

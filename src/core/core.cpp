@@ -218,7 +218,8 @@ struct Core::State {
 
 // The set-up that ticks only read (Collision's GJK solver carries nothing between queries: its
 // cached guess is off; the distances Collision keeps from earlier queries save evaluations and
-// never change a result), over the state.
+// never change a result; the dome's radius each tick sets comes from the state's last loads, so
+// a restored state sets it again), over the state.
 struct Core::Impl : Core::State {
   Impl(const scene::Scene& scene, std::span<const std::uint32_t> parts, int capsules,
        std::vector<std::array<int, 64>> element_of)
@@ -592,7 +593,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // (r1^2 + r2^2) / (4 p) per radian of tilt: the dome with that radius has its lowest point
   // there (the force on it stays the paper's K (eps - d), so the face resists its tilt by
   // N R = K I / A (1 + eps / p), the bed's stiffness where eps << p). The
-  // tolerance's dome (32 m at eps = 1e-5 m) reached the rim at a tilt of 1.25e-4 rad, which a
+  // tolerance's dome (32 m at eps = 1e-5 m) reached the rim at a tilt of 2.5e-4 rad, which a
   // stuck tip passes in one tick of a slide: the load point jumped 8 mm to the rim and the tube
   // took 4.6 mJ of bending in that tick (`stability --only "slide along a wall eps=1e-05m"`,
   // the face pressed 0.38 mm in). Its radius at 0.38 mm is 59 mm. It is taken at last tick's
@@ -602,7 +603,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     double pressed_N = 0.0;
     for (int q = 0; q < m.prev_count; ++q) {
       const Load& before = m.prev[std::size_t(q)];
-      if (before.active && before.s_m >= l && before.tube != states::TubeElement::kSide)
+      if (before.active && before.s_m >= l && before.tube != states::TubeElement::kSide &&
+          before.part_element >= 0 &&
+          IsFaceMask(elements_[std::size_t(before.part_element)].face_mask))
         pressed_N = std::max(pressed_N, before.shape_force_W.dot(before.normal_W));
     }
     const double r1 = scene_.tube.outer_radius_m, r2 = scene_.tube.inner_radius_m;
@@ -840,19 +843,22 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // behind it, and the load point jumped to the rim, turning the end by the moment's jump in one
   // tick (the rubber tube slid along a wall, ticks 604-605: the point jumped 1.1 mm at 3.9 N,
   // matched as the side the lateral force fell from 0.105 to 0.036 N, and the next tick's shape was
-  // 14 mm off its contact). Such a rim, on a face and not overlapping it, continues the active
-  // relaxed point before any other load, and the point goes on
-  // relaxing towards the rim (below) until the last step to it changes the load's force by at most
-  // 1 %: within min(eps/10, 0.01 N / K) of it (within eps/10, a K = 1e7 N/m slide's continuation
-  // ended with its distance stepping by 0.093 mm, 930 N of penalty; the contact opened and the tube
-  // sprang into the wall, held back for the last 97 ticks). A rim that overlaps the face ends it.
+  // 14 mm off its contact). Such a rim, on a face, continues the active relaxed point before any
+  // other load, and the point goes on relaxing towards the rim (below) until the last step to it
+  // changes the load's force by at most 1 %: within min(eps/10, 0.01 N / K) of it (within eps/10,
+  // a K = 1e7 N/m slide's continuation ended with its distance stepping by 0.093 mm, 930 N of
+  // penalty; the contact opened and the tube sprang into the wall, held back for the last 97
+  // ticks). A rim overlapping the face continues it too since stop 43: a face pressed through has
+  // the bed of springs' dome, whose rim overlaps wherever it is reached (before, an overlapping
+  // face had no dome, and an overlapping rim ended the continuation; the sweep passes the same
+  // cases either way, three outside the model's validity with other figures).
   // Not a face lying flat, loaded at its centre: with a stiff penalty (K = 1e7 N/m) its load then
   // sat near the centre for hundreds of ticks, the relaxation's step being 1 / (1 + g) with g in
   // the thousands, while the end pivoted freely and its rim sank into the wall; a fixed step of a
   // fifth of the way jumped 1.6 mm in the first tick and snapped the tube as before.
   const double rim_close_m = 0.1 * eps;
   const auto continues_centre = [&](const Load& ld, const Load& before) {
-    if (ld.tube == states::TubeElement::kEndFace || ld.s_m < l || ld.overlap || !before.active ||
+    if (ld.tube == states::TubeElement::kEndFace || ld.s_m < l || !before.active ||
         !before.pressure_centre || !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask))
       return false;
     const Eigen::Vector3d rim_H = R_WH.transpose() * (ld.x0_W - m.nodes_W[std::size_t(N)]);
@@ -867,8 +873,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // snapped (the base slide driven back, tick 1494, 2.3 mJ over the slack; found in review). The
   // face continues the rim's active load, its point relaxing from the rim's.
   const auto continues_rim = [&](const Load& ld, const Load& before) {
-    return ld.pressure_centre && ld.tube == states::TubeElement::kEndFace && !ld.overlap &&
-           before.active && !before.pressure_centre && !before.ghost && before.s_m >= l;
+    return ld.pressure_centre && ld.tube == states::TubeElement::kEndFace && before.active &&
+           !before.pressure_centre && !before.ghost && before.s_m >= l;
   };
   std::array<bool, kMaxLoads> taken{};
   // Loads that continue a face's point with the rim as its target (pass 0, above).
@@ -1133,10 +1139,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         // A turn theta about u moves the rim circle's lowest point along u x axis by
         // r1 cot(tilt) theta (stop 40 had r1 / sin(tilt): the same where the dome meets the rim,
         // but a spring r1 N on a side lying along the face, whose point a turn about u does not
-        // move). Where that is within the dome's height h (the tube's geometric tolerance) for a
+        // move). Where that is within the dome's height h (the tick's, set before the query) for a
         // turn of a radian, the point does not move: no spring (the tube lying in the groove,
         // its end's side on the floor).
-        if (ld.pressure_centre || ld.ghost || ld.overlap || at.s_m < l ||
+        if (ld.pressure_centre || ld.ghost || at.s_m < l ||
             !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask) ||
             !(u_H.norm() > 0.99 * r1) || !(sin_tilt * R > r1) ||
             !(r1 * cos_tilt > m.collision.dome_height_m() * sin_tilt))

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <random>
 #include <span>
 #include <vector>
@@ -286,12 +287,14 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
   const std::vector<std::array<int, 64>> element_of = MaskElements(s.parts.size());
   const int capsules = 24;
   const double piece_m = s.tube.length_m / capsules;
-  const core::Collision kept(s, parts, capsules, element_of);
+  core::Collision kept(s, parts, capsules, element_of);
   // A third with the same history that may leave every part out (the core's IdleParts, at a
   // floor of epsilon): each contact of a part it left out must lie in one of its groups, at
   // least the group's gap away, no farther along the tube than its s_max, with a normal in its
-  // span; and no end face at its dome's lowest point is left out.
-  const core::Collision idle(s, parts, capsules, element_of);
+  // span; and no end face at its dome's lowest point is left out. The dome's radius changes
+  // between queries as the core sets it (the tolerance's, or a bed of springs' down to 1.25 r1):
+  // a part left out while the dome's range was narrow must be looked at again once it widens.
+  core::Collision idle(s, parts, capsules, element_of);
   const std::vector<std::uint8_t> may_leave_out(s.parts.size(), 1);
   std::array<core::RawContact, core::kMaxRawContacts> got_idle{};
   int left_out = 0, covered = 0;
@@ -354,9 +357,18 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
     else if (band_roll < 0.3)
       band_m = 2.0 * s.contact.threshold_m + 1e-6 * (unit(rng) + 1.0);
     place(pose);
+    // Mostly the tolerance's dome; now and then one from 1.25 r1 to it, log-uniform.
+    const double dome_roll = 0.5 * (unit(rng) + 1.0);
+    const double r1 = s.tube.outer_radius_m, R_tol = kept.tolerance_dome_radius_m();
+    const double dome_m = dome_roll < 0.7
+                              ? R_tol
+                              : 1.25 * r1 * std::pow(R_tol / (1.25 * r1), 0.5 * (unit(rng) + 1.0));
+    kept.set_dome_radius_m(dome_m);
+    idle.set_dome_radius_m(dome_m);
 
     const int n = kept.Query(nodes_W, tip_tangent_W, band_m, got);
-    const core::Collision fresh(s, parts, capsules, element_of);
+    core::Collision fresh(s, parts, capsules, element_of);
+    fresh.set_dome_radius_m(dome_m);
     const int m = fresh.Query(nodes_W, tip_tangent_W, band_m, want);
     Complete(kept, s, capsules, got, n, nodes_W, false);
     completed_checked += Complete(fresh, s, capsules, want, m, nodes_W, query % 10 == 0);
@@ -605,10 +617,12 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   for (const Dome dome : {Dome{R_tol, 0.6e-3}, Dome{R_bed, 0.6e-3}, Dome{R_bed, -0.38e-3}}) {
     collision.set_dome_radius_m(dome.radius_m);
     const double R = dome.radius_m, d_c = dome.d_c;
-    const double h = R - std::sqrt(R * R - r1 * r1);
+    // The cap's height from R^2 = (R - h)^2 + r1^2, by the root that does not cancel; 1e-12:
+    // the collision's own rounding of it (at the tolerance's radius it keeps h = eps / 10).
+    const double h = r1 * r1 / (R + std::sqrt(R * R - r1 * r1));
     INFO("dome radius " << R << " m, height " << h << " m, face centre " << d_c << " m off");
     CHECK(collision.dome_radius_m() == R);
-    CHECK(collision.dome_height_m() == Approx(h).epsilon(1e-9));
+    CHECK(collision.dome_height_m() == Approx(h).epsilon(1e-12));
     const Eigen::Vector3d F(0.0, 0.0, wall_z - d_c), n = Eigen::Vector3d::UnitZ();
     struct End {
       states::TubeElement tube;
@@ -665,8 +679,8 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
     const End before = query(t_switch * (1.0 - 1e-9)), after = query(t_switch * (1.0 + 1e-9));
     CHECK(before.tube == states::TubeElement::kEndFace);
     CHECK(after.tube == states::TubeElement::kEndRim);
-    // A step of 2e-9 t_switch moves the lowest point by r1 times that (4e-15 m at R = 32 m,
-    // 2.2e-12 m at 59 mm), and the closed forms round at 1e-12 m.
+    // A step of 2e-9 t_switch moves the lowest point by r1 times that (4e-13 m at the
+    // tolerance's R = 0.32 m, 2.2e-12 m at 59 mm), and the closed forms round at 1e-12 m.
     CHECK(std::abs(after.distance_m - before.distance_m) < r1 * 2e-9 * t_switch + 1e-12);
   }
   // Out of its range, the radius is held to [1.25 r1, the tolerance's]: a dome no higher than
@@ -676,6 +690,69 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   CHECK(collision.dome_height_m() == h_tol);
   collision.set_dome_radius_m(0.0);
   CHECK(collision.dome_radius_m() == 1.25 * r1);
+  CHECK(collision.dome_height_m() == Approx(0.5 * r1).epsilon(1e-12));
+}
+
+TEST_CASE("A part left out under a narrow dome is looked at again when the dome widens",
+          "[core][collision]") {
+  // A thin tube (r1 = 1.5 mm, eps = 1 mm: a tube thinner than 2 eps, where a dome's point can
+  // lie in the band while the capsule round the end piece, the distance kept for it, is beyond
+  // the idle floor eps) pointing down at a floor, its end face tilted by sin(t) = 0.78 to it,
+  // the face's centre 2.55 mm above it. Under the tolerance's dome (R = 11.3 mm, range
+  // sin(t) < 0.13) the rim is the contact (1.38 mm off), the end does not face the floor, and the
+  // floor, idle, is left out and its evaluation kept. The core then sets a bed of springs' dome
+  // at its floor, R = 1.25 r1 (range sin(t) < 0.8): the end faces the floor within it, and a
+  // fresh query finds the dome's lowest point, 1.85 mm off, in the band. The kept evaluation,
+  // made for the narrow range, must not leave it out (collision.cpp, StillLeftOut).
+  scene::Scene s = GrooveScene();
+  s.tube.outer_radius_m = 1.5e-3;
+  s.tube.inner_radius_m = 1.0e-3;
+  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
+  s.parts.clear();
+  scene::BoxPart floor;
+  floor.name = "floor";
+  floor.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
+  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, -0.01);  // top at z = 0
+  s.parts.push_back(floor);
+  const std::vector<std::uint32_t> parts{0};
+  const int capsules = 24;
+  core::Collision idle(s, parts, capsules, MaskElements(1));
+  core::Collision fresh(s, parts, capsules, MaskElements(1));
+  const double sin_t = 0.78, cos_t = std::sqrt(1.0 - sin_t * sin_t);
+  const Eigen::Vector3d u(0.0, sin_t, -cos_t);  // towards the floor
+  const Eigen::Vector3d tip(0.0, 0.0, 2.55e-3);
+  std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+  for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = tip - (l - l * k / capsules) * u;
+  const double band_m = 2.0 * eps;
+  const std::vector<std::uint8_t> may_leave_out{1};
+  std::array<core::RawContact, core::kMaxRawContacts> out{};
+  const auto pressure_centres = [&](int count) {
+    int found = 0;
+    for (int i = 0; i < count; ++i) found += out[std::size_t(i)].pressure_centre ? 1 : 0;
+    return found;
+  };
+  // The tolerance's dome: once a query has kept the pieces' distances, the floor is left out.
+  const int rim_only = idle.Query(nodes_W, u, band_m, out);
+  REQUIRE(rim_only > 0);
+  REQUIRE(pressure_centres(rim_only) == 0);
+  core::IdleParts first;
+  first.may_leave_out = may_leave_out;
+  first.floor_m = eps;
+  CHECK(idle.Query(nodes_W, u, band_m, out, &first) == 0);
+  CHECK(first.left_out == 1);
+  // The bed of springs' dome, the tube where it was.
+  idle.set_dome_radius_m(0.0);
+  fresh.set_dome_radius_m(0.0);
+  REQUIRE(fresh.dome_radius_m() == 1.25 * r1);
+  const int want = fresh.Query(nodes_W, u, band_m, out);
+  REQUIRE(pressure_centres(want) == 1);
+  core::IdleParts second;
+  second.may_leave_out = may_leave_out;
+  second.floor_m = eps;
+  const int got = idle.Query(nodes_W, u, band_m, out, &second);
+  CHECK(second.left_out == 0);
+  CHECK(got == want);
+  CHECK(pressure_centres(got) == 1);
 }
 
 TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever its tilt",

@@ -429,7 +429,8 @@ TEST_CASE("The core holds the tube back instead of carrying it through a part", 
   std::mt19937_64 rng(20261125);
   // Enough trials for at least three to go through with the guard off: 3 of the first 20 did
   // until stop 43, 2 since the end face pressed into a part became a bed of springs (one trial
-  // pressed its end 10 N into the floor and no longer goes through).
+  // pressed its end into the floor with more than K eps = 10 N and no longer goes through; 4 of
+  // the 30 do).
   constexpr int kTrials = 30;
   int held_ticks = 0, trials_held = 0, trials_through_off = 0, switched_inside = 0;
   double deepest_on = -1.0, deepest_off = -1.0;

@@ -234,41 +234,48 @@ TEST_CASE("Stability: slide along a wall and back: the face takes the load over 
   // slack). Now the face continues the rim's load from the rim's point: the shape stays on its
   // contacts, the tube is never held back, and the normal force changes by less than 0.25 N a
   // tick (0.1 N at most, measured; the snap's was 0.93 N).
-  const study::StabilityCase base = testing::QuickCase("slide along a wall base");
-  const scene::Scene& s = base.scene;
-  core::Core core(s);
-  const double gap = 2.0 * s.contact.threshold_m + 1e-3, dt = s.model.time_step_s;
-  const std::vector<Eigen::Vector3d> waypoints{
-      {0, 0, gap + 0.01}, {0.04, 0, gap + 0.01}, {0, 0, gap + 0.01}};
-  Eigen::Vector3d hand = Eigen::Vector3d::Zero();
-  double t = 0.0, last_N = 0.0, worst_jump_N = 0.0;
-  int tick = 0, off = 0, held = 0, worst_at = 0;
-  const auto step = [&](const Eigen::Vector3d& h) {
-    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-    X.translation() = h;
-    const core::StepOutput& o = core.Step(t += dt, X);
-    ++tick;
-    if (o.flags & core::kShapeOffContacts) ++off;
-    if (o.flags & core::kHeldBack) ++held;
-    double N = 0.0;
-    for (const core::ContactState& pc : o.Contacts()) N += pc.normal_force_N;
-    if (tick > 1 && std::abs(N - last_N) > worst_jump_N) {
-      worst_jump_N = std::abs(N - last_N);
-      worst_at = tick;
+  // The same with a 10 um band: the face pressed 0.38 mm through the wall has the bed of
+  // springs' dome (stop 43), and its rim, reached on the way back, overlaps the wall in most
+  // ticks. Before stop 43 its load jumped 3.5 N in a tick and its shape left its contacts (tick
+  // 223); now 0.08 N at most, measured.
+  for (const char* name : {"slide along a wall base", "slide along a wall eps=1e-05m"}) {
+    INFO(name);
+    const study::StabilityCase base = testing::QuickCase(name);
+    const scene::Scene& s = base.scene;
+    core::Core core(s);
+    const double gap = 2.0 * s.contact.threshold_m + 1e-3, dt = s.model.time_step_s;
+    const std::vector<Eigen::Vector3d> waypoints{
+        {0, 0, gap + 0.01}, {0.04, 0, gap + 0.01}, {0, 0, gap + 0.01}};
+    Eigen::Vector3d hand = Eigen::Vector3d::Zero();
+    double t = 0.0, last_N = 0.0, worst_jump_N = 0.0;
+    int tick = 0, off = 0, held = 0, worst_at = 0;
+    const auto step = [&](const Eigen::Vector3d& h) {
+      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+      X.translation() = h;
+      const core::StepOutput& o = core.Step(t += dt, X);
+      ++tick;
+      if (o.flags & core::kShapeOffContacts) ++off;
+      if (o.flags & core::kHeldBack) ++held;
+      double N = 0.0;
+      for (const core::ContactState& pc : o.Contacts()) N += pc.normal_force_N;
+      if (tick > 1 && std::abs(N - last_N) > worst_jump_N) {
+        worst_jump_N = std::abs(N - last_N);
+        worst_at = tick;
+      }
+      last_N = N;
+    };
+    for (const Eigen::Vector3d& target : waypoints) {
+      const int n = std::max(1, int(std::ceil((target - hand).norm() / (base.speed_m_per_s * dt))));
+      const Eigen::Vector3d from = hand;
+      for (int i = 1; i <= n; ++i) step(from + (target - from) * (double(i) / n));
+      hand = target;
     }
-    last_N = N;
-  };
-  for (const Eigen::Vector3d& target : waypoints) {
-    const int n = std::max(1, int(std::ceil((target - hand).norm() / (base.speed_m_per_s * dt))));
-    const Eigen::Vector3d from = hand;
-    for (int i = 1; i <= n; ++i) step(from + (target - from) * (double(i) / n));
-    hand = target;
+    for (int i = 0; i < 100; ++i) step(hand);
+    INFO("largest change of N " << worst_jump_N << " N at tick " << worst_at);
+    CHECK(off == 0);
+    CHECK(held == 0);
+    CHECK(worst_jump_N < 0.25);
   }
-  for (int i = 0; i < 100; ++i) step(hand);
-  INFO("largest change of N " << worst_jump_N << " N at tick " << worst_at);
-  CHECK(off == 0);
-  CHECK(held == 0);
-  CHECK(worst_jump_N < 0.25);
 }
 
 TEST_CASE("Stability: roll over an edge, the side pressed on it with stuck friction, then drawn",
