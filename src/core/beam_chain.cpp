@@ -296,41 +296,53 @@ int ElasticaSegmentAt(const std::array<ElasticaSegment, kMaxLoads>& segments, in
   return -1;
 }
 
-// Points of one segment from its dimensionless centreline at (s_m - clamp) / length.
-void SegmentPoints(const ElasticaSegment& seg, std::span<const double> s_m,
-                   std::span<Eigen::Vector3d> out) {
-  constexpr std::size_t kChunk = 32;
-  for (std::size_t first = 0; first < s_m.size(); first += kChunk) {
-    const std::size_t n = std::min(kChunk, s_m.size() - first);
-    std::array<double, kChunk> s_unit{};
-    std::array<Eigen::Vector2d, kChunk> xz;
-    std::array<double, kChunk> theta{};
-    for (std::size_t i = 0; i < n; ++i)
-      s_unit[i] = std::clamp((s_m[first + i] - seg.clamp_m) / seg.length_m, 0.0, 1.0);
-    model::ElasticaCentreline(seg.solution, std::span<const double>(s_unit.data(), n),
-                              std::span<Eigen::Vector2d>(xz.data(), n),
-                              std::span<double>(theta.data(), n));
-    for (std::size_t i = 0; i < n; ++i)
-      out[first + i] =
-          seg.origin_H + seg.R_HS * (seg.length_m * (xz[i].x() * seg.bend_x_S +
-                                                     xz[i].y() * Eigen::Vector3d::UnitZ()));
-  }
+// A segment's point in H from its dimensionless centreline point (x, z) / L.
+Eigen::Vector3d SegmentPoint(const ElasticaSegment& seg, const Eigen::Vector2d& xz) {
+  return seg.origin_H +
+         seg.R_HS * (seg.length_m * (xz.x() * seg.bend_x_S + xz.y() * Eigen::Vector3d::UnitZ()));
+}
+
+// The point of one segment at s_m from its dimensionless centreline at (s_m - clamp) / length.
+Eigen::Vector3d SegmentPointAt(const ElasticaSegment& seg, double s_m) {
+  const double s_unit = std::clamp((s_m - seg.clamp_m) / seg.length_m, 0.0, 1.0);
+  Eigen::Vector2d xz;
+  double theta = 0.0;
+  model::ElasticaCentreline(seg.solution, std::span<const double>(&s_unit, 1),
+                            std::span<Eigen::Vector2d>(&xz, 1), std::span<double>(&theta, 1));
+  return SegmentPoint(seg, xz);
 }
 
 }  // namespace
 
-void BeamChain::ElasticaPoints(const std::array<ElasticaSegment, kMaxLoads>& segments,
-                               int segment_count, std::span<const double> s_m,
-                               std::span<Eigen::Vector3d> out) const {
-  for (std::size_t i = 0; i < s_m.size();) {
-    const int g = ElasticaSegmentAt(segments, segment_count, s_m[i]);
+void BeamChain::ElasticaEvenPoints(const std::array<ElasticaSegment, kMaxLoads>& segments,
+                                   int segment_count, std::span<Eigen::Vector3d> out) const {
+  const std::size_t count = out.size();
+  const auto s_at = [&](std::size_t k) {
+    return count > 1 ? length_m_ * double(k) / double(count - 1) : length_m_;
+  };
+  // A segment's points in chunks of at most kChunk (no allocation), each walked by
+  // ElasticaSamples over its range; a chunk of one point, and the points beyond the chain, one
+  // by one.
+  constexpr std::size_t kChunk = 64;
+  std::array<Eigen::Vector2d, kChunk> xz, tangent;
+  for (std::size_t i = 0; i < count;) {
+    const int g = ElasticaSegmentAt(segments, segment_count, s_at(i));
     std::size_t n = 1;
-    while (i + n < s_m.size() && ElasticaSegmentAt(segments, segment_count, s_m[i + n]) == g) ++n;
-    if (g < 0 || !(segments[std::size_t(g)].length_m > 0.0)) {
+    while (i + n < count && n < kChunk &&
+           ElasticaSegmentAt(segments, segment_count, s_at(i + n)) == g)
+      ++n;
+    if (g < 0 || n < 2 || !(segments[std::size_t(g)].length_m > 0.0)) {
       for (std::size_t k = i; k < i + n; ++k)
-        out[k] = ElasticaPoint(segments, segment_count, s_m[k]);
+        out[k] = ElasticaPoint(segments, segment_count, s_at(k));
     } else {
-      SegmentPoints(segments[std::size_t(g)], s_m.subspan(i, n), out.subspan(i, n));
+      const ElasticaSegment& seg = segments[std::size_t(g)];
+      const auto unit = [&](std::size_t k) {
+        return std::clamp((s_at(k) - seg.clamp_m) / seg.length_m, 0.0, 1.0);
+      };
+      model::ElasticaSamples(seg.solution, unit(i), unit(i + n - 1),
+                             std::span<Eigen::Vector2d>(xz.data(), n),
+                             std::span<Eigen::Vector2d>(tangent.data(), n));
+      for (std::size_t k = 0; k < n; ++k) out[i + k] = SegmentPoint(seg, xz[k]);
     }
     i += n;
   }
@@ -342,9 +354,7 @@ Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxL
   if (g >= 0) {
     const ElasticaSegment& seg = segments[std::size_t(g)];
     if (!(seg.length_m > 0.0)) return seg.origin_H;
-    Eigen::Vector3d point;
-    SegmentPoints(seg, std::span<const double>(&s_m, 1), std::span<Eigen::Vector3d>(&point, 1));
-    return point;
+    return SegmentPointAt(seg, s_m);
   }
   // Beyond the last segment (or no segment): straight along the last tip's tangent.
   if (segment_count == 0) return {0.0, 0.0, s_m};

@@ -155,11 +155,12 @@ class BeamChain {
   /// Position in H of the centreline at s_m of a solved elastica chain.
   Eigen::Vector3d ElasticaPoint(const std::array<ElasticaSegment, kMaxLoads>& segments,
                                 int segment_count, double s_m) const;
-  /// ElasticaPoint at each of s_m (ascending) into out, the same bits: a run of points on one
-  /// segment shares one evaluation of the segment's root figures (ElasticaCentreline), which
-  /// point by point cost half of each point's time.
-  void ElasticaPoints(const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count,
-                      std::span<const double> s_m, std::span<Eigen::Vector3d> out) const;
+  /// The centreline of a solved chain at s = k l / (out.size() - 1), frame H, as ElasticaPoint
+  /// to ~1e-14 of l: a segment's points are walked by model::ElasticaSamples over their range
+  /// (the Jacobi functions carried from point to point by their addition theorems), a tenth of
+  /// ElasticaPoint's cost a point (Core::Centreline, the shape a consumer asks for).
+  void ElasticaEvenPoints(const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count,
+                          std::span<Eigen::Vector3d> out) const;
   /// The centreline of a solved chain at s = k l / (nodes.size() - 1), frame H: exact at
   /// kElasticaSamples points per segment and cubic Hermite (positions and tangents) between
   /// them: within 2 um of the exact shape up to alpha = 10 (tests/core/beam_chain_test.cpp),

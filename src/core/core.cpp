@@ -2517,16 +2517,8 @@ void Core::Centreline(std::span<Eigen::Vector3d> p_W_m) const {
     return count > 1 ? l * double(k) / double(count - 1) : l;
   };
   if (m.elastica_shape) {
-    // A segment's points in one call: its root figures are computed once (ElasticaPoints).
-    constexpr std::size_t kChunk = 64;
-    for (std::size_t first = 0; first < count; first += kChunk) {
-      const std::size_t n = std::min(kChunk, count - first);
-      std::array<double, kChunk> s_m{};
-      for (std::size_t k = 0; k < n; ++k) s_m[k] = s_at(first + k);
-      m.beam.ElasticaPoints(m.segments, m.segment_count, std::span<const double>(s_m.data(), n),
-                            p_W_m.subspan(first, n));
-      for (std::size_t k = first; k < first + n; ++k) p_W_m[k] = out_.X_WH * p_W_m[k];
-    }
+    m.beam.ElasticaEvenPoints(m.segments, m.segment_count, p_W_m);
+    for (Eigen::Vector3d& p : p_W_m) p = out_.X_WH * p;
     return;
   }
   for (std::size_t k = 0; k < count; ++k) {

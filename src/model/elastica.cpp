@@ -822,13 +822,29 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
 
 void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d> xz_out,
                      std::span<Eigen::Vector2d> tangent_out) {
+  ElasticaSamples(solution, 0.0, 1.0, xz_out, tangent_out);
+}
+
+void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_last,
+                     std::span<Eigen::Vector2d> xz_out, std::span<Eigen::Vector2d> tangent_out) {
   const std::size_t n = xz_out.size();
   if (tangent_out.size() != n || n < 2) {
     throw std::invalid_argument(
         "ElasticaSamples: xz_out and tangent_out must have the same size, at least 2");
   }
+  if (!(s_first >= 0.0 && s_first <= s_last && s_last <= 1.0)) {
+    char buffer[160];
+    std::snprintf(buffer, sizeof(buffer),
+                  "ElasticaSamples: the range [%.17g, %.17g] is not within [0, 1] in order",
+                  s_first, s_last);
+    throw std::invalid_argument(buffer);
+  }
   const double last = double(n - 1);
-  const auto s_of = [&](std::size_t j) { return j + 1 == n ? 1.0 : double(j) / last; };
+  const double span = s_last - s_first;
+  // (Over [0, 1]: 0 + 1 * (j / last), the same bits as j / last.)
+  const auto s_of = [&](std::size_t j) {
+    return j + 1 == n ? s_last : s_first + span * (double(j) / last);
+  };
   const ElasticaTip& tip = solution.tip;
   if (tip.tip_angle_rad == 0.0 && tip.deflection == 0.0) {
     for (std::size_t j = 0; j < n; ++j) {
@@ -863,7 +879,7 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
   // three R_D instead of one of each per sample. Samples with w <= tau step w up from the tip
   // (w = 0: sn 0, cn 1, dn 1, D 0), the others tau up from the root and are reflected, as in
   // ShapeFromTip.
-  const double delta = sqrt_alpha / last;
+  const double delta = sqrt_alpha * span / last;
   const double k = solution.modulus_k, kc = solution.modulus_kc, k_sq = k * k;
   const double d_complete = k_sq * Rd(0.0, kc * kc, 1.0) / 3.0;  // D(K)
   const double big_k = tau0 + sqrt_alpha;
@@ -892,9 +908,10 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
     return next;
   };
   std::size_t first_tip_side = 0;
-  if (sqrt_alpha > tau0) {  // the root sample lies beyond K/2 from the tip: the root side
+  const double tau_first = tau0 + sqrt_alpha * s_of(0);
+  if (sqrt_alpha * (1.0 - s_of(0)) > tau_first) {  // the first sample lies beyond K/2 from the tip
     Stepped at_tau;
-    at_tau.j = JacobiFunctions(tau0, chain);  // tau0 < K/2 here, as w + tau = K
+    at_tau.j = JacobiFunctions(tau_first, chain);  // tau < K/2 here, as w + tau = K
     at_tau.big_d = EpsilonDefect(k, at_tau.j);
     std::size_t& i = first_tip_side;
     for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
@@ -905,18 +922,27 @@ void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d
   }
   walked = 0.0;
   Stepped at_w;  // w = 0 at the tip: sn 0, cn 1, dn 1, D 0
+  if (s_last < 1.0 && first_tip_side < n) {
+    // The last sample short of the tip, on the tip side (w <= K/2): evaluated afresh.
+    at_w.j = JacobiFunctions(sqrt_alpha * (1.0 - s_last), chain);
+    at_w.big_d = EpsilonDefect(k, at_w.j);
+  }
   for (std::size_t i = n; i-- > first_tip_side;) {
     if (i + 1 < n) at_w = advance(at_w, sqrt_alpha * (1.0 - s_of(i)));
     store(i,
           FromJacobi(solution, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
   }
-  // As in ElasticaCentreline: positions from the root sample.
-  const FromRoot from_root(solution, load, xz_out[0].x(), xz_out[0].y());
+  // As in ElasticaCentreline: positions from the root, the first sample's figures when it is
+  // the root.
+  const FromTip root = s_first == 0.0 ? FromTip{xz_out[0].x(), xz_out[0].y()}
+                                      : ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
+  const FromRoot from_root(solution, load, root.along, root.across);
   const double sin_tip = std::sin(tip.tip_angle_rad), cos_tip = std::cos(tip.tip_angle_rad);
   for (std::size_t j = 0; j < n; ++j) {
-    xz_out[j] = from_root.At(s_of(j), xz_out[j].x(), xz_out[j].y());
-    tangent_out[j] = j == 0 ? Eigen::Vector2d(0.0, 1.0)
-                            : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
+    const double s = s_of(j);
+    xz_out[j] = from_root.At(s, xz_out[j].x(), xz_out[j].y());
+    tangent_out[j] = s == 0.0 ? Eigen::Vector2d(0.0, 1.0)
+                              : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
   }
 }
 

@@ -319,10 +319,55 @@ TEST_CASE("Evenly spaced elastica samples agree with the centreline evaluated po
     }
   }
   std::vector<Eigen::Vector2d> one(1), two(2);
+  CHECK_THROWS_AS(tubeplan::model::ElasticaSamples(SolveElastica(1.0, 0.0), 0.5, 0.4, two, two),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(tubeplan::model::ElasticaSamples(SolveElastica(1.0, 0.0), -0.1, 0.4, two, two),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(tubeplan::model::ElasticaSamples(SolveElastica(1.0, 0.0), 0.5, 1.5, two, two),
+                  std::invalid_argument);
   CHECK_THROWS_AS(tubeplan::model::ElasticaSamples(SolveElastica(1.0, 0.0), one, one),
                   std::invalid_argument);
   CHECK_THROWS_AS(tubeplan::model::ElasticaSamples(SolveElastica(1.0, 0.0), two, one),
                   std::invalid_argument);
+}
+
+TEST_CASE("Elastica samples over a part of the length agree with the centreline point by point",
+          "[elastica]") {
+  // ElasticaSamples over [s_first, s_last]: the walk starts afresh past the root and short of
+  // the tip (a chain segment's points, Core::Centreline). Ranges on the root side of K/2 only,
+  // the tip side only, across it, a single point twice, and the whole; the same 1e-12 as the
+  // whole length's samples (the walk is no longer, so it loses no more).
+  const double alphas[] = {1e-6, 2e-3, 2.0, 13.8, 260.0, 1e3, 1e4};
+  const double psis[] = {-1.3, 0.0, 0.6, kPi / 2.0 - 1e-6};
+  const std::array<std::array<double, 2>, 6> ranges{
+      {{0.0, 0.2}, {0.05, 0.35}, {0.3, 0.95}, {0.7, 1.0}, {0.4, 0.4}, {0.0, 1.0}}};
+  for (const int n : {2, 5, 21}) {
+    for (const double alpha : alphas) {
+      for (const double psi : psis) {
+        const ElasticaSolution solution = SolveElastica(alpha, psi);
+        for (const auto& [s_first, s_last] : ranges) {
+          INFO("n = " << n << ", alpha = " << alpha << ", psi = " << psi << ", [" << s_first << ", "
+                      << s_last << "]");
+          std::vector<double> s(static_cast<std::size_t>(n));
+          for (int j = 0; j < n; ++j)
+            s[std::size_t(j)] =
+                j == n - 1 ? s_last : s_first + (s_last - s_first) * (double(j) / (n - 1));
+          std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
+          std::vector<double> theta(s.size());
+          ElasticaCentreline(solution, s, xz, theta);
+          tubeplan::model::ElasticaSamples(solution, s_first, s_last, samples, tangents);
+          double position_error = 0.0, tangent_error = 0.0;
+          for (std::size_t j = 0; j < s.size(); ++j) {
+            position_error = std::max(position_error, (samples[j] - xz[j]).norm());
+            const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
+            tangent_error = std::max(tangent_error, (tangents[j] - expected).norm());
+          }
+          CHECK(position_error <= 1e-12);
+          CHECK(tangent_error <= 1e-12);
+        }
+      }
+    }
+  }
 }
 
 TEST_CASE("An elastica solved from a nearby solution is the one solved from scratch",

@@ -68,5 +68,11 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
 /// or n < 2. No heap allocation.
 void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d> xz_out,
                      std::span<Eigen::Vector2d> tangent_out);
+/// The same over [s_first, s_last] (0 <= s_first <= s_last <= 1): s_j = s_first + (s_last -
+/// s_first) j / (n - 1), the last exactly s_last (a shape's points on one segment of a chain).
+/// The walk starts afresh at a first sample past the root and a last short of the tip. Throws
+/// std::invalid_argument for a range out of [0, 1] or out of order, as for the sizes.
+void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_last,
+                     std::span<Eigen::Vector2d> xz_out, std::span<Eigen::Vector2d> tangent_out);
 
 }  // namespace tubeplan::model
