@@ -494,6 +494,7 @@ struct PcFound {
   states::TubeElement tube = states::TubeElement::kSide;
   int part_element = -1;
   int deepest = -1, first = -1, last = -1;  // raw contacts: smallest d, smallest s, largest s
+  double deepest_m = 0.0;                   // the deepest's distance (read for every contact)
 };
 
 }  // namespace
@@ -626,10 +627,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const auto joins_nothing = [](const RawContact& r) {
     return IsFaceMask(r.face_mask) && r.tube != states::TubeElement::kEndRim;
   };
+  // Query gives each part's contacts in one run (its parts are distinct, each queried once), so
+  // a contact's partners are in its run: the scan covers that run, not every contact (the tube
+  // lying in the groove: a hundred contacts over three parts, and edges among them).
+  int run_begin = 0, run_end = 0;
   for (int i = 0; i < raw_count; ++i) {
     RawContact& a = m.raw[std::size_t(i)];
+    if (i == run_end) {
+      run_begin = i;
+      while (run_end < raw_count && m.raw[std::size_t(run_end)].part == a.part) ++run_end;
+    }
     if (joins_nothing(a)) continue;
-    for (int j = 0; j < raw_count; ++j) {
+    for (int j = run_begin; j < run_end; ++j) {
       const RawContact& b = m.raw[std::size_t(j)];
       if (i == j || a.part != b.part) continue;
       const bool part_bounds = (a.face_mask & b.face_mask) == b.face_mask;
@@ -639,12 +648,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         a.part_element = b.part_element;
         a.tube = b.tube;
         if (joins_nothing(a)) break;
-        j = -1;  // its new element may itself be bounded by another's: look again
+        j = run_begin - 1;  // its new element may itself be bounded by another's: look again
       }
     }
   }
   std::array<PcFound, kMaxContacts> found{};
-  std::array<int, kMaxRawContacts> pc_of{};  // each raw contact's PC, -1 past kMaxContacts
+  // Each raw contact's PC, -1 past kMaxContacts: written for each before it is read (not
+  // cleared: 4 kB a tick).
+  std::array<int, kMaxRawContacts> pc_of;
   int found_count = 0;
   bool truncated = false;
   for (int i = 0; i < raw_count; ++i) {
@@ -668,11 +679,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         pc_of[std::size_t(i)] = -1;
         continue;
       }
-      found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i};
+      found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i, r.distance_m};
       continue;
     }
     PcFound& pc = found[std::size_t(k)];
-    if (r.distance_m < m.raw[std::size_t(pc.deepest)].distance_m) pc.deepest = i;
+    if (r.distance_m < pc.deepest_m) {
+      pc.deepest = i;
+      pc.deepest_m = r.distance_m;
+    }
   }
   // The region a PC spans: its pieces within the static band 2 epsilon, or within epsilon of
   // its deepest when that is itself only in the speculative sweep (at speed). The whole band
