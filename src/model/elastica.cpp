@@ -904,13 +904,21 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
   }
   // One step forward from `at`, or afresh at `argument` (<= K/2) when the walk since the last
   // fresh evaluation has reached the anchor spacing (always, for steps longer than it).
+  // Also afresh after kAnchorSteps steps: the step's own functions carry a relative error (~5e-14
+  // in cn and dn near k = 1) that each step adds again, and a short range of many points (a
+  // segment's mesh) walks hundreds of steps within one anchor spacing (2.6e-12 of the tangent
+  // at 64 steps, found in review). 16 steps: a walk over the whole length (n = 17 samples, the
+  // tick's) never reaches it, so the tick keeps its bits.
+  constexpr int kAnchorSteps = 16;
   double walked = 0.0;
+  int steps = 0;
   const auto advance = [&](const Stepped& at, double argument) {
     Stepped next = AddArgument(k_sq, at, step);
     walked += delta;
-    if (walked >= kJacobiAnchor) {
+    if (walked >= kJacobiAnchor || ++steps > kAnchorSteps) {
       next.j = JacobiFunctions(argument, chain);
       walked = 0.0;
+      steps = 0;
     }
     return next;
   };
@@ -928,6 +936,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     }
   }
   walked = 0.0;
+  steps = 0;
   Stepped at_w;  // w = 0 at the tip: sn 0, cn 1, dn 1, D 0
   if (s_last < 1.0 && first_tip_side < n) {
     // The last sample short of the tip, on the tip side (w <= K/2): evaluated afresh.
@@ -941,8 +950,21 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
   }
   // As in ElasticaCentreline: positions from the root, the first sample's figures when it is
   // the root.
-  const FromTip root = s_first == 0.0 ? FromTip{xz_out[0].x(), xz_out[0].y()}
-                                      : ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
+  // A root past the first sample is made as the walk would make it: on the root side of K/2 by
+  // reflection with the same D(K), whose rounding then cancels between the root and the samples
+  // there (ShapeFromTip's direct R_D left it in: 1.1e-12 of l at alpha = 0.002, found in review).
+  FromTip root;
+  if (s_first == 0.0) {
+    root = FromTip{xz_out[0].x(), xz_out[0].y()};
+  } else if (sqrt_alpha > tau0) {
+    Stepped at_root;
+    at_root.j = JacobiFunctions(tau0, chain);
+    at_root.big_d = EpsilonDefect(k, at_root.j);
+    const Reflected r = Reflect(k, kc, at_root.j, at_root.big_d, d_complete);
+    root = FromJacobi(solution, sqrt_alpha, 0.0, r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d);
+  } else {
+    root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
+  }
   const FromRoot from_root(solution, load, root.along, root.across);
   const double sin_tip = std::sin(tip.tip_angle_rad), cos_tip = std::cos(tip.tip_angle_rad);
   for (std::size_t j = 0; j < n; ++j) {

@@ -368,6 +368,36 @@ TEST_CASE("Elastica samples over a part of the length agree with the centreline 
       }
     }
   }
+  // Short ranges of many points, found in review: one anchor spacing holding hundreds of steps
+  // (alpha = 5000 near k = 1: the tangent drifted 2.6e-12 in 64 steps, 4.1e-11 in 1000), and a
+  // root made apart from the walk's D(K) (alpha = 0.002: 1.1e-12 of l).
+  struct Short {
+    double alpha, psi, s_first, s_last;
+  };
+  for (const Short& c :
+       {Short{5000.0, -1.3, 0.0197, 0.0211}, Short{0.002, kPi / 2.0 - 1e-6, 0.124, 0.169},
+        Short{0.3, kPi / 2.0 - 1e-6, 0.124, 0.169}}) {
+    for (const int n : {64, 300, 1000}) {
+      INFO("n = " << n << ", alpha = " << c.alpha << ", [" << c.s_first << ", " << c.s_last << "]");
+      const ElasticaSolution solution = SolveElastica(c.alpha, c.psi);
+      std::vector<double> s(static_cast<std::size_t>(n));
+      for (int j = 0; j < n; ++j)
+        s[std::size_t(j)] =
+            j == n - 1 ? c.s_last : c.s_first + (c.s_last - c.s_first) * (double(j) / (n - 1));
+      std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
+      std::vector<double> theta(s.size());
+      ElasticaCentreline(solution, s, xz, theta);
+      tubeplan::model::ElasticaSamples(solution, c.s_first, c.s_last, samples, tangents);
+      double position_error = 0.0, tangent_error = 0.0;
+      for (std::size_t j = 0; j < s.size(); ++j) {
+        position_error = std::max(position_error, (samples[j] - xz[j]).norm());
+        const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
+        tangent_error = std::max(tangent_error, (tangents[j] - expected).norm());
+      }
+      CHECK(position_error <= 1e-12);
+      CHECK(tangent_error <= 1e-12);
+    }
+  }
 }
 
 TEST_CASE("An elastica solved from a nearby solution is the one solved from scratch",
