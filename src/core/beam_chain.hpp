@@ -159,7 +159,7 @@ class BeamChain {
   /// to 1e-12 of l (tests/core/beam_chain_test.cpp): a segment's points are walked by
   /// model::ElasticaSamples over their range (the Jacobi functions carried from point to point
   /// by their addition theorems), about a third of ElasticaPoint's cost a point (21 points:
-  /// 7.6 k instructions against 21.8 k; Core::Centreline, the shape a consumer asks for).
+  /// 8.0 k instructions against 21.8 k; Core::Centreline, the shape a consumer asks for).
   void ElasticaEvenPoints(const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count,
                           std::span<Eigen::Vector3d> out) const;
   /// The centreline of a solved chain at s = k l / (nodes.size() - 1), frame H: exact at
