@@ -143,6 +143,33 @@ bool AllFinite(const ElasticaSolution& solution) {
          std::isfinite(solution.modulus_kc) && std::isfinite(solution.u0);
 }
 
+// The largest position and tangent differences between ElasticaSamples over [s_first, s_last]
+// at n points and ElasticaCentreline at the same arc positions (over [0, 1] through the
+// whole-length overload).
+struct SampleErrors {
+  double position = 0.0, tangent = 0.0;
+};
+SampleErrors SamplesAgainstCentreline(const ElasticaSolution& solution, double s_first,
+                                      double s_last, int n) {
+  std::vector<double> s(static_cast<std::size_t>(n));
+  for (int j = 0; j < n; ++j)
+    s[std::size_t(j)] = j == n - 1 ? s_last : s_first + (s_last - s_first) * (double(j) / (n - 1));
+  std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
+  std::vector<double> theta(s.size());
+  ElasticaCentreline(solution, s, xz, theta);
+  if (s_first == 0.0 && s_last == 1.0)
+    tubeplan::model::ElasticaSamples(solution, samples, tangents);
+  else
+    tubeplan::model::ElasticaSamples(solution, s_first, s_last, samples, tangents);
+  SampleErrors e;
+  for (std::size_t j = 0; j < s.size(); ++j) {
+    e.position = std::max(e.position, (samples[j] - xz[j]).norm());
+    const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
+    e.tangent = std::max(e.tangent, (tangents[j] - expected).norm());
+  }
+  return e;
+}
+
 }  // namespace
 
 TEST_CASE("Elastica matches Mattiasson's table for a lateral tip load", "[elastica]") {
@@ -300,21 +327,9 @@ TEST_CASE("Evenly spaced elastica samples agree with the centreline evaluated po
     for (const double alpha : alphas) {
       for (const double psi : psis) {
         INFO("n = " << n << ", alpha = " << alpha << ", psi = " << psi);
-        const ElasticaSolution solution = SolveElastica(alpha, psi);
-        std::vector<double> s(static_cast<std::size_t>(n));
-        for (int j = 0; j < n; ++j) s[std::size_t(j)] = double(j) / (n - 1);
-        std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
-        std::vector<double> theta(s.size());
-        ElasticaCentreline(solution, s, xz, theta);
-        tubeplan::model::ElasticaSamples(solution, samples, tangents);
-        double position_error = 0.0, tangent_error = 0.0;
-        for (std::size_t j = 0; j < s.size(); ++j) {
-          position_error = std::max(position_error, (samples[j] - xz[j]).norm());
-          const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
-          tangent_error = std::max(tangent_error, (tangents[j] - expected).norm());
-        }
-        CHECK(position_error <= 1e-12);
-        CHECK(tangent_error <= 1e-12);
+        const SampleErrors e = SamplesAgainstCentreline(SolveElastica(alpha, psi), 0.0, 1.0, n);
+        CHECK(e.position <= 1e-12);
+        CHECK(e.tangent <= 1e-12);
       }
     }
   }
@@ -348,22 +363,9 @@ TEST_CASE("Elastica samples over a part of the length agree with the centreline 
         for (const auto& [s_first, s_last] : ranges) {
           INFO("n = " << n << ", alpha = " << alpha << ", psi = " << psi << ", [" << s_first << ", "
                       << s_last << "]");
-          std::vector<double> s(static_cast<std::size_t>(n));
-          for (int j = 0; j < n; ++j)
-            s[std::size_t(j)] =
-                j == n - 1 ? s_last : s_first + (s_last - s_first) * (double(j) / (n - 1));
-          std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
-          std::vector<double> theta(s.size());
-          ElasticaCentreline(solution, s, xz, theta);
-          tubeplan::model::ElasticaSamples(solution, s_first, s_last, samples, tangents);
-          double position_error = 0.0, tangent_error = 0.0;
-          for (std::size_t j = 0; j < s.size(); ++j) {
-            position_error = std::max(position_error, (samples[j] - xz[j]).norm());
-            const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
-            tangent_error = std::max(tangent_error, (tangents[j] - expected).norm());
-          }
-          CHECK(position_error <= 1e-12);
-          CHECK(tangent_error <= 1e-12);
+          const SampleErrors e = SamplesAgainstCentreline(solution, s_first, s_last, n);
+          CHECK(e.position <= 1e-12);
+          CHECK(e.tangent <= 1e-12);
         }
       }
     }
@@ -379,23 +381,10 @@ TEST_CASE("Elastica samples over a part of the length agree with the centreline 
         Short{0.3, kPi / 2.0 - 1e-6, 0.124, 0.169}}) {
     for (const int n : {64, 300, 1000}) {
       INFO("n = " << n << ", alpha = " << c.alpha << ", [" << c.s_first << ", " << c.s_last << "]");
-      const ElasticaSolution solution = SolveElastica(c.alpha, c.psi);
-      std::vector<double> s(static_cast<std::size_t>(n));
-      for (int j = 0; j < n; ++j)
-        s[std::size_t(j)] =
-            j == n - 1 ? c.s_last : c.s_first + (c.s_last - c.s_first) * (double(j) / (n - 1));
-      std::vector<Eigen::Vector2d> xz(s.size()), samples(s.size()), tangents(s.size());
-      std::vector<double> theta(s.size());
-      ElasticaCentreline(solution, s, xz, theta);
-      tubeplan::model::ElasticaSamples(solution, c.s_first, c.s_last, samples, tangents);
-      double position_error = 0.0, tangent_error = 0.0;
-      for (std::size_t j = 0; j < s.size(); ++j) {
-        position_error = std::max(position_error, (samples[j] - xz[j]).norm());
-        const Eigen::Vector2d expected(std::sin(theta[j]), std::cos(theta[j]));
-        tangent_error = std::max(tangent_error, (tangents[j] - expected).norm());
-      }
-      CHECK(position_error <= 1e-12);
-      CHECK(tangent_error <= 1e-12);
+      const SampleErrors e =
+          SamplesAgainstCentreline(SolveElastica(c.alpha, c.psi), c.s_first, c.s_last, n);
+      CHECK(e.position <= 1e-12);
+      CHECK(e.tangent <= 1e-12);
     }
   }
 }
