@@ -154,8 +154,9 @@ namespace {
 [[gnu::always_inline]] inline bool OneFaceDistanceSquared(const Eigen::Vector3d& a,
                                                           const Eigen::Vector3d& b,
                                                           const Eigen::Vector3d& half,
-                                                          double& f_min, double& t_min) {
-  int outside = -1;
+                                                          double& f_min, double& t_min,
+                                                          int& outside) {
+  outside = -1;
   bool one_face = true;
   for (int k = 0; k < 3 && one_face; ++k) {
     const bool a_out = std::abs(a[k]) > half[k], b_out = std::abs(b[k]) > half[k];
@@ -224,7 +225,8 @@ double SegmentBoxDistanceSquaredAnyFace(const Eigen::Vector3d& a, const Eigen::V
 double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                  const Eigen::Vector3d& half, double& t_min) {
   double f = 0.0;
-  if (OneFaceDistanceSquared(a, b, half, f, t_min)) return f;
+  int outside = -1;
+  if (OneFaceDistanceSquared(a, b, half, f, t_min, outside)) return f;
   return SegmentBoxDistanceSquaredAnyFace(a, b, half, t_min);
 }
 
@@ -298,7 +300,8 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
     Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P, Eigen::Vector3d& c_P,
     double& axis_m) const {
   double t = 0.0, axis_sq = 0.0;
-  if (!OneFaceDistanceSquared(a_P, b_P, part.half_m, axis_sq, t))
+  int outside = -1;
+  if (!OneFaceDistanceSquared(a_P, b_P, part.half_m, axis_sq, t, outside))
     axis_sq = SegmentBoxDistanceSquaredAnyFace(a_P, b_P, part.half_m, t);
   axis_m = std::sqrt(axis_sq);
   c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
@@ -801,7 +804,118 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       to_part_frame();
     else
       to_part_frame(std::size_t(k_begin));
+    // A capsule apart from the part within the band: what forms the PCs now, the points only if
+    // it becomes a load (Complete; made here, they were a third of the query's instructions for
+    // a tube lying in the groove, a hundred contacts of which six become loads).
+    const auto emit_deferred = [&](int k, double d, std::uint8_t face_mask)
+        __attribute__((always_inline)) {
+      RawContact& c = out[std::size_t(count++)];
+      c.tube = states::TubeElement::kSide;
+      c.part = part.index;
+      c.distance_m = d;
+      c.overlap = false;
+      c.pressure_centre = false;
+      c.face_mask = face_mask;
+      c.part_element = element_of_[part.index][face_mask];
+      c.over_face = IsFaceMask(face_mask);
+      c.line = false;
+      c.piece = k;
+      c.part_slot = static_cast<int>(part_i);
+      c.deferred = true;
+#ifndef NDEBUG
+      // Unmade until Complete: NaN in the debug (sanitizer) build, where a read before it
+      // reaches the core's checks of its outputs instead of last tick's values.
+      constexpr double kUnmade = std::numeric_limits<double>::quiet_NaN();
+      c.normal_W.setConstant(kUnmade);
+      c.q_W_m.setConstant(kUnmade);
+      c.p_W_m.setConstant(kUnmade);
+      c.s_m = kUnmade;
+#endif
+    };
+    // A run of kGroup capsules of an aligned part whose box lies beyond one face and within the
+    // other two slabs: each node of it does (the box is its nodes' box, bit for bit, above), so
+    // each capsule of it is the case OneFaceDistanceSquared settles (a tube lying on a part: a
+    // hundred pieces a tick). Their face's axis, or -1. The nodes are finite (the core commits
+    // only a finite shape); a NaN could drop out of the box.
+    // The run's face mask too (else 0), when its nodes lie clear of the face's edges by more than
+    // the rounding of the nearest point a + t (b - a) (t = 0 or 1, each coordinate within
+    // 2 DBL_EPSILON max(|a|, |b|) of a node's; 8 taken): FaceMask of any such point then has
+    // only the face's own bits, which it has for the point beyond the face at the run's lower
+    // corner.
+    int face_axis = -1;
+    std::uint8_t group_mask = 0;
     for (int k = k_begin; k < pieces; ++k) {
+      if (part.aligned && k < capsules && (k == k_begin || k % kGroup == 0)) {
+        if (!groups_made) make_groups();
+        const Eigen::Vector3d lo_g = group_lo_W_[std::size_t(k / kGroup)] + part.p_PW;
+        const Eigen::Vector3d hi_g = group_hi_W_[std::size_t(k / kGroup)] + part.p_PW;
+        int beyond = 0;
+        for (int j = 0; j < 3; ++j) {
+          if (lo_g[j] > part.half_m[j] || hi_g[j] < part.minus_half_m[j]) {
+            face_axis = j;
+            ++beyond;
+          } else if (hi_g[j] > part.half_m[j] || lo_g[j] < part.minus_half_m[j]) {
+            beyond = 2;  // astride a face's plane
+          }
+        }
+        if (beyond != 1) face_axis = -1;
+        group_mask = 0;
+        if (face_axis >= 0) {
+          bool clear = true;
+          for (int j = 0; j < 3; ++j) {
+            const double margin_m =
+                8.0 * std::numeric_limits<double>::epsilon() * std::max(-lo_g[j], hi_g[j]);
+            clear = clear && (j == face_axis ? (lo_g[j] - margin_m > part.half_m[j] ||
+                                                hi_g[j] + margin_m < part.minus_half_m[j])
+                                             : (lo_g[j] - margin_m > part.edge_below_m[j] &&
+                                                hi_g[j] + margin_m < part.edge_above_m[j]));
+          }
+          if (clear) {
+            Eigen::Vector3d corner_P = lo_g.cwiseMax(part.minus_half_m).cwiseMin(part.half_m);
+            group_mask = FaceMask(part, corner_P);
+          }
+        }
+      }
+      if (face_axis >= 0 && k < pieces - 2) {
+        // Such a capsule: the steps below for it, the same operations on the same values,
+        // without their general cases (they were a third of the query's instructions). Only its
+        // axis across the face can fail the broad phase (within the other two slabs, an end's
+        // grown extent reaches the part), and the distance is the nearer end's excess over the
+        // face, as in OneFaceDistanceSquared. A pair whose distance the steps below would not
+        // sign goes through them; nothing here has changed state by then.
+        const Eigen::Vector3d& a_P = nodes_P_[std::size_t(k)];
+        const Eigen::Vector3d& b_P = nodes_P_[std::size_t(k) + 1];
+        const int o = face_axis;
+        if (a_P[o] > 0.0 ? std::min(a_P[o], b_P[o]) - grow > part.half_m[o]
+                         : std::max(a_P[o], b_P[o]) + grow < part.minus_half_m[o])
+          continue;  // PassesBroadPhase's answer
+        const double excess_a = std::abs(a_P[o]) - part.half_m[o];
+        const double excess_b = std::abs(b_P[o]) - part.half_m[o];
+        const double t = excess_b < excess_a ? 1.0 : 0.0;
+        const double e = std::min(excess_a, excess_b);
+        const double axis_m = std::sqrt(e * e);
+        const double d = axis_m - radius_m_;
+        if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
+          if (count == static_cast<int>(out.size())) return count;
+          KeptDistance& kept_k = kept[k];
+          const Eigen::Vector3d& a_W = nodes_W[std::size_t(k)];
+          const Eigen::Vector3d& b_W = nodes_W[std::size_t(k) + 1];
+          if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
+            ++coherent_skips_;
+            continue;
+          }
+          ++narrow_calls_;
+          Keep(kept_k, a_W, b_W, d);
+          if (d >= band_m) continue;
+          if (group_mask != 0) {
+            emit_deferred(k, d, group_mask);
+          } else {
+            const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);
+            emit_deferred(k, d, FaceMask(part, c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m)));
+          }
+          continue;
+        }
+      }
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
       const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];
@@ -849,32 +963,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         if (separated) Keep(kept_k, a_W, b_W, d);
         if (separated && d >= band_m) continue;
         if (separated && !signed_depth && k != pieces - 2) {
-          // Apart, within the band: what forms the PCs now, the points only if it becomes a
-          // load (Complete; made here, they were a third of the query's instructions for a tube
-          // lying in the groove, a hundred contacts of which six become loads). Not the last
-          // capsule, whose point is needed below to tell its cap inside the end cylinder.
-          RawContact& c = out[std::size_t(count++)];
-          c.tube = states::TubeElement::kSide;
-          c.part = part.index;
-          c.distance_m = d;
-          c.overlap = false;
-          c.pressure_centre = false;
-          c.face_mask = FaceMask(part, q_P);
-          c.part_element = element_of_[part.index][c.face_mask];
-          c.over_face = IsFaceMask(c.face_mask);
-          c.line = false;
-          c.piece = k;
-          c.part_slot = static_cast<int>(part_i);
-          c.deferred = true;
-#ifndef NDEBUG
-          // Unmade until Complete: NaN in the debug (sanitizer) build, where a read before it
-          // reaches the core's checks of its outputs instead of last tick's values.
-          constexpr double kUnmade = std::numeric_limits<double>::quiet_NaN();
-          c.normal_W.setConstant(kUnmade);
-          c.q_W_m.setConstant(kUnmade);
-          c.p_W_m.setConstant(kUnmade);
-          c.s_m = kUnmade;
-#endif
+          // Apart, within the band: deferred. Not the last capsule, whose point is needed below
+          // to tell its cap inside the end cylinder.
+          emit_deferred(k, d, FaceMask(part, q_P));
           continue;
         }
         // The normal from the box to the axis, read only with a signed depth (a pair apart
