@@ -905,3 +905,101 @@ TEST_CASE("The last capsule's cap inside the end cylinder is no contact", "[core
   }
   CHECK(end_face == 1);
 }
+
+// The world directions of a face mask's faces, summed (at most one face an axis here: the sum
+// names the set). FaceMask's bits: +x 2, -x 3, +y 4, -y 5, +z 0, -z 1.
+Eigen::Vector3d MaskNormals_W(std::uint8_t mask, const Eigen::Matrix3d& R_WP) {
+  constexpr std::array<int, 3> kPositive = {2, 4, 0}, kNegative = {3, 5, 1};
+  Eigen::Vector3d sum_W = Eigen::Vector3d::Zero();
+  for (int a = 0; a < 3; ++a) {
+    if (mask & (1u << kPositive[std::size_t(a)])) sum_W += R_WP.col(a);
+    if (mask & (1u << kNegative[std::size_t(a)])) sum_W -= R_WP.col(a);
+  }
+  return sum_W;
+}
+
+TEST_CASE("A run of capsules beyond one face of an aligned part: the same contacts as a turned one",
+          "[core][collision]") {
+  // Query settles a run of capsules beyond one face of a part aligned with the world by a path of
+  // its own (and its face mask once, when the run is clear of the face's edges). The same floor
+  // turned a quarter about z, its x and y sizes swapped, is the same box, but not aligned: each
+  // of its capsules takes the general steps. The rotation's entries are 0 and +-1, so the part
+  // frame's coordinates are the aligned ones permuted, exactly, and every contact must match bit
+  // for bit: its piece, distance, points, normal and arc position (after Complete), and its faces'
+  // directions. Tubes of the groove scene lying over the floor at random: along either axis or
+  // askew, bent, tilted, across its edges and corners, from dipping into it to beyond the band.
+  scene::Scene s = GrooveScene();
+  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
+  s.parts.clear();
+  scene::BoxPart aligned;
+  aligned.name = "aligned";
+  aligned.size_m = Eigen::Vector3d(0.12, 0.2, 0.02);
+  aligned.X_WP.translation() = Eigen::Vector3d(0.013, 0.07, -0.01);  // top at z = 0
+  scene::BoxPart turned = aligned;
+  turned.name = "turned";
+  turned.size_m = Eigen::Vector3d(0.2, 0.12, 0.02);
+  turned.X_WP.linear() << 0.0, -1.0, 0.0,  //
+      1.0, 0.0, 0.0,                       //
+      0.0, 0.0, 1.0;
+  s.parts = {aligned, turned};
+  const int capsules = 48;
+  const core::Collision on_aligned(s, std::vector<std::uint32_t>{0}, capsules, MaskElements(2));
+  const core::Collision on_turned(s, std::vector<std::uint32_t>{1}, capsules, MaskElements(2));
+  std::mt19937 rng(20261129);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int deferred = 0, compared = 0;
+  // FaceMask's edges lie 1 % of epsilon inside the faces' borders: the askew tubes of the last
+  // kind run along y within a few of that of the floor's x borders, so that its edges' bits
+  // change within a run of capsules.
+  const double edge_m = 0.01 * eps, x_border = aligned.X_WP.translation().x() + 0.06;
+  for (int trial = 0; trial < 600; ++trial) {
+    // Along x, along y or askew; from the floor's middle or from beyond its edges.
+    const int kind = trial < 400 ? trial % 3 : 3;
+    const double side = trial % 2 == 0 ? 1.0 : -1.0;  // which x border, for the last kind
+    double yaw = kind == 0 ? 0.0 : kind == 1 ? 0.5 * std::numbers::pi : 2.0 * unit(rng);
+    if (kind == 3) yaw = 0.5 * std::numbers::pi + side * (unit(rng) - 0.5) * 12.0 * edge_m / l;
+    const double tilt = (unit(rng) - 0.5) * 4.0 * eps / l, bend = (unit(rng) - 0.5) * 1e-3;
+    Eigen::Vector3d start(-0.08 + 0.2 * unit(rng), -0.06 + 0.2 * unit(rng),
+                          r1 - 0.3e-3 + 3.0 * eps * unit(rng));
+    if (kind == 3)
+      start.x() = aligned.X_WP.translation().x() +
+                  side * (x_border - aligned.X_WP.translation().x() - 4.0 * edge_m * unit(rng));
+    Eigen::Vector3d u(std::cos(yaw) * std::cos(tilt), std::sin(yaw) * std::cos(tilt),
+                      std::sin(tilt));
+    std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+    nodes_W[0] = start;
+    const Eigen::AngleAxisd turn(kind == 3 ? 0.0 : bend,
+                                 Eigen::Vector3d::UnitZ().cross(u).normalized());
+    for (int k = 1; k <= capsules; ++k) {
+      nodes_W[std::size_t(k)] = nodes_W[std::size_t(k) - 1] + (l / capsules) * u;
+      u = turn * u;
+    }
+    std::array<core::RawContact, core::kMaxRawContacts> out_a{}, out_t{};
+    const int count_a = on_aligned.Query(nodes_W, u, 2.0 * eps, out_a);
+    const int count_t = on_turned.Query(nodes_W, u, 2.0 * eps, out_t);
+    INFO("trial " << trial);
+    REQUIRE(count_a == count_t);
+    for (int i = 0; i < count_a; ++i) deferred += out_a[std::size_t(i)].deferred ? 1 : 0;
+    Complete(on_aligned, s, capsules, out_a, count_a, nodes_W, false);
+    Complete(on_turned, s, capsules, out_t, count_t, nodes_W, false);
+    for (int i = 0; i < count_a; ++i) {
+      const core::RawContact& a = out_a[std::size_t(i)];
+      const core::RawContact& t = out_t[std::size_t(i)];
+      INFO("contact " << i << " piece " << a.piece << " d " << a.distance_m);
+      CHECK(a.piece == t.piece);
+      CHECK(a.tube == t.tube);
+      CHECK(SameBits(a.distance_m, t.distance_m));
+      CHECK(SameBits(a.s_m, t.s_m));
+      CHECK(SameBits(a.p_W_m, t.p_W_m));
+      CHECK(SameBits(a.q_W_m, t.q_W_m));
+      CHECK(SameBits(a.normal_W, t.normal_W));
+      CHECK(a.over_face == t.over_face);
+      CHECK(MaskNormals_W(a.face_mask, aligned.X_WP.linear()) ==
+            MaskNormals_W(t.face_mask, turned.X_WP.linear()));
+      ++compared;
+    }
+  }
+  // Most contacts are of capsules apart from the floor within the band: the runs' own path.
+  CHECK(deferred > compared / 2);
+  CHECK(compared > 4000);
+}
