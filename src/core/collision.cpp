@@ -842,10 +842,16 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     // 2 DBL_EPSILON max(|a|, |b|) of a node's; 8 taken): FaceMask of any such point then has
     // only the face's own bits, which it has for the point beyond the face at the run's lower
     // corner.
-    int face_axis = -1;
+    // The run's capsules before the last (whose cap the steps below look at) all pass the broad
+    // phase when the run's box does on the face's axis (each capsule's coordinates lie within
+    // the run's, and rounding is monotonic): `all_pass`. Pieces before `fast_end` take that path;
+    // the next run starts at `next_run`.
+    int face_axis = -1, fast_end = -1, next_run = part.aligned ? k_begin : pieces;
+    bool all_pass = false;
     std::uint8_t group_mask = 0;
     for (int k = k_begin; k < pieces; ++k) {
-      if (part.aligned && k < capsules && (k == k_begin || k % kGroup == 0)) {
+      if (k == next_run && k < capsules) {
+        next_run = (k / kGroup + 1) * kGroup;
         if (!groups_made) make_groups();
         const Eigen::Vector3d lo_g = group_lo_W_[std::size_t(k / kGroup)] + part.p_PW;
         const Eigen::Vector3d hi_g = group_hi_W_[std::size_t(k / kGroup)] + part.p_PW;
@@ -860,7 +866,11 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         }
         if (beyond != 1) face_axis = -1;
         group_mask = 0;
+        fast_end = face_axis >= 0 ? std::min(next_run, pieces - 2) : -1;
         if (face_axis >= 0) {
+          const int o = face_axis;
+          all_pass = lo_g[o] > 0.0 ? !(hi_g[o] - grow > part.half_m[o])
+                                   : !(lo_g[o] + grow < part.minus_half_m[o]);
           bool clear = true;
           for (int j = 0; j < 3; ++j) {
             const double margin_m =
@@ -876,7 +886,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           }
         }
       }
-      if (face_axis >= 0 && k < pieces - 2) {
+      if (k < fast_end) {
         // Such a capsule: the steps below for it, the same operations on the same values,
         // without their general cases (they were a third of the query's instructions). Only its
         // axis across the face can fail the broad phase (within the other two slabs, an end's
@@ -886,8 +896,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const Eigen::Vector3d& a_P = nodes_P_[std::size_t(k)];
         const Eigen::Vector3d& b_P = nodes_P_[std::size_t(k) + 1];
         const int o = face_axis;
-        if (a_P[o] > 0.0 ? std::min(a_P[o], b_P[o]) - grow > part.half_m[o]
-                         : std::max(a_P[o], b_P[o]) + grow < part.minus_half_m[o])
+        if (!all_pass && (a_P[o] > 0.0 ? std::min(a_P[o], b_P[o]) - grow > part.half_m[o]
+                                       : std::max(a_P[o], b_P[o]) + grow < part.minus_half_m[o]))
           continue;  // PassesBroadPhase's answer
         const double excess_a = std::abs(a_P[o]) - part.half_m[o];
         const double excess_b = std::abs(b_P[o]) - part.half_m[o];
