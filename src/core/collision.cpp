@@ -187,7 +187,12 @@ double SegmentBoxDistanceSquaredAnyFace(const Eigen::Vector3d& a, const Eigen::V
   for (int k = 0; k < 3; ++k) {
     if (d[k] == 0.0) continue;
     for (const double side : {-1.0, 1.0}) {
-      const double t = (side * half[k] - a[k]) / d[k];
+      // Only a crossing within (0, 1) is a cut: one whose quotient is not (a sign against the
+      // step's, or a numerator beyond it, whose quotient rounds to 1 or more) is passed over
+      // before its division.
+      const double num = side * half[k] - a[k];
+      if (!((d[k] > 0.0 ? num > 0.0 : num < 0.0) && std::abs(num) <= std::abs(d[k]))) continue;
+      const double t = num / d[k];
       if (t > 0.0 && t < 1.0) cuts[std::size_t(n++)] = t;
     }
   }
