@@ -658,36 +658,52 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<int, kMaxRawContacts> pc_of;
   int found_count = 0;
   bool truncated = false;
+  // The PC of the run of contacts at hand, and its deepest so far, kept here while the run
+  // lasts and written back when it ends: read and written through `found` for every contact,
+  // they made a chain of store-to-load forwarding a contact long.
+  int run_k = -1, run_deepest = -1;  // run_k is pc_of[i - 1]
+  double run_deepest_m = 0.0;
+  const auto end_run = [&] {
+    if (run_k < 0) return;
+    found[std::size_t(run_k)].deepest = run_deepest;
+    found[std::size_t(run_k)].deepest_m = run_deepest_m;
+  };
   for (int i = 0; i < raw_count; ++i) {
     const RawContact& r = m.raw[std::size_t(i)];
-    int k = 0;
     // Query gives a part's pieces in a run, so most raw contacts have the elements of the one
     // before: its PC is theirs (a PC's elements are no other's, so the search finds that one).
-    const RawContact* const before = i > 0 ? &m.raw[std::size_t(i) - 1] : nullptr;
-    if (before != nullptr && pc_of[std::size_t(i) - 1] >= 0 && before->tube == r.tube &&
-        before->part_element == r.part_element) {
-      k = pc_of[std::size_t(i) - 1];
-    } else {
-      while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
-                                  found[std::size_t(k)].part_element == r.part_element))
-        ++k;
+    if (run_k >= 0 && m.raw[std::size_t(i) - 1].tube == r.tube &&
+        m.raw[std::size_t(i) - 1].part_element == r.part_element) {
+      pc_of[std::size_t(i)] = run_k;
+      if (r.distance_m < run_deepest_m) {
+        run_deepest = i;
+        run_deepest_m = r.distance_m;
+      }
+      continue;
     }
+    end_run();
+    int k = 0;
+    while (k < found_count && !(found[std::size_t(k)].tube == r.tube &&
+                                found[std::size_t(k)].part_element == r.part_element))
+      ++k;
     pc_of[std::size_t(i)] = k;
+    run_k = k;
     if (k == found_count) {
       if (found_count == kMaxContacts) {
         truncated = true;
-        pc_of[std::size_t(i)] = -1;
+        pc_of[std::size_t(i)] = run_k = -1;
         continue;
       }
       found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i, r.distance_m};
-      continue;
     }
-    PcFound& pc = found[std::size_t(k)];
-    if (r.distance_m < pc.deepest_m) {
-      pc.deepest = i;
-      pc.deepest_m = r.distance_m;
+    run_deepest = found[std::size_t(k)].deepest;
+    run_deepest_m = found[std::size_t(k)].deepest_m;
+    if (r.distance_m < run_deepest_m) {
+      run_deepest = i;
+      run_deepest_m = r.distance_m;
     }
   }
+  end_run();
   // The region a PC spans: its pieces within the static band 2 epsilon, or within epsilon of
   // its deepest when that is itself only in the speculative sweep (at speed). The whole band
   // spanned a tube crossing an edge at 2 m/s (a band of 3.75 mm: the pieces either side, 3.2 mm
@@ -710,11 +726,17 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     pc.first = pc.last = -1;
     region_m[std::size_t(k)] = std::max(2.0 * eps, m.raw[std::size_t(pc.deepest)].distance_m + eps);
   }
+  // (Which PCs have their first: a bit each, not pc.first read back for every contact.)
+  static_assert(kMaxContacts <= 32);
+  std::uint32_t has_first = 0;
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
     if (k < 0 || m.raw[std::size_t(i)].distance_m > region_m[std::size_t(k)]) continue;
     PcFound& pc = found[std::size_t(k)];
-    if (pc.first < 0) pc.first = i;
+    if ((has_first & (1u << k)) == 0) {
+      has_first |= 1u << k;
+      pc.first = i;
+    }
     pc.last = i;
   }
   const std::span<const Eigen::Vector3d> query_nodes_W(m.nodes_W.data(), std::size_t(N) + 1);
