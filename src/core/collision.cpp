@@ -147,6 +147,16 @@ void Collision::Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen
 
 namespace {
 
+// A segment beyond one face along that face's axis only (ends a and b on the axis, the face at
+// half): the nearer end's excess over the face, and its parameter t (the first on a tie).
+[[gnu::always_inline]] inline double NearerEndExcess(double a, double b, double half,
+                                                     double& t_min) {
+  const double excess_a = std::abs(a) - half;
+  const double excess_b = std::abs(b) - half;
+  t_min = excess_b < excess_a ? 1.0 : 0.0;
+  return std::min(excess_a, excess_b);
+}
+
 // The common case of SegmentBoxDistanceSquared, inlined into the capsule's distance: both ends
 // beyond the same face and within the other two slabs (a capsule lying over a face). Then only
 // that axis is outside along the whole segment, its excess is linear in t, and the nearer end is
@@ -154,9 +164,8 @@ namespace {
 [[gnu::always_inline]] inline bool OneFaceDistanceSquared(const Eigen::Vector3d& a,
                                                           const Eigen::Vector3d& b,
                                                           const Eigen::Vector3d& half,
-                                                          double& f_min, double& t_min,
-                                                          int& outside) {
-  outside = -1;
+                                                          double& f_min, double& t_min) {
+  int outside = -1;
   bool one_face = true;
   for (int k = 0; k < 3 && one_face; ++k) {
     const bool a_out = std::abs(a[k]) > half[k], b_out = std::abs(b[k]) > half[k];
@@ -165,10 +174,7 @@ namespace {
     outside = k;
   }
   if (!one_face || outside < 0) return false;
-  const double excess_a = std::abs(a[outside]) - half[outside];
-  const double excess_b = std::abs(b[outside]) - half[outside];
-  t_min = excess_b < excess_a ? 1.0 : 0.0;
-  const double e = std::min(excess_a, excess_b);
+  const double e = NearerEndExcess(a[outside], b[outside], half[outside], t_min);
   f_min = e * e;
   return true;
 }
@@ -230,8 +236,7 @@ double SegmentBoxDistanceSquaredAnyFace(const Eigen::Vector3d& a, const Eigen::V
 double SegmentBoxDistanceSquared(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                  const Eigen::Vector3d& half, double& t_min) {
   double f = 0.0;
-  int outside = -1;
-  if (OneFaceDistanceSquared(a, b, half, f, t_min, outside)) return f;
+  if (OneFaceDistanceSquared(a, b, half, f, t_min)) return f;
   return SegmentBoxDistanceSquaredAnyFace(a, b, half, t_min);
 }
 
@@ -310,8 +315,7 @@ bool CylinderBoxPenetration(const Eigen::Vector3d& a, const Eigen::Vector3d& b, 
     Eigen::Vector3d& p_tube_P, Eigen::Vector3d& q_part_P, Eigen::Vector3d& c_P,
     double& axis_m) const {
   double t = 0.0, axis_sq = 0.0;
-  int outside = -1;
-  if (!OneFaceDistanceSquared(a_P, b_P, part.half_m, axis_sq, t, outside))
+  if (!OneFaceDistanceSquared(a_P, b_P, part.half_m, axis_sq, t))
     axis_sq = SegmentBoxDistanceSquaredAnyFace(a_P, b_P, part.half_m, t);
   axis_m = std::sqrt(axis_sq);
   c_P = a_P + t * (b_P - a_P);  // on the capsule's axis
@@ -909,10 +913,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         if (!all_pass && (a_P[o] > 0.0 ? std::min(a_P[o], b_P[o]) - grow > part.half_m[o]
                                        : std::max(a_P[o], b_P[o]) + grow < part.minus_half_m[o]))
           continue;  // PassesBroadPhase's answer
-        const double excess_a = std::abs(a_P[o]) - part.half_m[o];
-        const double excess_b = std::abs(b_P[o]) - part.half_m[o];
-        const double t = excess_b < excess_a ? 1.0 : 0.0;
-        const double e = std::min(excess_a, excess_b);
+        double t = 0.0;
+        const double e = NearerEndExcess(a_P[o], b_P[o], part.half_m[o], t);
         const double axis_m = std::sqrt(e * e);
         const double d = axis_m - radius_m_;
         if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
