@@ -211,6 +211,15 @@ scene::Scene GrooveScene() {
   return *loaded.scene;
 }
 
+// A box part of the given size centred at p_W, aligned with the world.
+scene::BoxPart Box(const char* name, const Eigen::Vector3d& size_m, const Eigen::Vector3d& p_W) {
+  scene::BoxPart box;
+  box.name = name;
+  box.size_m = size_m;
+  box.X_WP.translation() = p_W;
+  return box;
+}
+
 // Each face mask its own element: the contacts carry the mask twice.
 std::vector<std::array<int, 64>> MaskElements(std::size_t parts) {
   std::vector<std::array<int, 64>> element_of(parts);
@@ -597,12 +606,8 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
   scene::Scene s = GrooveScene();
   const double r1 = s.tube.outer_radius_m, r2 = s.tube.inner_radius_m, l = s.tube.length_m;
   const double wall_z = 0.5;
-  s.parts.clear();
-  scene::BoxPart wall;
-  wall.name = "wall";
-  wall.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
-  wall.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, wall_z + 0.01);
-  s.parts.push_back(wall);
+  s.parts = {
+      Box("wall", Eigen::Vector3d(0.4, 0.4, 0.02), Eigen::Vector3d(0.0, 0.0, wall_z + 0.01))};
   const std::vector<std::uint32_t> parts{0};
   const int capsules = 24;
   core::Collision collision(s, parts, capsules, MaskElements(1));
@@ -708,12 +713,8 @@ TEST_CASE("A part left out under a narrow dome is looked at again when the dome 
   s.tube.outer_radius_m = 1.5e-3;
   s.tube.inner_radius_m = 1.0e-3;
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
-  s.parts.clear();
-  scene::BoxPart floor;
-  floor.name = "floor";
-  floor.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
-  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, -0.01);  // top at z = 0
-  s.parts.push_back(floor);
+  // Its top at z = 0.
+  s.parts = {Box("floor", Eigen::Vector3d(0.4, 0.4, 0.02), Eigen::Vector3d(0.0, 0.0, -0.01))};
   const std::vector<std::uint32_t> parts{0};
   const int capsules = 24;
   core::Collision idle(s, parts, capsules, MaskElements(1));
@@ -767,12 +768,8 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
   // the face's edges joining it at their nearest points, as the core joins them) is not.
   scene::Scene s = GrooveScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
-  s.parts.clear();
-  scene::BoxPart floor;
-  floor.name = "floor";
-  floor.size_m = Eigen::Vector3d(0.2, 0.4, 0.02);
-  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.2, -0.01);  // top at z = 0, near edge y = 0
-  s.parts.push_back(floor);
+  // Its top at z = 0, its near edge at y = 0.
+  s.parts = {Box("floor", Eigen::Vector3d(0.2, 0.4, 0.02), Eigen::Vector3d(0.0, 0.2, -0.01))};
   const std::vector<std::uint32_t> parts{0};
   const int capsules = 24;
   const double piece_m = l / capsules;
@@ -872,12 +869,8 @@ TEST_CASE("The last capsule's cap inside the end cylinder is no contact", "[core
   // end face does). A cap that bulges outside the cylinder (a bend) is another matter, kept.
   scene::Scene s = GrooveScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
-  s.parts.clear();
-  scene::BoxPart wall;
-  wall.name = "wall";
-  wall.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
-  wall.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, l + 0.01);  // its face at z = l
-  s.parts.push_back(wall);
+  // Its face at z = l.
+  s.parts = {Box("wall", Eigen::Vector3d(0.4, 0.4, 0.02), Eigen::Vector3d(0.0, 0.0, l + 0.01))};
   const int capsules = 24;
   const std::vector<std::uint32_t> parts{0};
   const core::Collision collision(s, parts, capsules, MaskElements(1));
@@ -930,14 +923,11 @@ TEST_CASE("A run of capsules beyond one face of an aligned part: the same contac
   // askew, bent, tilted, across its edges and corners, from dipping into it to beyond the band.
   scene::Scene s = GrooveScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
-  s.parts.clear();
-  scene::BoxPart aligned;
-  aligned.name = "aligned";
-  aligned.size_m = Eigen::Vector3d(0.12, 0.2, 0.02);
-  aligned.X_WP.translation() = Eigen::Vector3d(0.013, 0.07, -0.01);  // top at z = 0
-  scene::BoxPart turned = aligned;
-  turned.name = "turned";
-  turned.size_m = Eigen::Vector3d(0.2, 0.12, 0.02);
+  // Its top at z = 0.
+  const scene::BoxPart aligned =
+      Box("aligned", Eigen::Vector3d(0.12, 0.2, 0.02), Eigen::Vector3d(0.013, 0.07, -0.01));
+  scene::BoxPart turned =
+      Box("turned", Eigen::Vector3d(0.2, 0.12, 0.02), aligned.X_WP.translation());
   turned.X_WP.linear() << 0.0, -1.0, 0.0,  //
       1.0, 0.0, 0.0,                       //
       0.0, 0.0, 1.0;
