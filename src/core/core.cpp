@@ -1389,7 +1389,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         if (!member[std::size_t(j)]) continue;
         Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
         Wij = R_WH * Wij * R_WH.transpose();
-        if (want_elastica) ld.base_W -= Wij * m.loads[std::size_t(j)].f_lin_W;
+        // (noalias: the product goes straight into the sum. Eigen otherwise assumes aliasing and
+        // makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
+        if (want_elastica) ld.base_W.noalias() -= Wij * m.loads[std::size_t(j)].f_lin_W;
       }
     }
     // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
@@ -1535,7 +1537,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           continue;
         }
         Dij = m.beam.InfluenceSlope(bi.s_m, m.beam_loads[std::size_t(j)]) * M_i;
-        ld.stick_base_W += Dij * m.loads[std::size_t(j)].f_lin_W;
+        ld.stick_base_W.noalias() += Dij * m.loads[std::size_t(j)].f_lin_W;
       }
     }
   };
