@@ -109,8 +109,12 @@ void Collision::ForgetDistances() {
   std::fill(summaries_.begin(), summaries_.end(), IdleSummary{});
 }
 
-bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& a_W,
-                               const Eigen::Vector3d& b_W, double band_m) const {
+// Inlined where Query calls it (twice a piece of a tube lying in the groove): most calls end at its
+// first test.
+[[gnu::always_inline]] inline bool Collision::KeptBeyondBand(const KeptDistance& kept,
+                                                             const Eigen::Vector3d& a_W,
+                                                             const Eigen::Vector3d& b_W,
+                                                             double band_m) const {
   // The distance from a capsule to a fixed box is 1-Lipschitz in the motion of its axis's ends:
   // if each end moved by at most delta, every axis point a + t (b - a) moved by at most
   // (1 - t) |da| + t |db| <= delta, and a point's distance to the box is 1-Lipschitz. So a pair
@@ -129,15 +133,16 @@ bool Collision::KeptBeyondBand(const KeptDistance& kept, const Eigen::Vector3d& 
                         band_m);
 }
 
-bool Collision::KeptBeyondBand(const KeptDistance& kept, double moved_a_sq, double moved_b_sq,
-                               double band_m) const {
+[[gnu::always_inline]] inline bool Collision::KeptBeyondBand(const KeptDistance& kept,
+                                                             double moved_a_sq, double moved_b_sq,
+                                                             double band_m) const {
   const double slack_m = kept.d_m - (std::max(band_m, 0.0) + kCoherenceMargin_m);
   const double slack_sq = slack_m * slack_m;
   return slack_m > 0.0 && moved_a_sq <= slack_sq && moved_b_sq <= slack_sq;
 }
 
-void Collision::Keep(KeptDistance& kept, const Eigen::Vector3d& a_W, const Eigen::Vector3d& b_W,
-                     double d_m) const {
+[[gnu::always_inline]] inline void Collision::Keep(KeptDistance& kept, const Eigen::Vector3d& a_W,
+                                                   const Eigen::Vector3d& b_W, double d_m) const {
   // Only a finite distance: one from infinite coordinates would make every later motion look
   // small against it.
   kept.d_m = std::isfinite(d_m) ? d_m : -std::numeric_limits<double>::infinity();
