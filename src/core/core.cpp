@@ -630,14 +630,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // Query gives each part's contacts in one run (its parts are distinct, each queried once), so
   // a contact's partners are in its run: the scan covers that run, not every contact (the tube
   // lying in the groove: a hundred contacts over three parts, and edges among them).
+  // The run's bounds are found only for a contact that may join (a tube lying in the groove has
+  // none): back from it to the run's first, on to its last.
   int run_begin = 0, run_end = 0;
   for (int i = 0; i < raw_count; ++i) {
     RawContact& a = m.raw[std::size_t(i)];
-    if (i == run_end) {
+    if (joins_nothing(a)) continue;
+    if (i >= run_end) {
       run_begin = i;
+      while (run_begin > 0 && m.raw[std::size_t(run_begin) - 1].part == a.part) --run_begin;
+      run_end = i + 1;
       while (run_end < raw_count && m.raw[std::size_t(run_end)].part == a.part) ++run_end;
     }
-    if (joins_nothing(a)) continue;
     for (int j = run_begin; j < run_end; ++j) {
       const RawContact& b = m.raw[std::size_t(j)];
       if (i == j || a.part != b.part) continue;
