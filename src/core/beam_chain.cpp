@@ -34,6 +34,8 @@ BeamChain::BeamChain(const scene::Scene& scene)
       // The rod's steps: l/48, no longer than the shortest capsule of the chain it draws. Its
       // error is second order in the step (tests/model/rod_test.cpp): at l/48 the tip of the
       // rubber tube at alpha = 5 is within ~0.1 % of l of the exact elastica.
+      moments_finite_(std::isfinite(2.0 * length_m_ * length_m_ / EI_) &&
+                      std::isfinite(length_m_ / EI_)),
       rod_(EI_, scene.tube.length_m / kMaxCapsules),
       rule_(scene.model.multi_contact) {}
 
@@ -91,17 +93,26 @@ struct Coefficients {
   double uF = 0.0, thF = 0.0, uM = 0.0, thM = 0.0;
 };
 
+// The force's coefficients uF and thF of Coeffs, for a, b > 0.
+[[gnu::always_inline]] inline void ForceCoeffs(double a, double b, double EI, double& uF,
+                                               double& thF) {
+  if (a <= b) {
+    uF = a * a * (3.0 * b - a) / (6.0 * EI);
+    thF = a * (2.0 * b - a) / (2.0 * EI);
+  } else {
+    uF = b * b * (3.0 * a - b) / (6.0 * EI);
+    thF = b * b / (2.0 * EI);
+  }
+}
+
 Coefficients Coeffs(double a, double b, double EI) {
   Coefficients c;
   if (a <= 0.0 || b <= 0.0) return c;
+  ForceCoeffs(a, b, EI, c.uF, c.thF);
   if (a <= b) {
-    c.uF = a * a * (3.0 * b - a) / (6.0 * EI);
-    c.thF = a * (2.0 * b - a) / (2.0 * EI);
     c.uM = a * a / (2.0 * EI);
     c.thM = a / EI;
   } else {
-    c.uF = b * b * (3.0 * a - b) / (6.0 * EI);
-    c.thF = b * b / (2.0 * EI);
     c.uM = b * (2.0 * a - b) / (2.0 * EI);
     c.thM = b / EI;
   }
@@ -110,8 +121,14 @@ Coefficients Coeffs(double a, double b, double EI) {
 }  // namespace
 
 Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool moments) const {
-  const Coefficients c = Coeffs(i.s_m - j.clamp_m, j.s_m - j.clamp_m, EI_);
-  if (!moments && std::isfinite(c.uM) && std::isfinite(c.thM)) {
+  const double a = i.s_m - j.clamp_m, b = j.s_m - j.clamp_m;
+  // The shortcut below needs finite moment coefficients, not their values: with a and b at
+  // most l they are at most l^2 / EI and l / EI (rounding is monotonic; a NaN fails the test),
+  // finite by moments_finite_. So only uF and thF are formed there, as Coeffs forms them (two
+  // divisions of its four, 18 calls a three-PC tick).
+  if (!moments && moments_finite_ && a <= length_m_ && b <= length_m_) {
+    double uF = 0.0, thF = 0.0;
+    if (a > 0.0 && b > 0.0) ForceCoeffs(a, b, EI_, uF, thF);
     // Without the offset moment (Rj = 0: the elastica's ticks, a call per load pair and
     // member) its two products are 3 x 3 products with a zero matrix. With finite coefficients
     // (Coeffs makes them +0 or positive) every entry of both is +0: uM kZ Rj is subtracted
@@ -123,13 +140,14 @@ Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool
     // product thF r_c (or zero) plus exact zeros, so written out it has the same bits but for
     // the sign of a zero, and takes a tenth of the instructions.
     const Eigen::Vector3d& r = i.r_H_m;
-    const double t_rz = c.thF * r.z();
+    const double t_rz = thF * r.z();
     Eigen::Matrix3d W;
-    W << c.uF + t_rz, 0.0, 0.0,  //
-        0.0, c.uF + t_rz, 0.0,   //
-        -c.thF * r.x(), -c.thF * r.y(), 0.0;
+    W << uF + t_rz, 0.0, 0.0,  //
+        0.0, uF + t_rz, 0.0,   //
+        -thF * r.x(), -thF * r.y(), 0.0;
     return W;
   }
+  const Coefficients c = Coeffs(a, b, EI_);
   const Eigen::Matrix3d Rj = moments ? Skew(j.r_H_m) : Eigen::Matrix3d::Zero();
   return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
 }

@@ -228,6 +228,9 @@ class BeamChain {
   double length_m_ = 0.0;
   double r1_ = 0.0;
   double group_tolerance_m_ = 0.0;
+  // Whether the moment coefficients (uM <= l^2 / EI, thM <= l / EI) are finite for arc lengths
+  // within the tube's (Compliance).
+  bool moments_finite_ = false;
   model::Rod rod_;
   scene::MultiContactRule rule_ = scene::MultiContactRule::kSegmented;
 };
