@@ -81,7 +81,8 @@ struct Loading {
   double sin_psi = 0.0;
 };
 
-Loading MakeLoading(double psi_rad) {
+// The angles of MakeLoading, without its sines.
+Loading LoadingAngles(double psi_rad) {
   Loading load;
   load.psi = psi_rad;
   // Both sums are exact or rounded relative to their own size, so neither axial end loses digits.
@@ -89,10 +90,27 @@ Loading MakeLoading(double psi_rad) {
   load.gap = kHalfPi - psi_rad;
   if (load.phi0 < kAxialAngle) load.phi0 = 0.0;
   if (load.gap < kAxialAngle) load.gap = 0.0;
+  return load;
+}
+
+Loading MakeLoading(double psi_rad) {
+  Loading load = LoadingAngles(psi_rad);
   load.s0 = std::sin(0.5 * load.phi0);
   load.c0 = std::sin(0.5 * load.gap);
   load.cos_psi = std::sin(std::min(load.phi0, load.gap));
   load.sin_psi = std::sin(psi_rad);
+  return load;
+}
+
+// A solution's loading: its kept sines when they are its direction's (SolveElastica keeps
+// them), else made afresh. The same numbers either way.
+Loading LoadingOf(const ElasticaSolution& solution) {
+  if (!(solution.loading_psi_rad == solution.psi_rad)) return MakeLoading(solution.psi_rad);
+  Loading load = LoadingAngles(solution.psi_rad);
+  load.s0 = solution.loading_s0;
+  load.c0 = solution.loading_c0;
+  load.cos_psi = solution.loading_cos_psi;
+  load.sin_psi = solution.loading_sin_psi;
   return load;
 }
 
@@ -604,7 +622,7 @@ void SolveElliptic(const Loading& load, ElasticaSolution& solution, const Elasti
     // two loads: t by linear theory's alpha cos(psi) / 2, y by the large-alpha asymptote
     // 8 c0 / (1 + s0) e^-sqrt(alpha) (SolveAmplitude's starts), so that a change of the load's
     // direction is followed as well.
-    const Loading near_load = MakeLoading(near->psi_rad);
+    const Loading near_load = LoadingOf(*near);
     const double t_near =
         near->tip.tip_angle_rad * (alpha * load.cos_psi) / (near->alpha * near_load.cos_psi);
     const double y_near = 2.0 * std::asin(std::min(near->modulus_kc, 1.0)) *
@@ -806,6 +824,11 @@ ElasticaSolution SolveElastica(double alpha, double psi_rad, const ElasticaSolut
   solution.alpha = alpha;
   solution.psi_rad = psi_rad;
   const Loading load = MakeLoading(psi_rad);
+  solution.loading_psi_rad = psi_rad;
+  solution.loading_s0 = load.s0;
+  solution.loading_c0 = load.c0;
+  solution.loading_cos_psi = load.cos_psi;
+  solution.loading_sin_psi = load.sin_psi;
   // Straight answers: no load, pure tension, and pure compression up to and including Euler's
   // load (the double nearest pi^2/4 counts as "not yet buckled").
   if (alpha == 0.0 || load.gap == 0.0) return solution;
@@ -892,7 +915,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     }
     return;
   }
-  const Loading load = MakeLoading(solution.psi_rad);
+  const Loading load = LoadingOf(solution);
   if (solution.series) {
     const SeriesShape shape = BuildSeries(solution.alpha, load);
     for (std::size_t j = 0; j < n; ++j) {

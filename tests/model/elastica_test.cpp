@@ -439,6 +439,49 @@ TEST_CASE("An elastica solved from a nearby solution is the one solved from scra
         SolveElastica(2.0, 0.3).tip.tip_angle_rad);
 }
 
+TEST_CASE("A solution's kept load sines give the shape and warm start fresh ones give",
+          "[elastica]") {
+  // SolveElastica keeps its loading's four sines in the solution, for the shape evaluations
+  // and a warm start from it; the same solution without them (loading_psi_rad NaN, as a
+  // solution made by hand) makes them afresh. Both must give the same bits. So must a solution
+  // whose psi_rad was changed after the solve: its kept sines are then not its direction's.
+  using tubeplan::model::ElasticaSamples;
+  const auto samples_of = [](const ElasticaSolution& solution) {
+    std::array<Eigen::Vector2d, 17> xz{}, tangent{};
+    ElasticaSamples(solution, xz, tangent);
+    std::array<double, 4 * 17> flat{};
+    for (std::size_t j = 0; j < xz.size(); ++j) {
+      flat[4 * j] = xz[j].x();
+      flat[4 * j + 1] = xz[j].y();
+      flat[4 * j + 2] = tangent[j].x();
+      flat[4 * j + 3] = tangent[j].y();
+    }
+    return flat;
+  };
+  const double alphas[] = {0.05, 2.0, 13.8, 300.0};
+  const double psis[] = {-1.3, -0.4, 0.0, 0.6, 1.4};
+  for (const double alpha : alphas) {
+    for (const double psi : psis) {
+      INFO("alpha = " << alpha << ", psi = " << psi);
+      const ElasticaSolution kept = SolveElastica(alpha, psi);
+      CHECK(kept.loading_psi_rad == psi);
+      ElasticaSolution bare = kept;
+      bare.loading_psi_rad = std::numeric_limits<double>::quiet_NaN();
+      CHECK(samples_of(kept) == samples_of(bare));
+      const ElasticaSolution warm_kept = SolveElastica(alpha * 1.01, psi + 0.01, &kept);
+      const ElasticaSolution warm_bare = SolveElastica(alpha * 1.01, psi + 0.01, &bare);
+      CHECK(warm_kept.tip.tip_angle_rad == warm_bare.tip.tip_angle_rad);
+      CHECK(warm_kept.tip.deflection == warm_bare.tip.deflection);
+      CHECK(warm_kept.iterations == warm_bare.iterations);
+      ElasticaSolution moved = kept;
+      moved.psi_rad = -psi + 0.1;
+      ElasticaSolution moved_bare = moved;
+      moved_bare.loading_psi_rad = std::numeric_limits<double>::quiet_NaN();
+      CHECK(samples_of(moved) == samples_of(moved_bare));
+    }
+  }
+}
+
 TEST_CASE("Elastica series and elliptic branches agree across the switch", "[elastica]") {
   // Locate the switch from the outside (the 'series' flag) instead of copying the constant.
   double lo = 1e-6;  // series here

@@ -13,6 +13,7 @@
 // cantilever as alpha grows from 0 (for pure compression below Euler's load pi^2/4 that is the
 // straight rod itself).
 
+#include <limits>
 #include <span>
 
 #include <Eigen/Core>
@@ -39,6 +40,11 @@ struct ElasticaSolution {
   double u0 = 0.0;          ///< amplitude-parameter at the root
   int iterations = 0;       ///< root-finding iterations used
   bool series = false;      ///< true when the small-alpha series produced the answer
+  /// The load direction's sines (elastica.cpp's Loading: sin(phi0/2), sin(gap/2), cos psi,
+  /// sin psi), valid while loading_psi_rad equals psi_rad (NaN: none): a warm start from this
+  /// solution and its shape evaluations take them instead of four sin calls each.
+  double loading_psi_rad = std::numeric_limits<double>::quiet_NaN();
+  double loading_s0 = 0.0, loading_c0 = 0.0, loading_cos_psi = 0.0, loading_sin_psi = 0.0;
 };
 
 /// The largest load parameter SolveElastica accepts.
