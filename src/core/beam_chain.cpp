@@ -120,7 +120,8 @@ Coefficients Coeffs(double a, double b, double EI) {
 }
 }  // namespace
 
-Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool moments) const {
+void BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool moments,
+                           Eigen::Matrix3d& W) const {
   const double a = i.s_m - j.clamp_m, b = j.s_m - j.clamp_m;
   // The shortcut below needs finite moment coefficients, not their values: with a and b at
   // most l they are at most l^2 / EI and l / EI (rounding is monotonic; a NaN fails the test),
@@ -141,15 +142,14 @@ Eigen::Matrix3d BeamChain::Compliance(const BeamLoad& i, const BeamLoad& j, bool
     // the sign of a zero, and takes a tenth of the instructions.
     const Eigen::Vector3d& r = i.r_H_m;
     const double t_rz = thF * r.z();
-    Eigen::Matrix3d W;
     W << uF + t_rz, 0.0, 0.0,  //
         0.0, uF + t_rz, 0.0,   //
         -thF * r.x(), -thF * r.y(), 0.0;
-    return W;
+    return;
   }
   const Coefficients c = Coeffs(a, b, EI_);
   const Eigen::Matrix3d Rj = moments ? Skew(j.r_H_m) : Eigen::Matrix3d::Zero();
-  return c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
+  W = c.uF * kLateral - c.uM * kZ * Rj - Skew(i.r_H_m) * (c.thF * kZ + c.thM * kLateral * Rj);
 }
 
 double BeamChain::DisplacementBound(const BeamLoad& j, const Eigen::Vector3d& df_H, bool moments,

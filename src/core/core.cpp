@@ -1137,12 +1137,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
                    m.beam.ElasticaCovers(m.beam_loads, m.order, members, groups);
     const auto linear_compliance = [&] {
       for (int i = 0; i < load_count; ++i)
-        for (int j = 0; j < load_count; ++j)
-          m.W[std::size_t(i)][std::size_t(j)] =
-              member[std::size_t(j)]
-                  ? m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
-                                      !use_elastica)
-                  : Eigen::Matrix3d::Zero();
+        for (int j = 0; j < load_count; ++j) {
+          Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+          if (member[std::size_t(j)])
+            m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
+                              !use_elastica, Wij);
+          else
+            Wij.setZero();
+        }
     };
     linear_compliance();
     bool rod_end_spring = false;  // the rod's tangent, with the end's response to a moment
