@@ -1386,19 +1386,26 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         }
       }
     }
+    // A load that is not a member moves nothing: its column is zero in any frame (most of the
+    // loads of a tube lying in the groove, in the band of a wall it does not touch).
+    for (int i = 0; i < load_count; ++i)
+      for (int j = 0; j < load_count; ++j)
+        if (member[std::size_t(j)]) {
+          Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+          Wij = R_WH * Wij * R_WH.transpose();
+        }
+    // In a pass of its own, after the turns: read back right after it was written, a block's
+    // column (24 bytes) straddles the 16-byte stores that wrote it, and such a load waits for
+    // them to reach the cache (`perf` had a third of this function's time on that load).
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       ld.base_W = ld.x0_W - p_start_W;
-      for (int j = 0; j < load_count; ++j) {
-        // A load that is not a member moves nothing: its column is zero in any frame (most of
-        // the loads of a tube lying in the groove, in the band of a wall it does not touch).
-        if (!member[std::size_t(j)]) continue;
-        Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
-        Wij = R_WH * Wij * R_WH.transpose();
-        // (noalias: the product goes straight into the sum. Eigen otherwise assumes aliasing and
-        // makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
-        if (want_elastica) ld.base_W.noalias() -= Wij * m.loads[std::size_t(j)].f_lin_W;
-      }
+      for (int j = 0; j < load_count && want_elastica; ++j)
+        // (noalias: the product goes straight into the sum. Eigen otherwise assumes aliasing
+        // and makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
+        if (member[std::size_t(j)])
+          ld.base_W.noalias() -=
+              m.W[std::size_t(i)][std::size_t(j)] * m.loads[std::size_t(j)].f_lin_W;
     }
     // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
     // by where last tick's loads were. The tick's shape is x_straight + W F (step 8), so
@@ -1543,8 +1550,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           continue;
         }
         Dij = m.beam.InfluenceSlope(bi.s_m, m.beam_loads[std::size_t(j)]) * M_i;
-        ld.stick_base_W.noalias() += Dij * m.loads[std::size_t(j)].f_lin_W;
       }
+    }
+    // The sums in a pass of their own, as the compliance's base (build_compliance).
+    for (int i = 0; i < load_count; ++i) {
+      Load& ld = m.loads[std::size_t(i)];
+      if (!ld.friction || !use_elastica) continue;
+      for (int j = 0; j < load_count; ++j)
+        if (member[std::size_t(j)])
+          ld.stick_base_W.noalias() +=
+              m.W_turn[std::size_t(i)][std::size_t(j)] * m.loads[std::size_t(j)].f_lin_W;
     }
   };
   build_compliance();
