@@ -157,22 +157,9 @@ double ResidualSlope(const Loading& load, const Trial& trial) {
   const double c0_sq = load.c0 * load.c0;
   const double dy = kkc * (trial.kc * trial.kc - k_sq) / c0_sq;
   const double dz = kkc;
-  const double rd_xzy = Rd(x, z, y), rd_xyz = Rd(x, y, z);
-  double sum = rd_xzy * dy + rd_xyz * dz;
-  // With s0 = 0 the first argument is identically zero and its term vanishes. Otherwise its
-  // R_D(y, z, x) comes from the other two by R_D(x, y, z) + R_D(y, z, x) + R_D(z, x, y) =
-  // 3 / sqrt(x y z) (Carlson; DLMF section 19.21. R_D is symmetric in its first two arguments): one
-  // R_D, and its pow, fewer a Newton step. x <= y <= z here (s0 <= k, r <= 1), so R_D(y, z, x) is
-  // the largest of the three, at least a third of the sum: the subtraction loses at most a few
-  // units in the last place (1.7e-15 relative at worst over 2e5 random x <= y <= z in
-  // [1e-12, 1]), and the slope only steers Newton's step. Where the product x y z would
-  // underflow, R_D itself.
-  if (load.s0 > 0.0) {
-    const double sum_of_three = 3.0 / (std::sqrt(x) * std::sqrt(y * z));
-    const double rd_yzx =
-        std::isfinite(sum_of_three) ? sum_of_three - rd_xzy - rd_xyz : Rd(y, z, x);
-    sum += rd_yzx * (-load.s0 * load.s0 * kkc / c0_sq);
-  }
+  double sum = Rd(x, z, y) * dy + Rd(x, y, z) * dz;
+  // With s0 = 0 the first argument is identically zero and its term vanishes.
+  if (load.s0 > 0.0) sum += Rd(y, z, x) * (-load.s0 * load.s0 * kkc / c0_sq);
   return kkc / trial.d - sum / (3.0 * trial.rf);
 }
 
