@@ -1400,7 +1400,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = m.loads[std::size_t(i)];
       ld.base_W = ld.x0_W - p_start_W;
-      for (int j = 0; j < load_count && want_elastica; ++j)
+      if (!want_elastica) continue;  // the linear model's base: below
+      for (int j = 0; j < load_count; ++j)
         // (noalias: the product goes straight into the sum. Eigen otherwise assumes aliasing
         // and makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
         if (member[std::size_t(j)])
