@@ -387,6 +387,18 @@ void Collision::LineEnds(RawContact& c, std::span<const Eigen::Vector3d> nodes_W
       std::max(0.0, s0_m + std::clamp((c.t_hi - 0.5) * length_m - offset_m, -half_m, half_m));
 }
 
+RawContact Collision::StripPiece(const RawContact& strip, int piece) const {
+  // A strip's entry is its first piece's contact as Query wrote it, but for the strip's figures:
+  // every other field is the same for each of its pieces.
+  RawContact c = strip;
+  c.piece = piece;
+  c.distance_m = StripPieceDistance(strip, piece);
+  c.strip_pieces = 1;
+  c.strip_deepest = piece;
+  c.strip_farthest_m = c.distance_m;
+  return c;
+}
+
 void Collision::Complete(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const {
   if (!c.deferred) return;
   // Query's steps for a capsule apart from the part, on the same nodes: the same bits.
@@ -722,7 +734,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
                      double band_m, std::span<RawContact> out, IdleParts* idle) const {
   // Capsules 0 .. pieces - 2, then the end cylinder as piece pieces - 1.
   const int pieces = static_cast<int>(nodes_W.size()) - end_pieces_;
-  int count = 0;
+  int count = 0;  // entries written
+  int stood = 0;  // contacts they stand for (a strip, its pieces): at most out.size()
   narrow_calls_ = 0;
   coherent_skips_ = 0;
   const Eigen::Vector3d tip_W = nodes_W.back();
@@ -826,8 +839,32 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     // A capsule apart from the part within the band: what forms the PCs now, the points only if
     // it becomes a load (Complete; made here, they were a third of the query's instructions for
     // a tube lying in the groove, a hundred contacts of which six become loads).
+    // One over a face, next to the piece before it over the same face, joins that one's strip
+    // (RawContact::strip_pieces): the core forms PCs from strips, and needs a piece of one only
+    // where it becomes a load (StripPiece); written one by one, they made a third of its contact
+    // work and most of the query's writes. Its distance is the one kept for its piece (Keep,
+    // before each call here). `strip_entry`: the strip that is the last entry, if it is one.
+    int strip_entry = -1, strip_next = -1;
+    std::uint8_t strip_mask = 0;
     const auto emit_deferred = [&](int k, double d, std::uint8_t face_mask)
         __attribute__((always_inline)) {
+      ++stood;
+      if (strip_entry == count - 1 && strip_next == k && strip_mask == face_mask) {
+        RawContact& strip = out[std::size_t(strip_entry)];
+        ++strip.strip_pieces;
+        if (d < strip.distance_m) {
+          strip.distance_m = d;
+          strip.strip_deepest = k;
+        }
+        strip.strip_farthest_m = std::max(strip.strip_farthest_m, d);
+        ++strip_next;
+        return;
+      }
+      if (IsFaceMask(face_mask)) {
+        strip_entry = count;
+        strip_next = k + 1;
+        strip_mask = face_mask;
+      }
       RawContact& c = out[std::size_t(count++)];
       c.tube = states::TubeElement::kSide;
       c.part = part.index;
@@ -841,6 +878,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       c.piece = k;
       c.part_slot = static_cast<int>(part_i);
       c.deferred = true;
+      c.strip_pieces = 1;
+      c.strip_deepest = k;
+      c.strip_farthest_m = d;
 #ifndef NDEBUG
       // Unmade until Complete: NaN in the debug (sanitizer) build, where a read before it
       // reaches the core's checks of its outputs instead of last tick's values.
@@ -927,7 +967,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const double axis_m = std::abs(e);
         const double d = axis_m - radius_m_;
         if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
-          if (count == static_cast<int>(out.size())) return count;
+          if (stood == static_cast<int>(out.size())) return count;
           KeptDistance& kept_k = kept[k];
           const Eigen::Vector3d& a_W = nodes_W[std::size_t(k)];
           const Eigen::Vector3d& b_W = nodes_W[std::size_t(k) + 1];
@@ -953,7 +993,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       const Eigen::Vector3d& a_P = is_end ? end_start_P : nodes_P_[std::size_t(k)];
       const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
       if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
-      if (count == static_cast<int>(out.size())) return count;
+      if (stood == static_cast<int>(out.size())) return count;
       // Most pieces that pass the broad phase lie beside a part, farther than the band, and
       // move micrometres a tick: the distance computed some ticks ago, less how far the piece
       // has moved since, still says so (KeptBeyondBand), and the narrow phase below would
@@ -1144,16 +1184,20 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         const Eigen::Vector3d radial_W = p_tube_W - centre_W - along * axis_W;
         const RawContact side = c;  // out[count] may take the first end
         for (const double end : {-half_m, half_m}) {
-          if (count == static_cast<int>(out.size())) return count;
+          if (stood == static_cast<int>(out.size())) return count;
           RawContact e = side;
           e.p_W_m = centre_W + radial_W + end * axis_W;
           e.distance_m = side.distance_m + side.normal_W.dot(e.p_W_m - p_tube_W);
           e.s_m = std::max(0.0, s0 + half_m + end);
-          if (e.distance_m < band_m && e.distance_m > 0.0) out[std::size_t(count++)] = e;
+          if (e.distance_m < band_m && e.distance_m > 0.0) {
+            out[std::size_t(count++)] = e;
+            ++stood;
+          }
         }
         continue;
       }
       ++count;
+      ++stood;
     }
   }
   return count;

@@ -54,6 +54,15 @@ struct RawContact {
   bool deferred = false;
   int piece = 0;
   int part_slot = 0;  ///< the part among the Collision's
+  /// A deferred contact may stand for a strip of them: pieces `piece` .. `piece + strip_pieces -
+  /// 1`, consecutive, of one part, each over the same face (a tube lying on a face: tens a part).
+  /// Their distances differ, nothing else does: `distance_m` is the least of them, at piece
+  /// `strip_deepest` (the first of equals), `strip_farthest_m` the greatest, and
+  /// Collision::StripPiece gives any one piece's contact, the one Query would have given alone.
+  /// One contact: strip_pieces 1 (and the other two unset).
+  int strip_pieces = 1;
+  int strip_deepest = 0;
+  double strip_farthest_m = 0.0;
   double t_lo = 0.0, t_hi = 0.0;
   double s_lo_m = 0.0, s_hi_m = 0.0;
   double d_lo_m = 0.0, d_hi_m = 0.0;
@@ -140,9 +149,12 @@ class Collision {
   /// in arc length from the held end) are `nodes_W`, with the free end's axis `tip_tangent_W`.
   /// The last intervals (at least r1 of tube) are one straight cylinder along the tip tangent, so
   /// that no capsule's round cap reaches past the flat end face. Writes at most out.size() contacts
-  /// and returns how many (the entry past them may be overwritten too); no allocation. Pairs closer
-  /// than `band_m` are returned (the core asks for more than epsilon so that a contact about to
-  /// close this tick is in its system, and one releasing leaves smoothly).
+  /// and returns how many entries it wrote (the entry past them may be overwritten too); no
+  /// allocation. Pairs closer than `band_m` are returned (the core asks for more than epsilon so
+  /// that a contact about to close this tick is in its system, and one releasing leaves smoothly).
+  /// A strip of deferred contacts takes one entry (RawContact::strip_pieces) and counts as its
+  /// pieces towards out.size(): the contacts it stands for are the ones a query writing each alone
+  /// would have written, in the same order (StripPiece gives them).
   ///
   /// `idle` (optional) names parts that may be left out; see IdleParts. An end piece within the
   /// band of a part it could face (its axis within the tilt at which an end face presses at its
@@ -190,6 +202,16 @@ class Collision {
   /// Query would have given (the same closed form on the same nodes); `nodes_W` are the nodes
   /// Query was given. Nothing for a contact that is not deferred.
   void Complete(RawContact& c, std::span<const Eigen::Vector3d> nodes_W) const;
+
+  /// The contact of piece `piece` of the strip `strip` the last Query wrote
+  /// (RawContact::strip_pieces): the same bits as Query writing it alone. Its distance is the one
+  /// Query kept for the piece; so only until the next Query.
+  RawContact StripPiece(const RawContact& strip, int piece) const;
+  /// The distance of piece `piece` of the strip `strip` the last Query wrote: StripPiece's, without
+  /// the rest of the contact.
+  double StripPieceDistance(const RawContact& strip, int piece) const {
+    return kept_[std::size_t(strip.part_slot) * std::size_t(kMaxCapsules) + std::size_t(piece)].d_m;
+  }
 
   /// Forgets the distances kept from earlier queries. Query's results never depend on them, only
   /// its narrow-phase count does: the core forgets them when it is reset or restored, so that

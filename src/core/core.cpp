@@ -195,7 +195,9 @@ struct Core::State {
   int tangent_current = 0;
 
   // Per-tick scratch (kept here so that Step allocates nothing).
-  std::array<RawContact, kMaxRawContacts> raw{};
+  // Query's entries, then the pieces of strips among them that a PC takes
+  // (RawContact::strip_pieces): three a PC at most.
+  std::array<RawContact, kMaxRawContacts + 3 * kMaxContacts> raw{};
   std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_W{};
   std::array<Load, kMaxLoads> loads{};
   std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W{};  // world frame
@@ -494,7 +496,9 @@ struct PcFound {
   states::TubeElement tube = states::TubeElement::kSide;
   int part_element = -1;
   int deepest = -1, first = -1, last = -1;  // raw contacts: smallest d, smallest s, largest s
-  double deepest_m = 0.0;                   // the deepest's distance (read for every contact)
+  // Where one of those is a strip's entry (RawContact::strip_pieces), its piece.
+  int deepest_piece = 0, first_piece = 0, last_piece = 0;
+  double deepest_m = 0.0;  // the deepest's distance (read for every contact)
 };
 
 }  // namespace
@@ -614,9 +618,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     m.collision.set_dome_radius_m(through_m > 0.0 ? (r1 * r1 + r2 * r2) / (4.0 * through_m)
                                                   : m.collision.tolerance_dome_radius_m());
   }
-  const int raw_count = m.collision.Query(
-      std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1), tip_tangent_W,
-      2.0 * eps + sweep_m, std::span<RawContact>(m.raw.data(), m.raw.size()), &idle);
+  const int raw_count =
+      m.collision.Query(std::span<const Eigen::Vector3d>(m.nodes_W.data(), std::size_t(N) + 1),
+                        tip_tangent_W, 2.0 * eps + sweep_m,
+                        std::span<RawContact>(m.raw.data(), std::size_t(kMaxRawContacts)), &idle);
   m.idle_left_out = idle.left_out;
 
   // 3. PCs: a raw contact whose elements are boundaries of another's (same part) joins that
@@ -665,11 +670,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // The PC of the run of contacts at hand, and its deepest so far, kept here while the run
   // lasts and written back when it ends: read and written through `found` for every contact,
   // they made a chain of store-to-load forwarding a contact long.
-  int run_k = -1, run_deepest = -1;  // run_k is pc_of[i - 1]
+  // A strip's entry (RawContact::strip_pieces) stands for its pieces: its distance is their
+  // least, at strip_deepest, the first of equals, as the scan of each would have found.
+  int run_k = -1, run_deepest = -1, run_deepest_piece = 0;  // run_k is pc_of[i - 1]
   double run_deepest_m = 0.0;
   const auto end_run = [&] {
     if (run_k < 0) return;
     found[std::size_t(run_k)].deepest = run_deepest;
+    found[std::size_t(run_k)].deepest_piece = run_deepest_piece;
     found[std::size_t(run_k)].deepest_m = run_deepest_m;
   };
   for (int i = 0; i < raw_count; ++i) {
@@ -681,6 +689,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       pc_of[std::size_t(i)] = run_k;
       if (r.distance_m < run_deepest_m) {
         run_deepest = i;
+        run_deepest_piece = r.strip_deepest;
         run_deepest_m = r.distance_m;
       }
       continue;
@@ -698,12 +707,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         pc_of[std::size_t(i)] = run_k = -1;
         continue;
       }
-      found[std::size_t(found_count++)] = PcFound{r.tube, r.part_element, i, i, i, r.distance_m};
+      PcFound& pc = found[std::size_t(found_count++)];
+      pc = PcFound{r.tube, r.part_element};
+      pc.deepest = pc.first = pc.last = i;
+      pc.deepest_piece = r.strip_deepest;
+      pc.deepest_m = r.distance_m;
     }
     run_deepest = found[std::size_t(k)].deepest;
+    run_deepest_piece = found[std::size_t(k)].deepest_piece;
     run_deepest_m = found[std::size_t(k)].deepest_m;
     if (r.distance_m < run_deepest_m) {
       run_deepest = i;
+      run_deepest_piece = r.strip_deepest;
       run_deepest_m = r.distance_m;
     }
   }
@@ -733,15 +748,44 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // (Which PCs have their first: a bit each, not pc.first read back for every contact.)
   static_assert(kMaxContacts <= 32);
   std::uint32_t has_first = 0;
+  // A strip's pieces in the region: from the first to the last within it (all of them when its
+  // farthest is; its least distance is the one tested first).
   for (int i = 0; i < raw_count; ++i) {
     const int k = pc_of[std::size_t(i)];
-    if (k < 0 || m.raw[std::size_t(i)].distance_m > region_m[std::size_t(k)]) continue;
+    const RawContact& r = m.raw[std::size_t(i)];
+    if (k < 0 || r.distance_m > region_m[std::size_t(k)]) continue;
+    int lo = r.piece, hi = r.piece + r.strip_pieces - 1;
+    if (r.strip_pieces > 1 && !(r.strip_farthest_m <= region_m[std::size_t(k)])) {
+      while (m.collision.StripPieceDistance(r, lo) > region_m[std::size_t(k)]) ++lo;
+      while (m.collision.StripPieceDistance(r, hi) > region_m[std::size_t(k)]) --hi;
+    }
     PcFound& pc = found[std::size_t(k)];
     if ((has_first & (1u << k)) == 0) {
       has_first |= 1u << k;
       pc.first = i;
+      pc.first_piece = lo;
     }
     pc.last = i;
+    pc.last_piece = hi;
+  }
+  // The pieces of strips a PC takes, each made whole after the entries (one contact made once
+  // however many of deepest, first and last it is): from here on a PC's contacts are single.
+  int piece_slot = raw_count;
+  for (int k = 0; k < found_count; ++k) {
+    PcFound& pc = found[std::size_t(k)];
+    const auto single = [&](int i, int piece) {
+      if (m.raw[std::size_t(i)].strip_pieces == 1) return i;
+      m.raw[std::size_t(piece_slot)] = m.collision.StripPiece(m.raw[std::size_t(i)], piece);
+      return piece_slot++;
+    };
+    const bool first_deepest = pc.first == pc.deepest && pc.first_piece == pc.deepest_piece;
+    const bool last_deepest = pc.last == pc.deepest && pc.last_piece == pc.deepest_piece;
+    const bool last_first = pc.last == pc.first && pc.last_piece == pc.first_piece;
+    const int deepest = single(pc.deepest, pc.deepest_piece);
+    const int first = first_deepest ? deepest : single(pc.first, pc.first_piece);
+    pc.last = last_deepest ? deepest : last_first ? first : single(pc.last, pc.last_piece);
+    pc.deepest = deepest;
+    pc.first = first;
   }
   const std::span<const Eigen::Vector3d> query_nodes_W(m.nodes_W.data(), std::size_t(N) + 1);
   for (int k = 0; k < found_count; ++k) {

@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <span>
@@ -273,6 +274,51 @@ int Complete(const core::Collision& collision, const scene::Scene& s, int capsul
   return checked;
 }
 
+// Query, with each strip of contacts it wrote as one entry (RawContact::strip_pieces) written out
+// as its pieces' contacts (Collision::StripPiece): the contacts of a query writing each alone.
+// Checks what a strip says of its pieces: one part, one face, consecutive pieces, and its least
+// distance (at the first piece that has it) and greatest, against each piece's. Returns how many
+// contacts; `entries`, if given, gets the query's own count.
+int QueryEach(const core::Collision& collision, std::span<const Eigen::Vector3d> nodes_W,
+              const Eigen::Vector3d& tip_tangent_W, double band_m, std::span<core::RawContact> out,
+              core::IdleParts* idle = nullptr, int* entries = nullptr) {
+  std::vector<core::RawContact> raw(out.size());
+  const int n = collision.Query(nodes_W, tip_tangent_W, band_m, raw, idle);
+  if (entries != nullptr) *entries = n;
+  int count = 0;
+  for (int i = 0; i < n; ++i) {
+    const core::RawContact& e = raw[std::size_t(i)];
+    REQUIRE(e.strip_pieces >= 1);
+    if (e.strip_pieces == 1) {
+      REQUIRE(count < static_cast<int>(out.size()));
+      out[std::size_t(count++)] = e;
+      continue;
+    }
+    INFO("strip of " << e.strip_pieces << " from piece " << e.piece);
+    CHECK(e.deferred);
+    CHECK(e.over_face);
+    double least_m = std::numeric_limits<double>::infinity(), greatest_m = -least_m;
+    int least_at = -1;
+    for (int k = e.piece; k < e.piece + e.strip_pieces; ++k) {
+      REQUIRE(count < static_cast<int>(out.size()));
+      const core::RawContact c = collision.StripPiece(e, k);
+      CHECK(c.piece == k);
+      CHECK(c.strip_pieces == 1);
+      CHECK((c.part == e.part && c.face_mask == e.face_mask && c.deferred));
+      CHECK(c.distance_m < band_m);
+      if (c.distance_m < least_m) {
+        least_m = c.distance_m;
+        least_at = k;
+      }
+      greatest_m = std::max(greatest_m, c.distance_m);
+      out[std::size_t(count++)] = c;
+    }
+    CHECK(SameBits(e.distance_m, least_m));
+    CHECK(e.strip_deepest == least_at);
+    CHECK(SameBits(e.strip_farthest_m, greatest_m));
+  }
+  return count;
+}
 }  // namespace
 
 TEST_CASE("Distances kept from earlier queries change no contact, and leave out only idle parts",
@@ -375,10 +421,10 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
     kept.set_dome_radius_m(dome_m);
     idle.set_dome_radius_m(dome_m);
 
-    const int n = kept.Query(nodes_W, tip_tangent_W, band_m, got);
+    const int n = QueryEach(kept, nodes_W, tip_tangent_W, band_m, got);
     core::Collision fresh(s, parts, capsules, element_of);
     fresh.set_dome_radius_m(dome_m);
-    const int m = fresh.Query(nodes_W, tip_tangent_W, band_m, want);
+    const int m = QueryEach(fresh, nodes_W, tip_tangent_W, band_m, want);
     Complete(kept, s, capsules, got, n, nodes_W, false);
     completed_checked += Complete(fresh, s, capsules, want, m, nodes_W, query % 10 == 0);
     INFO("query " << query << " band " << band_m);
@@ -391,7 +437,7 @@ TEST_CASE("Distances kept from earlier queries change no contact, and leave out 
     core::IdleParts groups;
     groups.may_leave_out = may_leave_out;
     groups.floor_m = s.contact.threshold_m;
-    const int n_idle = idle.Query(nodes_W, tip_tangent_W, band_m, got_idle, &groups);
+    const int n_idle = QueryEach(idle, nodes_W, tip_tangent_W, band_m, got_idle, &groups);
     Complete(idle, s, capsules, got_idle, n_idle, nodes_W, false);
     left_out += groups.left_out;
     int j = 0;  // the idle query's contacts are the full one's, less whole parts
@@ -638,7 +684,7 @@ TEST_CASE("The end face on a wall is a dome: its lowest point, continuous into t
       std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
       for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = F - (l - l * k / capsules) * u;
       std::array<core::RawContact, core::kMaxRawContacts> out{};
-      const int count = collision.Query(nodes_W, u, 2.0 * s.contact.threshold_m, out);
+      const int count = QueryEach(collision, nodes_W, u, 2.0 * s.contact.threshold_m, out);
       Complete(collision, s, capsules, out, count, nodes_W, true);
       End end{states::TubeElement::kSide, 0.0, -1.0};
       for (int i = 0; i < count; ++i) {
@@ -733,24 +779,24 @@ TEST_CASE("A part left out under a narrow dome is looked at again when the dome 
     return found;
   };
   // The tolerance's dome: once a query has kept the pieces' distances, the floor is left out.
-  const int rim_only = idle.Query(nodes_W, u, band_m, out);
+  const int rim_only = QueryEach(idle, nodes_W, u, band_m, out);
   REQUIRE(rim_only > 0);
   REQUIRE(pressure_centres(rim_only) == 0);
   core::IdleParts first;
   first.may_leave_out = may_leave_out;
   first.floor_m = eps;
-  CHECK(idle.Query(nodes_W, u, band_m, out, &first) == 0);
+  CHECK(QueryEach(idle, nodes_W, u, band_m, out, &first) == 0);
   CHECK(first.left_out == 1);
   // The bed of springs' dome, the tube where it was.
   idle.set_dome_radius_m(0.0);
   fresh.set_dome_radius_m(0.0);
   REQUIRE(fresh.dome_radius_m() == 1.25 * r1);
-  const int want = fresh.Query(nodes_W, u, band_m, out);
+  const int want = QueryEach(fresh, nodes_W, u, band_m, out);
   REQUIRE(pressure_centres(want) == 1);
   core::IdleParts second;
   second.may_leave_out = may_leave_out;
   second.floor_m = eps;
-  const int got = idle.Query(nodes_W, u, band_m, out, &second);
+  const int got = QueryEach(idle, nodes_W, u, band_m, out, &second);
   CHECK(second.left_out == 0);
   CHECK(got == want);
   CHECK(pressure_centres(got) == 1);
@@ -785,7 +831,7 @@ TEST_CASE("A capsule over a face spans the stretch of its axis over it, whatever
     std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
     for (int k = 0; k <= capsules; ++k) nodes_W[std::size_t(k)] = start + (l * k / capsules) * u;
     std::array<core::RawContact, core::kMaxRawContacts> out{};
-    const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
+    const int count = QueryEach(collision, nodes_W, u, 2.0 * eps, out);
     Complete(collision, s, capsules, out, count, nodes_W, true);
     Region region;
     for (int i = 0; i < count; ++i) {
@@ -882,7 +928,7 @@ TEST_CASE("The last capsule's cap inside the end cylinder is no contact", "[core
   for (int k = 0; k <= capsules; ++k)
     nodes_W[std::size_t(k)] = (press_m + l * double(k) / capsules) * u;
   std::array<core::RawContact, core::kMaxRawContacts> out{};
-  const int count = collision.Query(nodes_W, u, 2.0 * eps, out);
+  const int count = QueryEach(collision, nodes_W, u, 2.0 * eps, out);
   Complete(collision, s, capsules, out, count, nodes_W, false);
   const Eigen::Vector3d end_start_W = nodes_W.back() - end_m * u;
   int end_face = 0;
@@ -897,6 +943,72 @@ TEST_CASE("The last capsule's cap inside the end cylinder is no contact", "[core
     CHECK_FALSE(inside);
   }
   CHECK(end_face == 1);
+}
+
+TEST_CASE(
+    "A tube lying on a face: strips of its pieces' contacts, each piece's distance exact, "
+    "cut where a full out cuts single contacts",
+    "[core][collision]") {
+  // The groove scene's tube lying along y over a floor whose top is z = 0, its nodes at heights
+  // rising slowly from r1 + eps / 5, and a hump of 3 eps over nodes 15 .. 24: the capsules
+  // between (15 .. 23) are beyond the band 2 eps, the others within it. A capsule over the face
+  // with both nodes above it is min(z_a, z_b) - r1 from it (its nearest point is over its
+  // nearer end): each piece's contact from a strip must carry exactly that, and the pieces with
+  // contacts must be exactly those within the band. The hump cuts the strip in two.
+  scene::Scene s = GrooveScene();
+  const double r1 = s.tube.outer_radius_m, l = s.tube.length_m, eps = s.contact.threshold_m;
+  s.parts = {Box("floor", Eigen::Vector3d(0.12, 0.4, 0.02), Eigen::Vector3d(0.0, 0.0, -0.01))};
+  const int capsules = 48;
+  const core::Collision collision(s, std::vector<std::uint32_t>{0}, capsules, MaskElements(1));
+  const Eigen::Vector3d u = Eigen::Vector3d::UnitY();
+  std::vector<Eigen::Vector3d> nodes_W(std::size_t(capsules) + 1);
+  for (int k = 0; k <= capsules; ++k) {
+    const double hump_m = k >= 15 && k <= 24 ? 3.0 * eps : 0.0;
+    nodes_W[std::size_t(k)] = Eigen::Vector3d(0.0, -0.08 + l * double(k) / capsules,
+                                              r1 + eps * (0.2 + 0.5 * k / capsules) + hump_m);
+  }
+  const double band_m = 2.0 * eps;
+  std::array<core::RawContact, core::kMaxRawContacts> out{};
+  int entries = 0;
+  const int count = QueryEach(collision, nodes_W, u, band_m, out, nullptr, &entries);
+  std::vector<int> strip_pieces;
+  for (int i = 0; i < count; ++i) {
+    const core::RawContact& c = out[std::size_t(i)];
+    if (!c.deferred) continue;  // the last capsule and the end cylinder's: made whole by Query
+    const int k = c.piece;
+    INFO("piece " << k);
+    // Within the rounding of the shift into the floor's frame (coordinates of centimetres,
+    // ~1e-18 m), with a margin.
+    CHECK(c.distance_m ==
+          Approx(std::min(nodes_W[std::size_t(k)].z(), nodes_W[std::size_t(k) + 1].z()) - r1)
+              .margin(1e-15));
+    strip_pieces.push_back(k);
+  }
+  // Every capsule but the last within the band, and no other: the end cylinder covers the last
+  // node intervals (at least r1 of tube), and the capsule before it is made whole by Query (its
+  // cap is looked at against the cylinder).
+  const double piece_m = l / capsules;
+  const int end_pieces = static_cast<int>(std::lround(collision.end_length_m() / piece_m));
+  std::vector<int> expected;
+  for (int k = 0; k < capsules - end_pieces - 1; ++k)
+    if (k < 15 || k > 23) expected.push_back(k);
+  CHECK(strip_pieces == expected);
+  // Two strips, and the few contacts near the end (the last capsule, the end cylinder's side as
+  // its generator's two ends), not a contact a piece.
+  CHECK(entries <= 5);
+  CHECK(count == static_cast<int>(expected.size()) + entries - 2);
+
+  // Out full: Query stops where it would stop writing each contact alone, in the middle of a
+  // strip too.
+  for (const int room : {1, 7, 15, 16, 30, count - 1}) {
+    INFO("room for " << room);
+    std::vector<core::RawContact> small(static_cast<std::size_t>(room));
+    REQUIRE(QueryEach(collision, nodes_W, u, band_m, small) == room);
+    for (int i = 0; i < room; ++i) {
+      CHECK(small[std::size_t(i)].piece == out[std::size_t(i)].piece);
+      CHECK(SameBits(small[std::size_t(i)].distance_m, out[std::size_t(i)].distance_m));
+    }
+  }
 }
 
 // The world directions of a face mask's faces, summed (at most one face an axis here: the sum
@@ -965,8 +1077,8 @@ TEST_CASE("A run of capsules beyond one face of an aligned part: the same contac
       u = turn * u;
     }
     std::array<core::RawContact, core::kMaxRawContacts> out_a{}, out_t{};
-    const int count_a = on_aligned.Query(nodes_W, u, 2.0 * eps, out_a);
-    const int count_t = on_turned.Query(nodes_W, u, 2.0 * eps, out_t);
+    const int count_a = QueryEach(on_aligned, nodes_W, u, 2.0 * eps, out_a);
+    const int count_t = QueryEach(on_turned, nodes_W, u, 2.0 * eps, out_t);
     INFO("trial " << trial);
     REQUIRE(count_a == count_t);
     for (int i = 0; i < count_a; ++i) deferred += out_a[std::size_t(i)].deferred ? 1 : 0;
