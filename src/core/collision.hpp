@@ -59,7 +59,8 @@ struct RawContact {
   /// Their distances differ, nothing else does: `distance_m` is the least of them, at piece
   /// `strip_deepest` (the first of equals), `strip_farthest_m` the greatest, and
   /// Collision::StripPiece gives any one piece's contact, the one Query would have given alone.
-  /// One contact: strip_pieces 1 (and the other two unset).
+  /// One contact: strip_pieces 1; the other two are read only for a strip (a deferred contact
+  /// sets them to its own piece and distance, any other leaves them unset).
   int strip_pieces = 1;
   int strip_deepest = 0;
   double strip_farthest_m = 0.0;

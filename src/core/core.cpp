@@ -770,6 +770,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   }
   // The pieces of strips a PC takes, each made whole after the entries (one contact made once
   // however many of deepest, first and last it is): from here on a PC's contacts are single.
+  // (The piece figures are compared only where they matter: `single` returns a single entry
+  // itself, whatever piece was noted for it.)
   int piece_slot = raw_count;
   for (int k = 0; k < found_count; ++k) {
     PcFound& pc = found[std::size_t(k)];
