@@ -780,12 +780,12 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
     // The nodes in the part's frame, made only for a part the tube may reach and that is not
-    // still left out (most of the groove's ticks leave out both walls).
+    // still left out (most of the groove's ticks leave out both walls); an aligned part's only
+    // for its evaluation as idle (LeaveOut), its pieces take theirs where they read them.
     bool in_part_frame = false;
-    // (From node `first` on: the loop below reads no node before its first piece's.)
-    const auto to_part_frame = [&](std::size_t first = 0) {
+    const auto to_part_frame = [&] {
       if (in_part_frame) return;
-      for (std::size_t i = first; i < node_count; ++i) nodes_P_[i] = part.ToPart(nodes_W[i]);
+      for (std::size_t i = 0; i < node_count; ++i) nodes_P_[i] = part.ToPart(nodes_W[i]);
       in_part_frame = true;
     };
     Eigen::Vector3d lo, hi;
@@ -833,10 +833,11 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       }
       k_begin = std::min(k_begin, capsules);
     }
-    if (k_begin == 0)
-      to_part_frame();
-    else
-      to_part_frame(std::size_t(k_begin));
+    // An aligned part's pieces take their nodes into its frame where they read them: its runs
+    // beyond one face only their face's axis (a hundred nodes a tick for a tube lying in the
+    // groove), its other pieces, a few a part, both nodes. The same sums as ToPart's, not made
+    // for every node first.
+    if (!part.aligned) to_part_frame();
     // A capsule apart from the part within the band: what forms the PCs now, the points only if
     // it becomes a load (Complete; made here, they were a third of the query's instructions for
     // a tube lying in the groove, a hundred contacts of which six become loads).
@@ -967,14 +968,16 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // grown extent reaches the part), and the distance is the nearer end's excess over the
         // face, as in OneFaceDistanceSquared. A pair whose distance the steps below would not
         // sign goes through them; nothing here has changed state by then.
-        const Eigen::Vector3d& a_P = nodes_P_[std::size_t(k)];
-        const Eigen::Vector3d& b_P = nodes_P_[std::size_t(k) + 1];
+        const Eigen::Vector3d& a_W = nodes_W[std::size_t(k)];
+        const Eigen::Vector3d& b_W = nodes_W[std::size_t(k) + 1];
         const int o = face_axis;
-        if (!all_pass && (a_P[o] > 0.0 ? std::min(a_P[o], b_P[o]) - grow > part.half_m[o]
-                                       : std::max(a_P[o], b_P[o]) + grow < part.minus_half_m[o]))
+        // The face's axis of the nodes in the part's frame, ToPart's sum (the part is aligned).
+        const double a_o = a_W[o] + part.p_PW[o], b_o = b_W[o] + part.p_PW[o];
+        if (!all_pass && (a_o > 0.0 ? std::min(a_o, b_o) - grow > part.half_m[o]
+                                    : std::max(a_o, b_o) + grow < part.minus_half_m[o]))
           continue;  // PassesBroadPhase's answer
         double t = 0.0;
-        const double e = NearerEndExcess(a_P[o], b_P[o], part.half_m[o], t);
+        const double e = NearerEndExcess(a_o, b_o, part.half_m[o], t);
         // |e|: the root of e's rounded square, which the general steps take, is |e| itself in
         // binary floating point (barring underflow, below 1e-154 m, which the test after it
         // sends to the general steps either way); without the root's latency in each capsule's
@@ -984,8 +987,6 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
           if (stood == static_cast<int>(out.size())) return count;
           KeptDistance& kept_k = kept[k];
-          const Eigen::Vector3d& a_W = nodes_W[std::size_t(k)];
-          const Eigen::Vector3d& b_W = nodes_W[std::size_t(k) + 1];
           if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
             ++coherent_skips_;
             continue;
@@ -996,6 +997,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           if (group_mask != 0) {
             emit_deferred(k, d, group_mask);
           } else {
+            const Eigen::Vector3d a_P = part.ToPart(a_W), b_P = part.ToPart(b_W);
             const Eigen::Vector3d c_P = a_P + t * (b_P - a_P);
             emit_deferred(k, d, FaceMask(part, c_P.cwiseMax(-part.half_m).cwiseMin(part.half_m)));
           }
@@ -1005,8 +1007,12 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
       const bool is_end = k == pieces - 1;
       const Eigen::Vector3d& a_W = is_end ? end_start_W : nodes_W[std::size_t(k)];
       const Eigen::Vector3d& b_W = is_end ? tip_W : nodes_W[std::size_t(k) + 1];
-      const Eigen::Vector3d& a_P = is_end ? end_start_P : nodes_P_[std::size_t(k)];
-      const Eigen::Vector3d& b_P = is_end ? nodes_P_[node_count - 1] : nodes_P_[std::size_t(k) + 1];
+      const Eigen::Vector3d a_P = is_end         ? end_start_P
+                                  : part.aligned ? part.ToPart(a_W)
+                                                 : nodes_P_[std::size_t(k)];
+      const Eigen::Vector3d b_P = part.aligned ? part.ToPart(b_W)
+                                  : is_end     ? nodes_P_[node_count - 1]
+                                               : nodes_P_[std::size_t(k) + 1];
       if (!PassesBroadPhase(part, a_P, b_P, band_m)) continue;
       if (stood == static_cast<int>(out.size())) return count;
       // Most pieces that pass the broad phase lie beside a part, farther than the band, and
