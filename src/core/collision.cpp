@@ -845,13 +845,16 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     // (RawContact::strip_pieces): the core forms PCs from strips, and needs a piece of one only
     // where it becomes a load (StripPiece); written one by one, they made a third of its contact
     // work and most of the query's writes. Its distance is the one kept for its piece (Keep,
-    // before each call here). `strip_entry`: the strip that is the last entry, if it is one.
+    // before each call here). `strip_entry`: the last strip, `strip_next` the piece that would
+    // extend it, which finds the strip the last entry: the pieces come in order, each writing its
+    // entries (a deferred one, or others) in its own turn, so an entry after the strip's would be
+    // that of strip_next or a later piece, whose turn has then come or passed.
     int strip_entry = -1, strip_next = -1;
     std::uint8_t strip_mask = 0;
     const auto emit_deferred = [&](int k, double d, std::uint8_t face_mask)
         __attribute__((always_inline)) {
       ++stood;
-      if (strip_entry == count - 1 && strip_next == k && strip_mask == face_mask) {
+      if (strip_next == k && strip_mask == face_mask) {
         RawContact& strip = out[std::size_t(strip_entry)];
         ++strip.strip_pieces;
         if (d < strip.distance_m) {
