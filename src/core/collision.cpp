@@ -990,7 +990,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
           if (stood == static_cast<int>(out.size())) return count;
           KeptDistance& kept_k = kept[k];
-          if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
+          // A pair in the band is not one the kept distance settles beyond it (KeptBeyondBand:
+          // one it settles is beyond the band in the steps below too), so that is asked only of
+          // a pair beyond the band (a hundred a tick are in it for a tube lying in the groove).
+          if (!(d < band_m) && KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
             ++coherent_skips_;
             continue;
           }
