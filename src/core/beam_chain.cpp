@@ -292,10 +292,10 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     const double f = std::hypot(fx, f_S.z());
     const double L = seg.length_m;
     if (L > 0.0) {
-      // The segment's last solution (last tick's, as a rule) is the solve's starting point.
-      const model::ElasticaSolution near = seg.solution;
+      // The segment's last solution (last tick's, as a rule) is the solve's starting point. It is
+      // read in place: the answer is a temporary until the solve returns.
       seg.solution = model::SolveElastica(std::min(f * L * L / EI_, model::kMaxElasticaAlpha),
-                                          f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0, &near);
+                                          f > 0.0 ? std::atan2(f_S.z(), fx) : 0.0, &seg.solution);
     } else {
       seg.solution = model::ElasticaSolution{};
     }
