@@ -83,6 +83,13 @@ Collision::Collision(const scene::Scene& scene, std::span<const std::uint32_t> p
       part.edge_below_m[a] = -part.half_m[a] + part_tolerance_m_;
     }
     part.aligned = part.R_WP == Eigen::Matrix3d::Identity();
+    for (int a = 0; a < 3; ++a) {
+      Eigen::Vector3d on_face_P = Eigen::Vector3d::Zero();
+      on_face_P[a] = part.minus_half_m[a];
+      part.face_mask_of_face[std::size_t(2 * a)] = FaceMask(part, on_face_P);
+      on_face_P[a] = part.half_m[a];
+      part.face_mask_of_face[std::size_t(2 * a + 1)] = FaceMask(part, on_face_P);
+    }
     parts_.push_back(part);
   }
   kept_.resize(parts_.size() * std::size_t(kMaxCapsules));
@@ -958,10 +965,13 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
                                              : (lo_g[j] - margin_m > part.edge_below_m[j] &&
                                                 hi_g[j] + margin_m < part.edge_above_m[j]));
           }
-          if (clear) {
-            Eigen::Vector3d corner_P = lo_g.cwiseMax(part.minus_half_m).cwiseMin(part.half_m);
-            group_mask = FaceMask(part, corner_P);
-          }
+          // That point's mask, kept with the part: clamped onto the part, the run's lower
+          // corner lies on the face's plane (+half_m[o] when beyond it, where lo_g[o] >
+          // half_m[o] >= 0; else -half_m[o]) and, along the other two axes, at lo_g, strictly
+          // between their edges' planes (clear), as 0 is (the planes are at +-(half_m -
+          // tolerance)): FaceMask gives it the bits of Part::face_mask_of_face's point.
+          if (clear)
+            group_mask = part.face_mask_of_face[std::size_t(2 * o + (lo_g[o] > 0.0 ? 1 : 0))];
         }
       }
       if (k < fast_end) {

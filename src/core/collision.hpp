@@ -234,6 +234,10 @@ class Collision {
     // point at or above the first lies on the face at +half_m, at or below the second on the one
     // at -half_m. Made once: FaceMask runs once a contact.
     std::array<double, 3> edge_above_m{}, edge_below_m{};
+    // FaceMask of a point on the face at -half_m (index 2 a) or +half_m (2 a + 1) along axis a,
+    // within the edges' planes of the other two axes: the face's bits alone (two for a part
+    // thinner than the tolerance). Query's runs over a face take it (collision.cpp).
+    std::array<std::uint8_t, 6> face_mask_of_face{};
     // Parts set square to the world (most scenes' floors and walls) skip the rotation: a
     // product with the identity gives the same numbers, so nothing else changes.
     bool aligned = false;
