@@ -748,41 +748,44 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
   const Eigen::Vector3d tip_W = nodes_W.back();
   const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
   const std::size_t node_count = nodes_W.size();
-  // The whole tube's bounding box first: most parts are nowhere near it. In the world frame once,
-  // for the parts aligned with it (their frame is a shift of the world's, and rounding is
-  // monotonic, so the shifted box is the box of the shifted nodes, bit for bit).
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d lo_W = Eigen::Vector3d::Constant(kInf), hi_W = -lo_W;
-  for (std::size_t i = 0; i < node_count; ++i) {
-    lo_W = lo_W.cwiseMin(nodes_W[i]);
-    hi_W = hi_W.cwiseMax(nodes_W[i]);
-  }
-  // And, for an aligned part that the tube's box reaches into by less than half its extent along
-  // some axis (a tube reaching it with its end only: the tip on the floor), the box of each run
-  // of kGroup capsules (their nodes): a run whose box is out of the part's grown box has every
-  // capsule out of it in the broad phase (each capsule's coordinates lie within its run's, and
-  // rounding is monotonic, so its grown extent lies beyond the run's). The runs out of reach
+  // The box of each run of kGroup capsules (their nodes), for an aligned part that the tube's
+  // box (below) reaches into by less than half its extent along some axis (a tube reaching it
+  // with its end only: the tip on the floor): a run whose box is out of the part's grown box has
+  // every capsule out of it in the broad phase (each capsule's coordinates lie within its run's,
+  // and rounding is monotonic, so its grown extent lies beyond the run's). The runs out of reach
   // from the held end on are passed over whole, and their nodes are not taken into the part's
   // frame. Where the capsules mostly pass (a tube lying on the part) the runs would only add
   // tests; testing every run here, not only the leading ones, cost the tube lying in the groove
   // more than it saved (the loop over the pieces tests each later run where it makes the run's
   // box in the part's frame anyway).
   const int capsules = pieces - 1;
-  bool groups_made = false;
-  const auto make_groups = [&] {
-    for (int g = 0; g * kGroup < capsules; ++g) {
-      const std::size_t first = std::size_t(g * kGroup);
-      const std::size_t last = std::size_t(std::min((g + 1) * kGroup, capsules));  // last node
-      Eigen::Vector3d lo_g = nodes_W[first], hi_g = nodes_W[first];
-      for (std::size_t i = first + 1; i <= last; ++i) {
-        lo_g = lo_g.cwiseMin(nodes_W[i]);
-        hi_g = hi_g.cwiseMax(nodes_W[i]);
-      }
-      group_lo_W_[std::size_t(g)] = lo_g;
-      group_hi_W_[std::size_t(g)] = hi_g;
+  for (int g = 0; g * kGroup < capsules; ++g) {
+    const std::size_t first = std::size_t(g * kGroup);
+    const std::size_t last = std::size_t(std::min((g + 1) * kGroup, capsules));  // last node
+    Eigen::Vector3d lo_g = nodes_W[first], hi_g = nodes_W[first];
+    for (std::size_t i = first + 1; i <= last; ++i) {
+      lo_g = lo_g.cwiseMin(nodes_W[i]);
+      hi_g = hi_g.cwiseMax(nodes_W[i]);
     }
-    groups_made = true;
-  };
+    group_lo_W_[std::size_t(g)] = lo_g;
+    group_hi_W_[std::size_t(g)] = hi_g;
+  }
+  // The whole tube's bounding box: most parts are nowhere near it. In the world frame once, for
+  // the parts aligned with it (their frame is a shift of the world's, and rounding is monotonic,
+  // so the shifted box is the box of the shifted nodes, bit for bit). From the runs' boxes and
+  // the nodes past them, not every node again (a run's box is its nodes' least and greatest
+  // coordinates, so the same box for the finite nodes the core commits; a thousand
+  // instructions of a three-PC tick).
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d lo_W = Eigen::Vector3d::Constant(kInf), hi_W = -lo_W;
+  for (int g = 0; g * kGroup < capsules; ++g) {
+    lo_W = lo_W.cwiseMin(group_lo_W_[std::size_t(g)]);
+    hi_W = hi_W.cwiseMax(group_hi_W_[std::size_t(g)]);
+  }
+  for (std::size_t i = capsules > 0 ? std::size_t(capsules) + 1 : 0; i < node_count; ++i) {
+    lo_W = lo_W.cwiseMin(nodes_W[i]);
+    hi_W = hi_W.cwiseMax(nodes_W[i]);
+  }
   for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
@@ -830,7 +833,6 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     }
     int k_begin = 0;
     if (by_group) {
-      if (!groups_made) make_groups();
       for (; k_begin < capsules; k_begin += kGroup) {
         const Eigen::Vector3d lo_g = group_lo_W_[std::size_t(k_begin / kGroup)] + part.p_PW;
         const Eigen::Vector3d hi_g = group_hi_W_[std::size_t(k_begin / kGroup)] + part.p_PW;
@@ -923,7 +925,6 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     for (int k = k_begin; k < pieces; ++k) {
       if (k == next_run && k < capsules) {
         next_run = (k / kGroup + 1) * kGroup;
-        if (!groups_made) make_groups();
         const Eigen::Vector3d lo_g = group_lo_W_[std::size_t(k / kGroup)] + part.p_PW;
         const Eigen::Vector3d hi_g = group_hi_W_[std::size_t(k / kGroup)] + part.p_PW;
         int beyond = 0;
