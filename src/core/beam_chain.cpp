@@ -304,7 +304,9 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     const model::ElasticaTip& tip = seg.solution.tip;
     origin_H += R_HS * (L * tip.deflection * seg.bend_x_S +
                         L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
-    R_HS = R_HS * Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
+    const Eigen::Matrix3d tip_R_S = Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
+    seg.tip_tangent_S = tip_R_S * Eigen::Vector3d::UnitZ();
+    R_HS = R_HS * tip_R_S;
     clamp_m = end_m;
   }
   return segment_count;
@@ -388,12 +390,10 @@ Eigen::Vector3d BeamChain::ElasticaPoint(const std::array<ElasticaSegment, kMaxL
   const ElasticaSegment& last = segments[std::size_t(segment_count - 1)];
   const double L = last.length_m;
   const model::ElasticaTip& tip = last.solution.tip;
-  const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(last.bend_x_S);
   const Eigen::Vector3d tip_H =
       last.origin_H + last.R_HS * (L * tip.deflection * last.bend_x_S +
                                    L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
-  const Eigen::Vector3d tangent_H =
-      last.R_HS * (Eigen::AngleAxisd(tip.tip_angle_rad, y_S) * Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d tangent_H = last.R_HS * last.tip_tangent_S;
   return tip_H + (s_m - last.clamp_m - L) * tangent_H;
 }
 
@@ -442,9 +442,7 @@ Eigen::Vector3d BeamChain::ElasticaTipTangent(
     const std::array<ElasticaSegment, kMaxLoads>& segments, int segment_count) const {
   if (segment_count == 0) return Eigen::Vector3d::UnitZ();
   const ElasticaSegment& last = segments[std::size_t(segment_count - 1)];
-  const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(last.bend_x_S);
-  return last.R_HS *
-         (Eigen::AngleAxisd(last.solution.tip.tip_angle_rad, y_S) * Eigen::Vector3d::UnitZ());
+  return last.R_HS * last.tip_tangent_S;
 }
 
 Eigen::Matrix3d BeamChain::ElasticaCompliance(const ElasticaSegment& segment,

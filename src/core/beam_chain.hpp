@@ -62,6 +62,10 @@ struct ElasticaSegment {
   Eigen::Vector3d origin_H = Eigen::Vector3d::Zero();   ///< clamp cross-section centre
   Eigen::Matrix3d R_HS = Eigen::Matrix3d::Identity();   ///< clamp frame S (z along the tangent)
   Eigen::Vector3d bend_x_S = Eigen::Vector3d::UnitX();  ///< bending direction in S
+  /// Unit tangent at the tip in S: the tip's turn (tip angle about z x bend_x_S) applied to z,
+  /// kept from SolveElasticaChain's carry of the clamp frame, which forms that turn anyway (the
+  /// tick's tip tangent took another sine and cosine of the same angle).
+  Eigen::Vector3d tip_tangent_S = Eigen::Vector3d::UnitZ();
   double clamp_m = 0.0, length_m = 0.0;
 };
 
