@@ -137,7 +137,11 @@ struct Core::State {
   Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
   Eigen::Matrix3d R_held_prev_W = Eigen::Matrix3d::Identity();
-  std::array<Load, kMaxLoads> prev{};
+  // Last tick's loads, load_sets[prev_set][0, prev_count), and the scratch for this tick's, the
+  // other set: a tick ends by turning them over, not by copying its loads (~100 instructions a
+  // load, six a tick with three PCs in the groove).
+  std::array<std::array<Load, kMaxLoads>, 2> load_sets{};
+  int prev_set = 0;
   int prev_count = 0;
   // The loads of the last tick as the beam saw them (the shape, and Centreline on request).
   std::array<BeamLoad, kMaxLoads> beam_loads{};
@@ -199,7 +203,6 @@ struct Core::State {
   // (RawContact::strip_pieces): three a PC at most.
   std::array<RawContact, kMaxRawContacts + 3 * kMaxContacts> raw{};
   std::array<Eigen::Vector3d, kMaxCapsules + 1> nodes_W{};
-  std::array<Load, kMaxLoads> loads{};
   std::array<std::array<Eigen::Matrix3d, kMaxLoads>, kMaxLoads> W{};  // world frame
   // The part of W_ij that is the turn of load i's section moving its offset surface point,
   // where the beam does not carry the offsets' moments (the elastica), for loads with friction:
@@ -520,6 +523,8 @@ const StepOutput& Core::Step(double t_s, const Eigen::Isometry3d& X_W_hand) {
 bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_idle) {
   Impl& m = *impl_;
   using Load = Impl::Load;
+  const std::array<Load, kMaxLoads>& prev = m.load_sets[std::size_t(m.prev_set)];
+  std::array<Load, kMaxLoads>& loads = m.load_sets[std::size_t(1 - m.prev_set)];
   const double T = scene_.model.time_step_s;
   const double K = scene_.contact.stiffness_N_per_m;
   const double eps = scene_.contact.threshold_m;
@@ -583,7 +588,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int q = 0; q < m.prev_count; ++q) {
       // A load that carried force is in this tick's system; an end face's relaxed load point is
       // carried to the next tick even while open.
-      const Load& before = m.prev[std::size_t(q)];
+      const Load& before = prev[std::size_t(q)];
       if (before.part_element >= 0 &&
           (before.active || before.pressure_centre || !before.force_W.isZero(0.0)))
         m.may_leave_out[elements_[std::size_t(before.part_element)].part_index] = 0;
@@ -607,7 +612,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   {
     double pressed_N = 0.0;
     for (int q = 0; q < m.prev_count; ++q) {
-      const Load& before = m.prev[std::size_t(q)];
+      const Load& before = prev[std::size_t(q)];
       if (before.active && before.s_m >= l && before.tube != states::TubeElement::kSide &&
           before.part_element >= 0 &&
           IsFaceMask(elements_[std::size_t(before.part_element)].face_mask))
@@ -829,7 +834,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       truncated = true;
       return;
     }
-    Load& ld = m.loads[std::size_t(load_count++)];
+    Load& ld = loads[std::size_t(load_count++)];
     ld = Load{};
     ld.pc = pc;
     ld.end = end;
@@ -969,12 +974,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<bool, kMaxLoads> from_rim{};
   for (int pass = 0; pass < 3; ++pass) {
     for (int i = 0; i < load_count; ++i) {
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       if (ld.matched) continue;
       int best = -1;
       double best_ds = m.beam.group_tolerance_m();
       for (int q = 0; q < m.prev_count; ++q) {
-        const Load& before = m.prev[std::size_t(q)];
+        const Load& before = prev[std::size_t(q)];
         if (taken[std::size_t(q)] || before.part_element != ld.part_element) continue;
         if (pass == 0 && !continues_centre(ld, before) && !continues_rim(ld, before)) continue;
         if (pass == 1 && !before.SameKey(ld)) continue;
@@ -983,7 +988,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         if (pass < 2) break;
       }
       if (best < 0) continue;
-      const Load& before = m.prev[std::size_t(best)];
+      const Load& before = prev[std::size_t(best)];
       taken[std::size_t(best)] = true;
       ld.matched = true;
       ld.continues = true;
@@ -1042,7 +1047,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const Eigen::Vector3d& tip_W = m.nodes_W[std::size_t(N)];
     const Eigen::Vector3d end_axis_W = tangent_at(l);
     for (int i = 0; i < load_count; ++i) {
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       if (!ld.pressure_centre || ld.ghost) continue;
       ld.dome_spring =
           (linear_beam || m.rod_shape) && !on_rim[std::size_t(i)] && !from_rim[std::size_t(i)];
@@ -1072,13 +1077,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // A load of last tick that nothing continues but that carried force is still in the shape:
   // it stays in this tick as a ghost, open, so that its force is taken out of the shape.
   for (int q = 0; q < m.prev_count; ++q) {
-    const Load& before = m.prev[std::size_t(q)];
+    const Load& before = prev[std::size_t(q)];
     if (taken[std::size_t(q)] || before.force_W.isZero(0.0)) continue;
     if (load_count == kMaxLoads) {
       truncated = true;
       break;
     }
-    Load& ghost = m.loads[std::size_t(load_count++)];
+    Load& ghost = loads[std::size_t(load_count++)];
     ghost = before;
     ghost.pc = -1;
     ghost.f_lin_W = before.shape_force_W;
@@ -1098,7 +1103,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // 5. The beam's compliance between the load points, about last tick's forces.
   m.SaveShape(std::size_t(N) + 1, out);
   for (int i = 0; i < load_count; ++i) {
-    Load& ld = m.loads[std::size_t(i)];
+    Load& ld = loads[std::size_t(i)];
     if (!ld.ghost) {
       const Eigen::Vector3d centre_W = p_start_W + R_WH * interpolate_node(ld.s_m);
       ld.r_H_m = R_WH.transpose() * (ld.x0_W - centre_W);
@@ -1119,7 +1124,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // carried it, at the arc position, offset and cut of the load it continues (a ghost: its own).
   // False if load j carries no f_lin.
   const auto reference_of = [&](int j, BeamLoad& then_j) {
-    const Load& lj = m.loads[std::size_t(j)];
+    const Load& lj = loads[std::size_t(j)];
     if (!lj.continues || lj.f_lin_W.isZero(0.0)) return false;
     then_j = m.beam_loads[std::size_t(j)];
     then_j.s_m = lj.lin_s_m;
@@ -1174,7 +1179,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // column). The linear model takes last tick's shape out whole (below): its members are the
     // loads in contact, and the cuts are the ones step 8 draws the shape with.
     for (int i = 0; i < load_count; ++i) {
-      const Load& ld = m.loads[std::size_t(i)];
+      const Load& ld = loads[std::size_t(i)];
       member[std::size_t(i)] = ld.active || (want_elastica && !ld.f_lin_W.isZero(0.0));
     }
     int members = 0;
@@ -1203,7 +1208,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // tangent, which then also gives the end's response to a moment. None for the elastica.
     dome.load = -1;
     for (int e = 0; e < load_count && (!want_elastica || (!use_elastica && members > 0)); ++e) {
-      const Load& ld = m.loads[std::size_t(e)];
+      const Load& ld = loads[std::size_t(e)];
       const double N0 = ld.f_lin_W.dot(ld.normal_W);
       if (!member[std::size_t(e)] || !(N0 > 0.0)) continue;
       const BeamLoad& at = m.beam_loads[std::size_t(e)];
@@ -1444,7 +1449,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // column (24 bytes) straddles the 16-byte stores that wrote it, and such a load waits for
     // them to reach the cache (`perf` had a third of this function's time on that load).
     for (int i = 0; i < load_count; ++i) {
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       ld.base_W = ld.x0_W - p_start_W;
       if (!want_elastica) continue;  // the linear model's base: below
       for (int j = 0; j < load_count; ++j)
@@ -1452,7 +1457,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         // and makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
         if (member[std::size_t(j)])
           ld.base_W.noalias() -=
-              m.W[std::size_t(i)][std::size_t(j)] * m.loads[std::size_t(j)].f_lin_W;
+              m.W[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
     }
     // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
     // by where last tick's loads were. The tick's shape is x_straight + W F (step 8), so
@@ -1475,9 +1480,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         // A member whose load has not moved: its column, just computed, is W(s_i, s_j then).
         const bool same = member[std::size_t(j)] && !moved(j, then_j);
         for (int i = 0; i < load_count; ++i)
-          m.loads[std::size_t(i)].base_W -=
+          loads[std::size_t(i)].base_W -=
               same ? Eigen::Vector3d(m.W[std::size_t(i)][std::size_t(j)] *
-                                     m.loads[std::size_t(j)].f_lin_W)
+                                     loads[std::size_t(j)].f_lin_W)
                    : Eigen::Vector3d(
                          R_WH *
                          (m.beam.Compliance(m.beam_loads[std::size_t(i)], then_j) * then_j.f_H_N));
@@ -1486,7 +1491,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     if (dome.load >= 0 && want_elastica && !rod_end_spring) dome.load = -1;
     if (dome.load >= 0) {
       const int e = dome.load;
-      const Load& ld = m.loads[std::size_t(e)];
+      const Load& ld = loads[std::size_t(e)];
       const double N0 = ld.f_lin_W.dot(ld.normal_W);
       const BeamLoad& at = m.beam_loads[std::size_t(e)];
       dome.k_r = N0 * dome.radius_m;
@@ -1545,11 +1550,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           const Eigen::Vector3d moved_H = (at.r_H_m - then_e.r_H_m).cross(then_e.f_H_N);
           dome.theta0_H -= t_M * moved_H;
           for (int i = 0; i < load_count; ++i)
-            m.loads[std::size_t(i)].base_W += R_WH * (dome.C_H[std::size_t(i)] * moved_H);
+            loads[std::size_t(i)].base_W += R_WH * (dome.C_H[std::size_t(i)] * moved_H);
         }
       }
       for (int i = 0; i < load_count; ++i) {
-        Load& li = m.loads[std::size_t(i)];
+        Load& li = loads[std::size_t(i)];
         const Eigen::Matrix3d CL = dome.C_H[std::size_t(i)] * dome.Q_H;
         li.base_W += R_WH * (CL * dome.theta0_H);
         for (int j = 0; j < load_count; ++j)
@@ -1583,7 +1588,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const auto build_stick_compliance = [&] {
     const Eigen::Vector3d t_W = R_WH.col(2);
     for (int i = 0; i < load_count; ++i) {
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       ld.stick_base_W = ld.base_W;
       ld.turn_seen = !use_elastica;
       if (!ld.friction) continue;
@@ -1601,12 +1606,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
     // The sums in a pass of their own, as the compliance's base (build_compliance).
     for (int i = 0; i < load_count; ++i) {
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       if (!ld.friction || !use_elastica) continue;
       for (int j = 0; j < load_count; ++j)
         if (member[std::size_t(j)])
           ld.stick_base_W.noalias() +=
-              m.W_turn[std::size_t(i)][std::size_t(j)] * m.loads[std::size_t(j)].f_lin_W;
+              m.W_turn[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
     }
   };
   build_compliance();
@@ -1663,7 +1668,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const auto solve_system = [&]() {
     int n_active = 0;
     for (int i = 0; i < load_count; ++i)
-      slot[std::size_t(i)] = m.loads[std::size_t(i)].active ? n_active++ : -1;
+      slot[std::size_t(i)] = loads[std::size_t(i)].active ? n_active++ : -1;
     const bool reduced = !torque_saturated;
     const int n = 3 * n_active + (reduced ? 0 : 6);
     const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
@@ -1672,7 +1677,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       const int si = slot[std::size_t(i)];
       if (si < 0) continue;
-      const Load& ld = m.loads[std::size_t(i)];
+      const Load& ld = loads[std::size_t(i)];
       const Eigen::Vector3d& nrm = ld.normal_W;
       const Eigen::Matrix3d NN = nrm * nrm.transpose();
       const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
@@ -1798,7 +1803,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const int sj = slot[std::size_t(j)];
       const Eigen::Vector3d F =
           sj >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * sj)) : Eigen::Vector3d::Zero();
-      df_H[std::size_t(j)] = R_WH.transpose() * (F - m.loads[std::size_t(j)].f_lin_W);
+      df_H[std::size_t(j)] = R_WH.transpose() * (F - loads[std::size_t(j)].f_lin_W);
     }
     const Eigen::Vector3d dp_W = p_W - p_start_W;
     const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
@@ -1856,10 +1861,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // farther than epsilon.
   const auto idle_parts_stay_open = [&](int changed_load) {
     const std::uint32_t changed_part =
-        changed_load < 0 || m.loads[std::size_t(changed_load)].ghost ||
-                m.loads[std::size_t(changed_load)].part_element < 0
+        changed_load < 0 || loads[std::size_t(changed_load)].ghost ||
+                loads[std::size_t(changed_load)].part_element < 0
             ? std::numeric_limits<std::uint32_t>::max()
-            : elements_[std::size_t(m.loads[std::size_t(changed_load)].part_element)].part_index;
+            : elements_[std::size_t(loads[std::size_t(changed_load)].part_element)].part_index;
     for (int g = 0; g < idle.group_count; ++g) {
       const IdleParts::Group& group = idle.groups[std::size_t(g)];
       if (group.first_part < changed_part &&
@@ -1871,10 +1876,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // The normal force of load i's PC in the current solve: its points' together (a point that
   // pulls counts nothing; a ghost is a PC of its own). Friction is the PC's (FrictionShare).
   const auto pc_normal_of = [&](int i) {
-    const Load& li = m.loads[std::size_t(i)];
+    const Load& li = loads[std::size_t(i)];
     double total_N = 0.0;
     for (int j = 0; j < load_count; ++j) {
-      const Load& lj = m.loads[std::size_t(j)];
+      const Load& lj = loads[std::size_t(j)];
       const int sj = slot[std::size_t(j)];
       if (sj < 0 || (j != i && (li.pc < 0 || lj.pc != li.pc))) continue;
       total_N += std::max(0.0, lj.normal_W.dot(m.z.segment<3>(3 * sj)));
@@ -1883,7 +1888,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   };
   // Where the anchors were before the solve: a sliding point's slip is its anchor's travel.
   for (int i = 0; i < load_count; ++i) {
-    Load& ld = m.loads[std::size_t(i)];
+    Load& ld = loads[std::size_t(i)];
     if (ld.friction) ld.anchor0_W = ld.anchor_W;
   }
   bool finite = true;
@@ -1898,7 +1903,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     int changed_load = -1;  // the first load whose decision changed
     for (int i = 0; i < load_count && !changed; ++i) {
       const int si = slot[std::size_t(i)];
-      Load& ld = m.loads[std::size_t(i)];
+      Load& ld = loads[std::size_t(i)];
       if (si < 0) {
         if (ld.released) continue;
         // An open load: does this tick's motion bring it within epsilon?
@@ -1998,7 +2003,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       for (int i = 0; i < load_count; ++i) {
         const int si = slot[std::size_t(i)];
         if (si >= 0)
-          moment_W += (m.loads[std::size_t(i)].x0_W - p_start_W).cross(m.z.segment<3>(3 * si));
+          moment_W += (loads[std::size_t(i)].x0_W - p_start_W).cross(m.z.segment<3>(3 * si));
       }
       if (moment_W.norm() > max_torque * (1.0 + 1e-12)) {
         // The grip cannot hold more than the device's torque: the held end turns until the
@@ -2078,7 +2083,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   std::array<Eigen::Vector3d, kMaxLoads> f_load_W;
   Eigen::Vector3d total_W = Eigen::Vector3d::Zero();
   for (int i = 0; i < load_count; ++i) {
-    Load& ld = m.loads[std::size_t(i)];
+    Load& ld = loads[std::size_t(i)];
     const int si = slot[std::size_t(i)];
     Eigen::Vector3d& F = f_load_W[std::size_t(i)];
     F = si >= 0 ? Eigen::Vector3d(m.z.segment<3>(3 * si)) : Eigen::Vector3d::Zero();
@@ -2110,13 +2115,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // The dome's point moves with the end's turn under its spring, -R turn x z (build_compliance),
   // kept on the face (within r1 of its centre, where the dome meets the rim).
   Eigen::Vector3d dome_shift_H = Eigen::Vector3d::Zero();
-  if (dome.load >= 0 && m.loads[std::size_t(dome.load)].active) {
+  if (dome.load >= 0 && loads[std::size_t(dome.load)].active) {
     // The end's turn along Q under the spring (its turn across Q is not resisted, and does not
     // move the point: the rim's radial direction).
     const Eigen::Vector3d turn_H =
         want_elastica ? Eigen::Vector3d(dome.turn_of_turn_H * forces_turn())
                       : Eigen::Vector3d(dome_turn() / (1.0 + dome.k_r * dome.turn_per_moment));
-    const Load& ld = m.loads[std::size_t(dome.load)];
+    const Load& ld = loads[std::size_t(dome.load)];
     const Eigen::Vector3d from_H = ld.r_H_m - dome.axis_H.dot(ld.r_H_m) * dome.axis_H;
     Eigen::Vector3d to_H = from_H - dome.radius_m * turn_H.cross(dome.axis_H);
     const double r1 = scene_.tube.outer_radius_m;
@@ -2126,7 +2131,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   }
   int beam_count = 0;
   for (int i = 0; i < load_count; ++i) {
-    Load& ld = m.loads[std::size_t(i)];
+    Load& ld = loads[std::size_t(i)];
     ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
     for (int j = 0; j < load_count; ++j) {
       const int sj = slot[std::size_t(j)];
@@ -2177,11 +2182,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const scene::Friction* friction = nullptr;
     double pc_normal_N = 0.0;  // the share each point's friction ratio is taken against
     for (int i = 0; i < load_count; ++i) {
-      const Load& ld = m.loads[std::size_t(i)];
+      const Load& ld = loads[std::size_t(i)];
       if (ld.pc == k && ld.active) pc_normal_N += std::max(0.0, ld.normal_W.dot(ld.force_W));
     }
     for (int i = 0; i < load_count; ++i) {
-      const Load& ld = m.loads[std::size_t(i)];
+      const Load& ld = loads[std::size_t(i)];
       if (ld.pc != k || !ld.active) continue;
       ++pc.loads;
       friction = ld.friction;
@@ -2233,8 +2238,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   int members = 0;
   const int groups = m.beam.Assign(m.beam_loads, beam_count, all, m.order, members);
   for (int i = 0, k = 0; i < load_count; ++i)
-    if (m.loads[std::size_t(i)].active)
-      m.loads[std::size_t(i)].clamp_m = m.beam_loads[std::size_t(k++)].clamp_m;
+    if (loads[std::size_t(i)].active)
+      loads[std::size_t(i)].clamp_m = m.beam_loads[std::size_t(k++)].clamp_m;
   double load_N = 0.0;
   for (int j = 0; j < beam_count; ++j) load_N += m.beam_loads[std::size_t(j)].f_H_N.norm();
   if (m.elastica_held_off && load_N < 0.5 * m.held_off_load_N) m.elastica_held_off = false;
@@ -2403,8 +2408,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       }
       if (pinned) {
         for (int i = 0, k = 0; i < load_count; ++i)
-          if (m.loads[std::size_t(i)].active)
-            m.loads[std::size_t(i)].shape_force_W = R_WH * m.beam_loads[std::size_t(k++)].f_H_N;
+          if (loads[std::size_t(i)].active)
+            loads[std::size_t(i)].shape_force_W = R_WH * m.beam_loads[std::size_t(k++)].f_H_N;
       }
     }
   }
@@ -2531,7 +2536,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // there from tick to tick.
     double end_m = pc.s_m;
     for (int j = 0; j < load_count; ++j) {
-      const Load& ld = m.loads[std::size_t(j)];
+      const Load& ld = loads[std::size_t(j)];
       if (ld.active && ld.tube == pc.tube && ld.part_element == pc.part_element)
         end_m = std::max(end_m, ld.s_m);
     }
@@ -2613,11 +2618,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   m.R_held_prev_W = R_WH_new;
   m.shape_flags = out.flags & (kLinearFallback | kBeyondLinearRange | kRodShape |
                                kShapeOffContacts | kSegmentationOff);
-  // Ghosts have done their work; the next tick continues this tick's real loads.
-  m.prev_count = 0;
-  for (int i = 0; i < load_count; ++i)
-    if (!m.loads[std::size_t(i)].ghost)
-      m.prev[std::size_t(m.prev_count++)] = m.loads[std::size_t(i)];
+  // Ghosts have done their work; the next tick continues this tick's real loads (ghosts are
+  // added after them, so the loop moves none in practice).
+  int real_count = 0;
+  for (int i = 0; i < load_count; ++i) {
+    if (loads[std::size_t(i)].ghost) continue;
+    if (real_count != i) loads[std::size_t(real_count)] = loads[std::size_t(i)];
+    ++real_count;
+  }
+  m.prev_count = real_count;
+  m.prev_set = 1 - m.prev_set;
   return true;
 }
 
