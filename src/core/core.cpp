@@ -33,9 +33,10 @@ constexpr int kTangentReuseTicks = 50;
 // ticks of other sizes paid for it.
 template <int kN>
 [[gnu::noinline]] void SolveFixed(Eigen::PartialPivLU<Eigen::Matrix<double, kN, kN>>& lu,
-                                  const SystemMatrix& M, const SystemVector& rhs, SystemVector& z) {
-  lu.compute(M.topLeftCorner<kN, kN>());
-  z = lu.solve(rhs.head<kN>());
+                                  const Eigen::Matrix<double, kN, kN>& M,
+                                  const Eigen::Matrix<double, kN, 1>& rhs, SystemVector& z) {
+  lu.compute(M);
+  z = lu.solve(rhs);
 }
 
 // f_k(N) = a + b N, tangent to mu_k N0 (N/N0)^beta at N (exact for beta = 1). At N = 0 with
@@ -1672,65 +1673,80 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const bool reduced = !torque_saturated;
     const int n = 3 * n_active + (reduced ? 0 : 6);
     const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
-    m.M.setZero(n, n);
-    m.rhs.setZero(n);
-    for (int i = 0; i < load_count; ++i) {
-      const int si = slot[std::size_t(i)];
-      if (si < 0) continue;
-      const Load& ld = loads[std::size_t(i)];
-      const Eigen::Vector3d& nrm = ld.normal_W;
-      const Eigen::Matrix3d NN = nrm * nrm.transpose();
-      const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
-      const bool stuck = ld.friction && !ld.sliding;
-      // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
-      // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
-      const Eigen::Vector3d n_eff =
-          ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
-      // The normal part and the stuck spring (which sees the point without the one-way turn of
-      // its offset, section 5).
-      const Eigen::Matrix3d Gn = K * n_eff * nrm.transpose();
-      const Eigen::Matrix3d Gt = (stuck ? Kt : 0.0) * Tp;
-      const Eigen::Matrix3d G = Gn + Gt;
-      Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
-      if (stuck) b += Kt * (Tp * ld.anchor_W);
-      if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
-      const int r = 3 * si;
-      m.M.block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
-      // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
-      const Eigen::Matrix3d G_p = reduced ? Eigen::Matrix3d(G / Kc_eff) : Eigen::Matrix3d::Zero();
-      for (int j = 0; j < load_count; ++j) {
-        const int sj = slot[std::size_t(j)];
-        if (sj < 0) continue;
-        const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
-        m.M.block<3, 3>(r, 3 * sj) += G * Wij + G_p;
-        if (stuck) m.M.block<3, 3>(r, 3 * sj) -= Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
+    // Into a zeroed M and rhs of n rows: the dynamic system's, or a fixed-size one's (below).
+    const auto assemble = [&](auto& M, auto& rhs) {
+      for (int i = 0; i < load_count; ++i) {
+        const int si = slot[std::size_t(i)];
+        if (si < 0) continue;
+        const Load& ld = loads[std::size_t(i)];
+        const Eigen::Vector3d& nrm = ld.normal_W;
+        const Eigen::Matrix3d NN = nrm * nrm.transpose();
+        const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
+        const bool stuck = ld.friction && !ld.sliding;
+        // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
+        // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
+        const Eigen::Vector3d n_eff =
+            ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
+        // The normal part and the stuck spring (which sees the point without the one-way turn of
+        // its offset, section 5).
+        const Eigen::Matrix3d Gn = K * n_eff * nrm.transpose();
+        const Eigen::Matrix3d Gt = (stuck ? Kt : 0.0) * Tp;
+        const Eigen::Matrix3d G = Gn + Gt;
+        Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
+        if (stuck) b += Kt * (Tp * ld.anchor_W);
+        if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
+        const int r = 3 * si;
+        M.template block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
+        // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
+        const Eigen::Matrix3d G_p = reduced ? Eigen::Matrix3d(G / Kc_eff) : Eigen::Matrix3d::Zero();
+        for (int j = 0; j < load_count; ++j) {
+          const int sj = slot[std::size_t(j)];
+          if (sj < 0) continue;
+          const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+          M.template block<3, 3>(r, 3 * sj) += G * Wij + G_p;
+          if (stuck)
+            M.template block<3, 3>(r, 3 * sj) -= Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
+        }
+        // The held end's turn omega moves the point by omega x r, r from the held end.
+        const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
+        rhs.template segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
+        if (reduced) {
+          rhs.template segment<3>(r) += G * (Rx * e_grip) - G_p * A;
+          continue;
+        }
+        M.template block<3, 3>(r, ip) = G;
+        M.template block<3, 3>(r, iw) = -G * Rx;
+        M.template block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
+        M.template block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
       }
-      // The held end's turn omega moves the point by omega x r, r from the held end.
-      const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
-      m.rhs.segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
-      if (reduced) {
-        m.rhs.segment<3>(r) += G * (Rx * e_grip) - G_p * A;
-        continue;
-      }
-      m.M.block<3, 3>(r, ip) = G;
-      m.M.block<3, 3>(r, iw) = -G * Rx;
-      m.M.block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
-      m.M.block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
-    }
+    };
     if (reduced) {
-      // One load, two or three (most ticks): the fixed-size factorisation, the same partial
-      // pivoting in the same order (the same bits) without the dynamic one's blocking and
+      // One load, two or three (most ticks): assembled and factorised at fixed size, the same
+      // partial pivoting in the same order (the same bits) without the dynamic one's blocking and
       // bookkeeping, which cost a 3 x 3 system ~700 instructions (and a 9 x 9 one, three PCs in
-      // the groove, ~1500).
+      // the groove, ~1500); the blocks' addresses then are constants too (assembled into the
+      // dynamic matrix, the 9 x 9 system's assembly took ~500 instructions more).
       if (n == 3) {
-        m.lu3.compute(m.M.topLeftCorner<3, 3>());
-        m.z = m.lu3.solve(m.rhs.head<3>());
+        Eigen::Matrix3d M3 = Eigen::Matrix3d::Zero();
+        Eigen::Vector3d rhs3 = Eigen::Vector3d::Zero();
+        assemble(M3, rhs3);
+        m.lu3.compute(M3);
+        m.z = m.lu3.solve(rhs3);
       } else if (n == 6) {
-        m.lu6.compute(m.M.topLeftCorner<6, 6>());
-        m.z = m.lu6.solve(m.rhs.head<6>());
+        Eigen::Matrix<double, 6, 6> M6 = Eigen::Matrix<double, 6, 6>::Zero();
+        Eigen::Matrix<double, 6, 1> rhs6 = Eigen::Matrix<double, 6, 1>::Zero();
+        assemble(M6, rhs6);
+        m.lu6.compute(M6);
+        m.z = m.lu6.solve(rhs6);
       } else if (n == 9) {
-        SolveFixed(m.lu9, m.M, m.rhs, m.z);
+        Eigen::Matrix<double, 9, 9> M9 = Eigen::Matrix<double, 9, 9>::Zero();
+        Eigen::Matrix<double, 9, 1> rhs9 = Eigen::Matrix<double, 9, 1>::Zero();
+        assemble(M9, rhs9);
+        SolveFixed(m.lu9, M9, rhs9, m.z);
       } else if (n > 0) {
+        m.M.setZero(n, n);
+        m.rhs.setZero(n);
+        assemble(m.M, m.rhs);
         m.lu.compute(m.M);
         m.z = m.lu.solve(m.rhs);
       } else {
@@ -1743,6 +1759,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       omega_W = e_grip;
       return p_W.allFinite();
     }
+    m.M.setZero(n, n);
+    m.rhs.setZero(n);
+    assemble(m.M, m.rhs);
     m.M.block<3, 3>(ip, ip) = Kc_eff * Eigen::Matrix3d::Identity();
     m.rhs.segment<3>(ip) = A;
     {
