@@ -1597,8 +1597,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const Eigen::Matrix3d M_i =
           bi.r_H_m.z() * Eigen::Matrix3d::Identity() - t_W * (R_WH * bi.r_H_m).transpose();
       for (int j = 0; j < load_count; ++j) {
+        // A load that is not a member is in no sum or system as one (a load that closes in a
+        // pass becomes a member first, and the compliances are built again): its block is not
+        // read.
+        if (!member[std::size_t(j)]) continue;
         Eigen::Matrix3d& Dij = m.W_turn[std::size_t(i)][std::size_t(j)];
-        if (!use_elastica || !member[std::size_t(j)]) {
+        if (!use_elastica) {
           Dij.setZero();
           continue;
         }
