@@ -1187,16 +1187,16 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
     use_elastica = want_elastica && !m.elastica_held_off && members > 0 &&
                    m.beam.ElasticaCovers(m.beam_loads, m.order, members, groups);
+    // A load that is not a member moves nothing, and is in no sum or system as one (a load that
+    // closes in a pass becomes a member first, and the compliances are built again): its column
+    // is left unwritten and is never read (most of the loads of a tube lying in the groove, in
+    // the band of a wall it does not touch).
     const auto linear_compliance = [&] {
       for (int i = 0; i < load_count; ++i)
-        for (int j = 0; j < load_count; ++j) {
-          Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
+        for (int j = 0; j < load_count; ++j)
           if (member[std::size_t(j)])
             m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
-                              !use_elastica, Wij);
-          else
-            Wij.setZero();
-        }
+                              !use_elastica, m.W[std::size_t(i)][std::size_t(j)]);
     };
     linear_compliance();
     bool rod_end_spring = false;  // the rod's tangent, with the end's response to a moment
@@ -1438,8 +1438,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         }
       }
     }
-    // A load that is not a member moves nothing: its column is zero in any frame (most of the
-    // loads of a tube lying in the groove, in the band of a wall it does not touch).
+    // A load that is not a member: its column is not read (linear_compliance).
     for (int i = 0; i < load_count; ++i)
       for (int j = 0; j < load_count; ++j)
         if (member[std::size_t(j)]) {
