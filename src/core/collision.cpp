@@ -748,16 +748,14 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
   const Eigen::Vector3d tip_W = nodes_W.back();
   const Eigen::Vector3d end_start_W = tip_W - end_m_ * tip_tangent_W;
   const std::size_t node_count = nodes_W.size();
-  // The box of each run of kGroup capsules (their nodes), for an aligned part that the tube's
-  // box (below) reaches into by less than half its extent along some axis (a tube reaching it
-  // with its end only: the tip on the floor): a run whose box is out of the part's grown box has
-  // every capsule out of it in the broad phase (each capsule's coordinates lie within its run's,
-  // and rounding is monotonic, so its grown extent lies beyond the run's). The runs out of reach
-  // from the held end on are passed over whole, and their nodes are not taken into the part's
-  // frame. Where the capsules mostly pass (a tube lying on the part) the runs would only add
-  // tests; testing every run here, not only the leading ones, cost the tube lying in the groove
-  // more than it saved (the loop over the pieces tests each later run where it makes the run's
-  // box in the part's frame anyway).
+  // The box of each run of kGroup capsules (their nodes), made every query: a run whose box is
+  // out of an aligned part's grown box has every capsule out of it in the broad phase (each
+  // capsule's coordinates lie within its run's, and rounding is monotonic, so its grown extent
+  // lies beyond the run's), and is passed over whole. Two places ask: before the loop over the
+  // pieces, the leading runs of a part the tube's box (below) reaches into by less than half its
+  // extent along some axis (a tube reaching it with its end only: the tip on the floor); in the
+  // loop, each later run, where its box in the part's frame is made anyway. The runs' boxes also
+  // give the tube's box.
   const int capsules = pieces - 1;
   for (int g = 0; g * kGroup < capsules; ++g) {
     const std::size_t first = std::size_t(g * kGroup);
