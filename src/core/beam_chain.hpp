@@ -245,6 +245,21 @@ class BeamChain {
   bool moments_finite_ = false;
   model::Rod rod_;
   scene::MultiContactRule rule_ = scene::MultiContactRule::kSegmented;
+  /// A centreline node's cubic Hermite weights (ElasticaNodes): the samples j and j + 1 it lies
+  /// between, and the weights of their points and of their tangents (the latter times the
+  /// samples' spacing h).
+  struct HermiteNode {
+    int j = 0;
+    double point0 = 0.0, tangent0_h = 0.0, point1 = 0.0, tangent1_h = 0.0;
+  };
+  static HermiteNode Hermite(double s_m, double clamp_m, double h_m);
+  /// The weights of the nodes of a segment clamped at the held end and as long as the tube
+  /// (clamp 0, length l: the tip loaded, one segment), for the tick's node count (the core's
+  /// ChainCapsuleCount + 1), the first `full_nodes_` of them on that segment: the same numbers
+  /// every tick, made once here. ElasticaNodes forms them per node otherwise.
+  std::array<HermiteNode, kMaxCapsules + 1> full_hermite_{};
+  int full_node_count_ = 0;  ///< the node count they are for (0: none)
+  int full_nodes_ = 0;
 };
 
 }  // namespace tubeplan::core
