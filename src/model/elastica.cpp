@@ -615,9 +615,14 @@ void SolveElliptic(const Loading& load, ElasticaSolution& solution, const Elasti
     const Loading near_load = LoadingOf(*near);
     const double t_near =
         near->tip.tip_angle_rad * (alpha * load.cos_psi) / (near->alpha * near_load.cos_psi);
-    const double y_near = 2.0 * std::asin(std::min(near->modulus_kc, 1.0)) *
-                          (load.c0 / near_load.c0) * ((1.0 + near_load.s0) / (1.0 + load.s0)) *
-                          std::exp(std::sqrt(near->alpha) - std::sqrt(alpha));
+    // y is SolveAmplitudeFrom's unknown only where t is above half its range: below it (the
+    // tick's warm starts, as a rule) its asin, exp and two roots would be formed for nothing.
+    const double y_near = t_near < 0.5 * load.gap
+                              ? 0.0
+                              : 2.0 * std::asin(std::min(near->modulus_kc, 1.0)) *
+                                    (load.c0 / near_load.c0) *
+                                    ((1.0 + near_load.s0) / (1.0 + load.s0)) *
+                                    std::exp(std::sqrt(near->alpha) - std::sqrt(alpha));
     warm = SolveAmplitudeFrom(load, alpha, t_near, y_near, root);
   }
   if (!warm) {
