@@ -304,9 +304,9 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     // The bending direction: along the lateral load; with none (axial load), the clamp's x.
     seg.bend_x_S =
         fx > 0.0 ? Eigen::Vector3d(f_S.x() / fx, f_S.y() / fx, 0.0) : Eigen::Vector3d::UnitX();
-    const double f = std::hypot(fx, f_S.z());
     const double L = seg.length_m;
     if (L > 0.0) {
+      const double f = std::hypot(fx, f_S.z());
       // The segment's last solution (last tick's, as a rule) is the solve's starting point. It is
       // read in place: the answer is a temporary until the solve returns.
       seg.solution = model::SolveElastica(std::min(f * L * L / EI_, model::kMaxElasticaAlpha),
@@ -314,14 +314,24 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
     } else {
       seg.solution = model::ElasticaSolution{};
     }
-    // Carry the clamp to the segment's tip: there the next segment starts.
-    const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(seg.bend_x_S);
-    const model::ElasticaTip& tip = seg.solution.tip;
-    origin_H += R_HS * (L * tip.deflection * seg.bend_x_S +
-                        L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
-    const Eigen::Matrix3d tip_R_S = Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
-    seg.tip_tangent_S = tip_R_S * Eigen::Vector3d::UnitZ();
-    R_HS = R_HS * tip_R_S;
+    // A first segment of no length (a load at the held end: three PCs, every tick) carries the
+    // clamp nowhere, and its carry changes no bit: it leaves the origin at +0, and its turn by
+    // a zero angle is the identity with zeros of either sign off the diagonal, so the identity
+    // times it is the identity again (each zero entry a sum with a +0 term) and its z column is
+    // z. So it is left out: an axis-angle rotation, a 3 x 3 product and the move, 0.24 k
+    // instructions a three-PC tick.
+    if (L > 0.0 || segment_count > 1) {
+      // Carry the clamp to the segment's tip: there the next segment starts.
+      const Eigen::Vector3d y_S = Eigen::Vector3d::UnitZ().cross(seg.bend_x_S);
+      const model::ElasticaTip& tip = seg.solution.tip;
+      origin_H += R_HS * (L * tip.deflection * seg.bend_x_S +
+                          L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
+      const Eigen::Matrix3d tip_R_S = Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
+      seg.tip_tangent_S = tip_R_S * Eigen::Vector3d::UnitZ();
+      R_HS = R_HS * tip_R_S;
+    } else {
+      seg.tip_tangent_S = Eigen::Vector3d::UnitZ();
+    }
     clamp_m = end_m;
   }
   return segment_count;
