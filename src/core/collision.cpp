@@ -784,6 +784,10 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     lo_W = lo_W.cwiseMin(nodes_W[i]);
     hi_W = hi_W.cwiseMax(nodes_W[i]);
   }
+  // The radius and CapsuleBoxDistance's least axis distance, as the runs over a face below take
+  // them: read from the members, they were loaded and multiplied again for each capsule (the
+  // query's writes could alias them).
+  const double r1_m = radius_m_, axis_floor_m = 1e-6 * radius_m_;
   for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
@@ -856,13 +860,16 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     // extend it, which finds the strip the last entry: the pieces come in order, each writing its
     // entries (a deferred one, or others) in its own turn, so an entry after the strip's would be
     // that of strip_next or a later piece, whose turn has then come or passed.
-    int strip_entry = -1, strip_next = -1;
+    // (The strip's entry as a pointer, not an index: its address is not formed again for each
+    // piece that joins it.)
+    RawContact* strip_entry = nullptr;
+    int strip_next = -1;
     std::uint8_t strip_mask = 0;
     const auto emit_deferred = [&](int k, double d, std::uint8_t face_mask)
         __attribute__((always_inline)) {
       ++stood;
       if (strip_next == k && strip_mask == face_mask) {
-        RawContact& strip = out[std::size_t(strip_entry)];
+        RawContact& strip = *strip_entry;
         ++strip.strip_pieces;
         if (d < strip.distance_m) {
           strip.distance_m = d;
@@ -873,7 +880,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         return;
       }
       if (IsFaceMask(face_mask)) {
-        strip_entry = count;
+        strip_entry = &out[std::size_t(count)];
         strip_next = k + 1;
         strip_mask = face_mask;
       }
@@ -1019,20 +1026,28 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // sends to the general steps either way); without the root's latency in each capsule's
         // chain of dependent operations.
         const double axis_m = std::abs(e);
-        const double d = axis_m - radius_m_;
-        if (axis_m > 1e-6 * radius_m_ && d > 0.0) {
+        const double d = axis_m - r1_m;
+        if (axis_m > axis_floor_m && d > 0.0) {
           if (stood == static_cast<int>(out.size())) return count;
           KeptDistance& kept_k = kept[k];
           // A pair in the band is not one the kept distance settles beyond it (KeptBeyondBand:
           // one it settles is beyond the band in the steps below too), so that is asked only of
           // a pair beyond the band (a hundred a tick are in it for a tube lying in the groove).
-          if (!(d < band_m) && KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
-            ++coherent_skips_;
+          if (!(d < band_m)) {
+            if (KeptBeyondBand(kept_k, a_W, b_W, band_m)) {
+              ++coherent_skips_;
+            } else {
+              ++narrow_calls_;
+              Keep(kept_k, a_W, b_W, d);
+            }
             continue;
           }
           ++narrow_calls_;
-          Keep(kept_k, a_W, b_W, d);
-          if (d >= band_m) continue;
+          // Kept as Keep would, without its finiteness test: 0 < d < band_m is finite (the test
+          // and a second comparison with the band were a tenth of each such capsule's steps).
+          kept_k.d_m = d;
+          kept_k.a_W_m = a_W;
+          kept_k.b_W_m = b_W;
           if (group_mask != 0) {
             emit_deferred(k, d, group_mask);
           } else {
