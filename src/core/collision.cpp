@@ -684,6 +684,7 @@ bool Collision::AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eige
   const Eigen::Vector3d lo(lo_xy.x() - grow_m, lo_xy.y() - grow_m, lo_z - grow_m);
   const Eigen::Vector3d hi(hi_xy.x() + grow_m, hi_xy.y() + grow_m, hi_z + grow_m);
   const Eigen::Vector3d centre_H = 0.5 * (lo + hi), half_H = 0.5 * (hi - lo);
+  const bool finite_pose = R_WH.allFinite() && p_WH.allFinite();
   for (const Part& part : parts_) {
     // A node deeper than depth_m has |q| < half - depth_m along every axis of the part.
     const Eigen::Vector3d inner_m = part.half_m - Eigen::Vector3d::Constant(depth_m);
@@ -696,8 +697,16 @@ bool Collision::AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eige
     if (thin_count > 1) continue;  // a rod or a speck: no face to cross through
     const bool sheet = thin_count == 1;
     const Eigen::Vector3d reject_m = sheet ? part.half_m : inner_m;
-    const Eigen::Matrix3d R_PH = part.R_PW * R_WH;
-    const Eigen::Vector3d p_PH = part.R_PW * p_WH + part.p_PW;
+    // A part set square to the world takes the pose as it is: the product with the identity
+    // differs from it at most in the sign of a zero, which no test below tells apart, when the
+    // pose is finite (0 times a NaN or an infinity would spread it through the product). The
+    // products were a fifth of the check's instructions, three parts in the groove.
+    Eigen::Matrix3d R_PH_turned;
+    if (!(part.aligned && finite_pose)) R_PH_turned = part.R_PW * R_WH;
+    const Eigen::Matrix3d& R_PH = part.aligned && finite_pose ? R_WH : R_PH_turned;
+    const Eigen::Vector3d p_PH = part.aligned && finite_pose
+                                     ? Eigen::Vector3d(p_WH + part.p_PW)
+                                     : Eigen::Vector3d(part.R_PW * p_WH + part.p_PW);
     const Eigen::Vector3d reach_P = R_PH.cwiseAbs() * half_H;
     if ((((R_PH * centre_H + p_PH).cwiseAbs() - reach_P).array() >= reject_m.array()).any())
       continue;
