@@ -1591,7 +1591,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       Load& ld = loads[std::size_t(i)];
       ld.stick_base_W = ld.base_W;
       ld.turn_seen = !use_elastica;
-      if (!ld.friction) continue;
+      // The row of a load that is not a member is not built either: only a load in the system
+      // reads its stuck spring's (an open load closing in a pass becomes a member, and this is
+      // built again), and an open load's point is not computed after the solve (step 7).
+      if (!ld.friction || !member[std::size_t(i)]) continue;
       const BeamLoad& bi = m.beam_loads[std::size_t(i)];
       const Eigen::Matrix3d M_i =
           bi.r_H_m.z() * Eigen::Matrix3d::Identity() - t_W * (R_WH * bi.r_H_m).transpose();
@@ -1611,7 +1614,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // The sums in a pass of their own, as the compliance's base (build_compliance).
     for (int i = 0; i < load_count; ++i) {
       Load& ld = loads[std::size_t(i)];
-      if (!ld.friction || !use_elastica) continue;
+      if (!ld.friction || !use_elastica || !member[std::size_t(i)]) continue;
       for (int j = 0; j < load_count; ++j)
         if (member[std::size_t(j)])
           ld.stick_base_W.noalias() +=
@@ -2154,17 +2157,23 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   int beam_count = 0;
   for (int i = 0; i < load_count; ++i) {
     Load& ld = loads[std::size_t(i)];
-    ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
-    for (int j = 0; j < load_count; ++j) {
-      const int sj = slot[std::size_t(j)];
-      if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
-    }
-    // Where the stuck spring saw the point (section 5): without the one-way turn of its offset.
-    ld.stick_x_W = ld.x_W + (ld.stick_base_W - ld.base_W);
-    for (int j = 0; j < load_count && ld.friction; ++j) {
-      const int sj = slot[std::size_t(j)];
-      if (sj >= 0)
-        ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+    // An open load's point, where the stuck spring saw it, its distance and its anchor are not
+    // computed: nothing reads them. The next tick takes a stretch only from a load that was
+    // active (carried_stretch), and an open load carries no force, so it leaves no ghost (three
+    // of the six loads of three PCs in the groove, ~600 instructions a tick).
+    if (ld.active) {
+      ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
+      for (int j = 0; j < load_count; ++j) {
+        const int sj = slot[std::size_t(j)];
+        if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+      }
+      // Where the stuck spring saw the point (section 5): without the one-way turn of its offset.
+      ld.stick_x_W = ld.x_W + (ld.stick_base_W - ld.base_W);
+      for (int j = 0; j < load_count && ld.friction; ++j) {
+        const int sj = slot[std::size_t(j)];
+        if (sj >= 0)
+          ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
+      }
     }
     if (i == dome.load) {
       // The pressure moves over the face, the material does not slip: the point, where it
@@ -2179,14 +2188,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
     ld.force_W = f_load_W[std::size_t(i)];
     ld.shape_force_W = ld.force_W;
+    if (!ld.active) continue;
     ld.distance_m += ld.normal_W.dot(ld.x_W - ld.x0_W);
-    if (!ld.active || !ld.friction) {
+    if (!ld.friction) {
       ld.anchor_W = ld.stick_x_W;
     } else if (ld.sliding) {
       const Eigen::Vector3d Ft = ld.force_W - ld.normal_W.dot(ld.force_W) * ld.normal_W;
       ld.anchor_W = ld.stick_x_W + Ft / Kt;
     }
-    if (!ld.active) continue;
     force_W += ld.force_W;
     torque_W += (ld.x_W - p_W).cross(ld.force_W);
     m.predicted_H[std::size_t(beam_count)] = R_WH_new.transpose() * (ld.x_W - p_W) - ld.r_H_m;
