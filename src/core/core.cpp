@@ -977,6 +977,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = loads[std::size_t(i)];
       if (ld.matched) continue;
+      // Pass 0 continues only a rim on a face at the end (continues_centre) or an end face's
+      // pressure centre (continues_rim): what the load itself rules out needs no scan of last
+      // tick's loads (most loads, each against every one of them).
+      if (pass == 0 &&
+          !(ld.tube != states::TubeElement::kEndFace && ld.s_m >= l &&
+            IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask)) &&
+          !(ld.pressure_centre && ld.tube == states::TubeElement::kEndFace))
+        continue;
       int best = -1;
       double best_ds = m.beam.group_tolerance_m();
       for (int q = 0; q < m.prev_count; ++q) {
