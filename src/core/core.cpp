@@ -1128,6 +1128,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const bool want_elastica = scene_.model.beam == model::BeamModel::kElastica;
   const Eigen::Matrix3d lateral = Eigen::Vector3d(1.0, 1.0, 0.0).asDiagonal();
   std::array<bool, kMaxLoads> member{};
+  // The members' indices in increasing order (the sums over them keep the order of a scan of
+  // every load), for the loops over member columns: scanning all six loads for the three
+  // members of three PCs in the groove, in each of five loops, cost ~800 instructions a tick.
+  std::array<int, kMaxLoads> member_index{};
+  int member_count = 0;
   bool use_elastica = false;
   // The linear model's reference (build_compliance): load j's force f_lin as last tick's shape
   // carried it, at the arc position, offset and cut of the load it continues (a ghost: its own).
@@ -1191,6 +1196,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const Load& ld = loads[std::size_t(i)];
       member[std::size_t(i)] = ld.active || (want_elastica && !ld.f_lin_W.isZero(0.0));
     }
+    member_count = 0;
+    for (int i = 0; i < load_count; ++i)
+      if (member[std::size_t(i)]) member_index[std::size_t(member_count++)] = i;
     int members = 0;
     const int groups = m.beam.Assign(m.beam_loads, load_count, member, m.order, members);
     use_elastica = want_elastica && !m.elastica_held_off && members > 0 &&
@@ -1201,10 +1209,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // the band of a wall it does not touch).
     const auto linear_compliance = [&] {
       for (int i = 0; i < load_count; ++i)
-        for (int j = 0; j < load_count; ++j)
-          if (member[std::size_t(j)])
-            m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
-                              !use_elastica, m.W[std::size_t(i)][std::size_t(j)]);
+        for (int k = 0; k < member_count; ++k) {
+          const int j = member_index[std::size_t(k)];
+          m.beam.Compliance(m.beam_loads[std::size_t(i)], m.beam_loads[std::size_t(j)],
+                            !use_elastica, m.W[std::size_t(i)][std::size_t(j)]);
+        }
     };
     linear_compliance();
     bool rod_end_spring = false;  // the rod's tangent, with the end's response to a moment
@@ -1448,11 +1457,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     }
     // A load that is not a member: its column is not read (linear_compliance).
     for (int i = 0; i < load_count; ++i)
-      for (int j = 0; j < load_count; ++j)
-        if (member[std::size_t(j)]) {
-          Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
-          Wij = R_WH * Wij * R_WH.transpose();
-        }
+      for (int k = 0; k < member_count; ++k) {
+        Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(member_index[std::size_t(k)])];
+        Wij = R_WH * Wij * R_WH.transpose();
+      }
     // In a pass of its own, after the turns: read back right after it was written, a block's
     // column (24 bytes) straddles the 16-byte stores that wrote it, and such a load waits for
     // them to reach the cache (`perf` had a third of this function's time on that load).
@@ -1460,12 +1468,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       Load& ld = loads[std::size_t(i)];
       ld.base_W = ld.x0_W - p_start_W;
       if (!want_elastica) continue;  // the linear model's base: below
-      for (int j = 0; j < load_count; ++j)
+      for (int k = 0; k < member_count; ++k) {
+        const int j = member_index[std::size_t(k)];
         // (noalias: the product goes straight into the sum. Eigen otherwise assumes aliasing
         // and makes a temporary, in an out-of-line call here: 18 calls a tick with three PCs.)
-        if (member[std::size_t(j)])
-          ld.base_W.noalias() -=
-              m.W[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
+        ld.base_W.noalias() -= m.W[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
+      }
     }
     // The linear model: x0 is last tick's shape, x_straight plus what last tick's forces bent it
     // by where last tick's loads were. The tick's shape is x_straight + W F (step 8), so
@@ -1606,11 +1614,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const BeamLoad& bi = m.beam_loads[std::size_t(i)];
       const Eigen::Matrix3d M_i =
           bi.r_H_m.z() * Eigen::Matrix3d::Identity() - t_W * (R_WH * bi.r_H_m).transpose();
-      for (int j = 0; j < load_count; ++j) {
+      for (int k = 0; k < member_count; ++k) {
         // A load that is not a member is in no sum or system as one (a load that closes in a
         // pass becomes a member first, and the compliances are built again): its block is not
         // read.
-        if (!member[std::size_t(j)]) continue;
+        const int j = member_index[std::size_t(k)];
         Eigen::Matrix3d& Dij = m.W_turn[std::size_t(i)][std::size_t(j)];
         if (!use_elastica) {
           Dij.setZero();
@@ -1623,10 +1631,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = loads[std::size_t(i)];
       if (!ld.friction || !use_elastica || !member[std::size_t(i)]) continue;
-      for (int j = 0; j < load_count; ++j)
-        if (member[std::size_t(j)])
-          ld.stick_base_W.noalias() +=
-              m.W_turn[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
+      for (int k = 0; k < member_count; ++k) {
+        const int j = member_index[std::size_t(k)];
+        ld.stick_base_W.noalias() +=
+            m.W_turn[std::size_t(i)][std::size_t(j)] * loads[std::size_t(j)].f_lin_W;
+      }
     }
   };
   build_compliance();
