@@ -1672,6 +1672,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   bool turn_limited = false;
   const double max_turn_rad = eps / (l + scene_.tube.outer_radius_m);
   std::array<int, kMaxLoads> slot{};
+  // The load in each slot (the active loads in increasing order), for the loops over the
+  // solved forces: the sums over them keep the order of a scan of every load for its slot,
+  // which cost three PCs in the groove (three slots of six loads) ~140 instructions a tick.
+  std::array<int, kMaxLoads> slot_load{};
+  int slot_count = 0;
   Eigen::Vector3d p_W = p_start_W;
   Eigen::Vector3d omega_W = Eigen::Vector3d::Zero();
   bool solved = false, saturated = false, force_saturated = false;
@@ -1691,16 +1696,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // 1 / k_reg, which substituted would swamp the rest.
   const auto solve_system = [&]() {
     int n_active = 0;
-    for (int i = 0; i < load_count; ++i)
-      slot[std::size_t(i)] = loads[std::size_t(i)].active ? n_active++ : -1;
+    for (int i = 0; i < load_count; ++i) {
+      slot[std::size_t(i)] = loads[std::size_t(i)].active ? n_active : -1;
+      if (loads[std::size_t(i)].active) slot_load[std::size_t(n_active++)] = i;
+    }
+    slot_count = n_active;
     const bool reduced = !torque_saturated;
     const int n = 3 * n_active + (reduced ? 0 : 6);
     const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
     // Into a zeroed M and rhs of n rows: the dynamic system's, or a fixed-size one's (below).
     const auto assemble = [&](auto& M, auto& rhs) {
-      for (int i = 0; i < load_count; ++i) {
-        const int si = slot[std::size_t(i)];
-        if (si < 0) continue;
+      for (int si = 0; si < slot_count; ++si) {
+        const int i = slot_load[std::size_t(si)];
         const Load& ld = loads[std::size_t(i)];
         const Eigen::Vector3d& nrm = ld.normal_W;
         const Eigen::Matrix3d NN = nrm * nrm.transpose();
@@ -1722,9 +1729,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         M.template block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
         // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
         const Eigen::Matrix3d G_p = reduced ? Eigen::Matrix3d(G / Kc_eff) : Eigen::Matrix3d::Zero();
-        for (int j = 0; j < load_count; ++j) {
-          const int sj = slot[std::size_t(j)];
-          if (sj < 0) continue;
+        for (int sj = 0; sj < slot_count; ++sj) {
+          const int j = slot_load[std::size_t(sj)];
           const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
           M.template block<3, 3>(r, 3 * sj) += G * Wij + G_p;
           if (stuck)
@@ -1950,10 +1956,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         if (ld.released) continue;
         // An open load: does this tick's motion bring it within epsilon?
         Eigen::Vector3d x = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
-        for (int j = 0; j < load_count; ++j) {
-          const int sj = slot[std::size_t(j)];
-          if (sj >= 0) x += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
-        }
+        for (int sj = 0; sj < slot_count; ++sj)
+          x +=
+              m.W[std::size_t(i)][std::size_t(slot_load[std::size_t(sj)])] * m.z.segment<3>(3 * sj);
         if (ld.distance_m + ld.normal_W.dot(x - ld.x0_W) < eps) {
           ld.active = true;
           changed = true;
@@ -2180,17 +2185,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // of the six loads of three PCs in the groove, ~600 instructions a tick).
     if (ld.active) {
       ld.x_W = ld.base_W + p_W + omega_W.cross(ld.x0_W - p_start_W);
-      for (int j = 0; j < load_count; ++j) {
-        const int sj = slot[std::size_t(j)];
-        if (sj >= 0) ld.x_W += m.W[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
-      }
+      for (int sj = 0; sj < slot_count; ++sj)
+        ld.x_W +=
+            m.W[std::size_t(i)][std::size_t(slot_load[std::size_t(sj)])] * m.z.segment<3>(3 * sj);
       // Where the stuck spring saw the point (section 5): without the one-way turn of its offset.
       ld.stick_x_W = ld.x_W + (ld.stick_base_W - ld.base_W);
-      for (int j = 0; j < load_count && ld.friction; ++j) {
-        const int sj = slot[std::size_t(j)];
-        if (sj >= 0)
-          ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(j)] * m.z.segment<3>(3 * sj);
-      }
+      for (int sj = 0; sj < slot_count && ld.friction; ++sj)
+        ld.stick_x_W -= m.W_turn[std::size_t(i)][std::size_t(slot_load[std::size_t(sj)])] *
+                        m.z.segment<3>(3 * sj);
     }
     if (i == dome.load) {
       // The pressure moves over the face, the material does not slip: the point, where it
