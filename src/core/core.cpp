@@ -1925,10 +1925,10 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   const auto pc_normal_of = [&](int i) {
     const Load& li = loads[std::size_t(i)];
     double total_N = 0.0;
-    for (int j = 0; j < load_count; ++j) {
+    for (int sj = 0; sj < slot_count; ++sj) {
+      const int j = slot_load[std::size_t(sj)];
       const Load& lj = loads[std::size_t(j)];
-      const int sj = slot[std::size_t(j)];
-      if (sj < 0 || (j != i && (li.pc < 0 || lj.pc != li.pc))) continue;
+      if (j != i && (li.pc < 0 || lj.pc != li.pc)) continue;
       total_N += std::max(0.0, lj.normal_W.dot(m.z.segment<3>(3 * sj)));
     }
     return total_N;
@@ -2046,10 +2046,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       changed = true;
     } else if (!torque_saturated && !turn_limited) {
       Eigen::Vector3d moment_W = Eigen::Vector3d::Zero();
-      for (int i = 0; i < load_count; ++i) {
-        const int si = slot[std::size_t(i)];
-        if (si >= 0)
-          moment_W += (loads[std::size_t(i)].x0_W - p_start_W).cross(m.z.segment<3>(3 * si));
+      for (int si = 0; si < slot_count; ++si) {
+        const Load& ld = loads[std::size_t(slot_load[std::size_t(si)])];
+        moment_W += (ld.x0_W - p_start_W).cross(m.z.segment<3>(3 * si));
       }
       if (moment_W.norm() > max_torque * (1.0 + 1e-12)) {
         // The grip cannot hold more than the device's torque: the held end turns until the
