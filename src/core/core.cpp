@@ -949,10 +949,18 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // the thousands, while the end pivoted freely and its rim sank into the wall; a fixed step of a
   // fifth of the way jumped 1.6 mm in the first tick and snapped the tube as before.
   const double rim_close_m = 0.1 * eps;
+  // What the load itself must be to continue a face's centre (a rim or side at the end, on a
+  // face) or a rim (an end face's pressure centre): pass 0 asks it once a load before scanning
+  // last tick's loads for it.
+  const auto may_continue_centre = [&](const Load& ld) {
+    return ld.tube != states::TubeElement::kEndFace && !(ld.s_m < l) &&
+           IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask);
+  };
+  const auto may_continue_rim = [](const Load& ld) {
+    return ld.pressure_centre && ld.tube == states::TubeElement::kEndFace;
+  };
   const auto continues_centre = [&](const Load& ld, const Load& before) {
-    if (ld.tube == states::TubeElement::kEndFace || ld.s_m < l || !before.active ||
-        !before.pressure_centre || !IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask))
-      return false;
+    if (!before.active || !before.pressure_centre || !may_continue_centre(ld)) return false;
     const Eigen::Vector3d rim_H = R_WH.transpose() * (ld.x0_W - m.nodes_W[std::size_t(N)]);
     const double N_before = before.shape_force_W.dot(before.normal_W);
     const double close_m =
@@ -965,8 +973,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // snapped (the base slide driven back, tick 1494, 2.3 mJ over the slack; found in review). The
   // face continues the rim's active load, its point relaxing from the rim's.
   const auto continues_rim = [&](const Load& ld, const Load& before) {
-    return ld.pressure_centre && ld.tube == states::TubeElement::kEndFace && before.active &&
-           !before.pressure_centre && !before.ghost && before.s_m >= l;
+    return may_continue_rim(ld) && before.active && !before.pressure_centre && !before.ghost &&
+           before.s_m >= l;
   };
   std::array<bool, kMaxLoads> taken{};
   // Loads that continue a face's point with the rim as its target (pass 0, above).
@@ -977,14 +985,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     for (int i = 0; i < load_count; ++i) {
       Load& ld = loads[std::size_t(i)];
       if (ld.matched) continue;
-      // Pass 0 continues only a rim on a face at the end (continues_centre) or an end face's
-      // pressure centre (continues_rim): what the load itself rules out needs no scan of last
-      // tick's loads (most loads, each against every one of them).
-      if (pass == 0 &&
-          !(ld.tube != states::TubeElement::kEndFace && ld.s_m >= l &&
-            IsFaceMask(elements_[std::size_t(ld.part_element)].face_mask)) &&
-          !(ld.pressure_centre && ld.tube == states::TubeElement::kEndFace))
-        continue;
+      // Pass 0: what the load itself rules out needs no scan of last tick's loads (most loads,
+      // each against every one of them).
+      if (pass == 0 && !may_continue_centre(ld) && !may_continue_rim(ld)) continue;
       int best = -1;
       double best_ds = m.beam.group_tolerance_m();
       for (int q = 0; q < m.prev_count; ++q) {
