@@ -11,6 +11,7 @@
 
 #include "beam_chain.hpp"
 #include "collision.hpp"
+#include "contact_system.hpp"
 
 namespace tubeplan::core {
 
@@ -1706,27 +1707,41 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const bool reduced = !torque_saturated;
     const int n = 3 * n_active + (reduced ? 0 : 6);
     const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
+    // Load i's rows: F_i + sum_j (G W_ij - [stuck] Gt W_turn_ij) F_j (+ G / Kc_eff sum_j F_j
+    // when reduced) = rhs, and, for the full system, G and G Rx on p and omega.
+    struct Rows {
+      Eigen::Matrix3d G, Gt, Rx;
+      Eigen::Vector3d rhs;
+      bool stuck;
+    };
+    const auto rows_of = [&](const Load& ld, Rows& rw) {
+      const Eigen::Vector3d& nrm = ld.normal_W;
+      const Eigen::Matrix3d NN = nrm * nrm.transpose();
+      const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
+      rw.stuck = ld.friction && !ld.sliding;
+      // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
+      // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
+      const Eigen::Vector3d n_eff =
+          ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
+      // The normal part and the stuck spring (which sees the point without the one-way turn of
+      // its offset, section 5).
+      const Eigen::Matrix3d Gn = K * n_eff * nrm.transpose();
+      rw.Gt = (rw.stuck ? Kt : 0.0) * Tp;
+      rw.G = Gn + rw.Gt;
+      Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
+      if (rw.stuck) b += Kt * (Tp * ld.anchor_W);
+      if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
+      // The held end's turn omega moves the point by omega x r, r from the held end.
+      rw.Rx = Skew(ld.x0_W - p_start_W);
+      rw.rhs = b - Gn * ld.base_W - rw.Gt * ld.stick_base_W;
+    };
     // Into a zeroed M and rhs of n rows: the dynamic system's, or a fixed-size one's (below).
     const auto assemble = [&](auto& M, auto& rhs) {
+      Rows rw;
       for (int si = 0; si < slot_count; ++si) {
         const int i = slot_load[std::size_t(si)];
-        const Load& ld = loads[std::size_t(i)];
-        const Eigen::Vector3d& nrm = ld.normal_W;
-        const Eigen::Matrix3d NN = nrm * nrm.transpose();
-        const Eigen::Matrix3d Tp = Eigen::Matrix3d::Identity() - NN;
-        const bool stuck = ld.friction && !ld.sliding;
-        // The normal force is N = K (eps - d - n.(x - x0)); sliding adds (a + b N) along the
-        // slide direction, so the law stays linear in x: F = (n + b t) N + a t.
-        const Eigen::Vector3d n_eff =
-            ld.sliding ? Eigen::Vector3d(nrm + ld.slide_b * ld.slide_dir_W) : nrm;
-        // The normal part and the stuck spring (which sees the point without the one-way turn of
-        // its offset, section 5).
-        const Eigen::Matrix3d Gn = K * n_eff * nrm.transpose();
-        const Eigen::Matrix3d Gt = (stuck ? Kt : 0.0) * Tp;
-        const Eigen::Matrix3d G = Gn + Gt;
-        Eigen::Vector3d b = K * n_eff * (eps - ld.distance_m + nrm.dot(ld.x0_W));
-        if (stuck) b += Kt * (Tp * ld.anchor_W);
-        if (ld.sliding) b += ld.slide_a * ld.slide_dir_W;
+        rows_of(loads[std::size_t(i)], rw);
+        const Eigen::Matrix3d& G = rw.G;
         const int r = 3 * si;
         M.template block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
         // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
@@ -1735,29 +1750,65 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
           const int j = slot_load[std::size_t(sj)];
           const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
           M.template block<3, 3>(r, 3 * sj) += G * Wij + G_p;
-          if (stuck)
-            M.template block<3, 3>(r, 3 * sj) -= Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
+          if (rw.stuck)
+            M.template block<3, 3>(r, 3 * sj) -= rw.Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
         }
-        // The held end's turn omega moves the point by omega x r, r from the held end.
-        const Eigen::Matrix3d Rx = Skew(ld.x0_W - p_start_W);
-        rhs.template segment<3>(r) = b - Gn * ld.base_W - Gt * ld.stick_base_W;
+        rhs.template segment<3>(r) = rw.rhs;
         if (reduced) {
-          rhs.template segment<3>(r) += G * (Rx * e_grip) - G_p * A;
+          rhs.template segment<3>(r) += G * (rw.Rx * e_grip) - G_p * A;
           continue;
         }
         M.template block<3, 3>(r, ip) = G;
-        M.template block<3, 3>(r, iw) = -G * Rx;
+        M.template block<3, 3>(r, iw) = -G * rw.Rx;
         M.template block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
-        M.template block<3, 3>(iw, r) = Rx;  // the contacts' moment sum r x F
+        M.template block<3, 3>(iw, r) = rw.Rx;  // the contacts' moment sum r x F
       }
     };
     if (reduced) {
-      // One load, two or three (most ticks): assembled and factorised at fixed size, the same
-      // partial pivoting in the same order (the same bits) without the dynamic one's blocking and
-      // bookkeeping, which cost a 3 x 3 system ~700 instructions (and a 9 x 9 one, three PCs in
-      // the groove, ~1500); the blocks' addresses then are constants too (assembled into the
-      // dynamic matrix, the 9 x 9 system's assembly took ~500 instructions more).
-      if (n == 3) {
+      // Where the only non-zero compliance block is one load's own (or none is), the system is
+      // solved by its structure (contact_system.hpp): a tube lying in the groove touches floor
+      // and walls at the held end, whose blocks are zero, and at its tip. Its blocks are tested
+      // as they are, not inferred: the structure holds exactly when they are zero.
+      int moving = -1;
+      bool split = n_active >= 2;
+      const auto is_zero = [](const Eigen::Matrix3d& B) { return (B.array() == 0.0).all(); };
+      for (int si = 0; si < slot_count && split; ++si) {
+        const int i = slot_load[std::size_t(si)];
+        const Load& ld = loads[std::size_t(i)];
+        const bool stuck = ld.friction && !ld.sliding;
+        for (int sj = 0; sj < slot_count && split; ++sj) {
+          const int j = slot_load[std::size_t(sj)];
+          if (is_zero(m.W[std::size_t(i)][std::size_t(j)]) &&
+              (!stuck || is_zero(m.W_turn[std::size_t(i)][std::size_t(j)])))
+            continue;
+          if (si != sj || moving >= 0)
+            split = false;
+          else
+            moving = si;
+        }
+      }
+      if (split) {
+        std::array<Eigen::Matrix3d, kMaxLoads> C;
+        std::array<Eigen::Vector3d, kMaxLoads> b;
+        Eigen::Matrix3d A_moving = Eigen::Matrix3d::Identity();
+        Rows rw;
+        for (int si = 0; si < slot_count; ++si) {
+          const int i = slot_load[std::size_t(si)];
+          rows_of(loads[std::size_t(i)], rw);
+          C[std::size_t(si)] = rw.G / Kc_eff;
+          b[std::size_t(si)] = rw.rhs + (rw.G * (rw.Rx * e_grip) - C[std::size_t(si)] * A);
+          if (si != moving) continue;
+          A_moving += rw.G * m.W[std::size_t(i)][std::size_t(i)];
+          if (rw.stuck) A_moving -= rw.Gt * m.W_turn[std::size_t(i)][std::size_t(i)];
+        }
+        m.z.resize(n);
+        SolveOneMoving(n_active, moving, A_moving, C, b, m.z);
+      } else if (n == 3) {
+        // Otherwise one load, two or three (most ticks) are assembled and factorised at fixed size,
+        // the same partial pivoting in the same order (the same bits) without the dynamic one's
+        // blocking and bookkeeping, which cost a 3 x 3 system ~700 instructions (and a 9 x 9 one,
+        // three PCs in the groove, ~1500); the blocks' addresses then are constants too (assembled
+        // into the dynamic matrix, the 9 x 9 system's assembly took ~500 instructions more).
         Eigen::Matrix3d M3 = Eigen::Matrix3d::Zero();
         Eigen::Vector3d rhs3 = Eigen::Vector3d::Zero();
         assemble(M3, rhs3);
