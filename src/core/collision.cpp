@@ -793,10 +793,12 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     lo_W = lo_W.cwiseMin(nodes_W[i]);
     hi_W = hi_W.cwiseMax(nodes_W[i]);
   }
-  // The radius and CapsuleBoxDistance's least axis distance, as the runs over a face below take
-  // them: read from the members, they were loaded and multiplied again for each capsule (the
-  // query's writes could alias them).
-  const double r1_m = radius_m_, axis_floor_m = 1e-6 * radius_m_;
+  // The radius, as the runs over a face below take it: read from the member, it was loaded again
+  // for each capsule (the query's writes could alias it). They ask no more of a capsule's axis
+  // distance than that it exceeds r1 (d > 0): CapsuleBoxDistance's least axis distance, 1e-6 r1,
+  // then holds too (for r1 > 0 it is below r1, for r1 <= 0 not above 0 <= |e|, equal only to a
+  // zero distance, which d > 0 refuses; a NaN fails both), so that test was always passed.
+  const double r1_m = radius_m_;
   for (std::size_t part_i = 0; part_i < parts_.size(); ++part_i) {
     const Part& part = parts_[part_i];
     KeptDistance* const kept = &kept_[part_i * std::size_t(kMaxCapsules)];
@@ -1037,7 +1039,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
             const double excess_b = std::abs(nodes_W[std::size_t(k) + 1][o] + p_o_m) - half_o_m;
             const double axis_m = std::abs(std::min(excess_a, excess_b));
             const double d = axis_m - r1_m;
-            if (!(axis_m > axis_floor_m && d > 0.0 && d < band_m)) break;
+            if (!(d > 0.0 && d < band_m)) break;
             KeptDistance& kept_k = kept[k];
             kept_k.d_m = d;
             kept_k.a_W_m = nodes_W[std::size_t(k)];
@@ -1084,7 +1086,7 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // chain of dependent operations.
         const double axis_m = std::abs(e);
         const double d = axis_m - r1_m;
-        if (axis_m > axis_floor_m && d > 0.0) {
+        if (d > 0.0) {
           if (stood == static_cast<int>(out.size())) return count;
           KeptDistance& kept_k = kept[k];
           // A pair in the band is not one the kept distance settles beyond it (KeptBeyondBand:
