@@ -1029,12 +1029,31 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           const int o = face_axis;
           const double half_o_m = part.half_m[o], p_o_m = part.p_PW[o];
           const int k_first = k;
-          const int k_stop = std::min(fast_end, k + (static_cast<int>(out.size()) - stood));
+          const int k_room = k + (static_cast<int>(out.size()) - stood);
+          int k_stop = std::min(fast_end, k_room);
           RawContact& strip = *strip_entry;
           int strip_deepest = strip.strip_deepest;
           double least_m = strip.distance_m, farthest_m = strip.strip_farthest_m;
           double excess_a = std::abs(nodes_W[std::size_t(k)][o] + p_o_m) - half_o_m;
-          for (; k < k_stop; ++k) {
+          for (;; ++k) {
+            if (k == k_stop) {
+              // The run's end. A tube whose box lies beyond the face (tube_face_axis) gives the
+              // next run the same face and mask: the strip goes on into it when the run's steps
+              // above, done here, find it within reach with all its capsules passing the broad
+              // phase (its new bounds set as they set them); else they are left to do it.
+              if (k != fast_end || k != next_run || tube_face_axis < 0 || !(k < capsules)) break;
+              const double lo_o = group_lo_W_[std::size_t(k / kGroup)][o] + p_o_m;
+              const double hi_o = group_hi_W_[std::size_t(k / kGroup)][o] + p_o_m;
+              const bool out_of_reach =
+                  lo_o > 0.0 ? lo_o - grow > half_o_m : hi_o + grow < part.minus_half_m[o];
+              const bool run_passes =
+                  lo_o > 0.0 ? !(hi_o - grow > half_o_m) : !(lo_o + grow < part.minus_half_m[o]);
+              if (out_of_reach || !run_passes) break;
+              next_run = (k / kGroup + 1) * kGroup;
+              fast_end = std::min(next_run, pieces - 2);
+              k_stop = std::min(fast_end, k_room);
+              if (k == k_stop) break;
+            }
             // NearerEndExcess's sums and choice.
             const double excess_b = std::abs(nodes_W[std::size_t(k) + 1][o] + p_o_m) - half_o_m;
             const double axis_m = std::abs(std::min(excess_a, excess_b));
