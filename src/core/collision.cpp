@@ -770,9 +770,14 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     const std::size_t first = std::size_t(g * kGroup);
     const std::size_t last = std::size_t(std::min((g + 1) * kGroup, capsules));  // last node
     Eigen::Vector3d lo_g = nodes_W[first], hi_g = nodes_W[first];
+    // The node first: its min / max with the box keeps the box's coordinate on a tie, so the box
+    // is updated in its registers (lo_g.cwiseMin(node) kept the node's, through a copy each: four
+    // instructions a node). A tie of two values differs only for +0 and -0, where the box may now
+    // hold the other zero: the boxes are only compared (shifted by the part's position at most),
+    // and the zeros compare equal; the nodes are finite (the core commits only a finite shape).
     for (std::size_t i = first + 1; i <= last; ++i) {
-      lo_g = lo_g.cwiseMin(nodes_W[i]);
-      hi_g = hi_g.cwiseMax(nodes_W[i]);
+      lo_g = nodes_W[i].cwiseMin(lo_g);
+      hi_g = nodes_W[i].cwiseMax(hi_g);
     }
     group_lo_W_[std::size_t(g)] = lo_g;
     group_hi_W_[std::size_t(g)] = hi_g;
