@@ -519,8 +519,11 @@ bool Collision::StillLeftOut(std::size_t part_i, std::span<const Eigen::Vector3d
   if (summary.valid) {
     // The largest motion along each world axis; every node's motion is within its norm.
     Eigen::Vector3d along_W = Eigen::Vector3d::Zero();
+    // (The motion first: its max with along_W keeps along_W's coordinate on a tie, so along_W is
+    // updated in its registers, not through a copy, two instructions a node; every value is an
+    // absolute value or the starting +0, so a tie is of the same bits, and the nodes are finite.)
     for (std::size_t i = 0; i < node_count; ++i)
-      along_W = along_W.cwiseMax((nodes_W[i] - anchor[i]).cwiseAbs());
+      along_W = (nodes_W[i] - anchor[i]).cwiseAbs().cwiseMax(along_W);
     along_W = along_W.cwiseMax((end_start_W - anchor[node_count]).cwiseAbs());
     const double delta_m = along_W.norm();
     // A part turned to the world: its own axes see at most delta.
