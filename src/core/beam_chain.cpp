@@ -22,6 +22,26 @@ Eigen::Vector2d ElasticaTipXZ(double fx, double fz, double length_m, double EI,
   return {length_m * solution.tip.deflection, length_m * (1.0 - solution.tip.shortening)};
 }
 
+// Eigen::AngleAxisd(angle, axis).toRotationMatrix() from the angle's sine and cosine: the same
+// operations in the same order (Eigen/src/Geometry/AngleAxis.h), so the same bits, for a caller
+// that keeps the sine and cosine.
+Eigen::Matrix3d TurnMatrix(const Eigen::Vector3d& axis, double sin_angle, double cos_angle) {
+  const Eigen::Vector3d sin_axis = sin_angle * axis;
+  const Eigen::Vector3d cos1_axis = (1.0 - cos_angle) * axis;
+  Eigen::Matrix3d R;
+  double tmp = cos1_axis.x() * axis.y();
+  R(0, 1) = tmp - sin_axis.z();
+  R(1, 0) = tmp + sin_axis.z();
+  tmp = cos1_axis.x() * axis.z();
+  R(0, 2) = tmp + sin_axis.y();
+  R(2, 0) = tmp - sin_axis.y();
+  tmp = cos1_axis.y() * axis.z();
+  R(1, 2) = tmp - sin_axis.x();
+  R(2, 1) = tmp + sin_axis.x();
+  R.diagonal() = cos1_axis.cwiseProduct(axis).array() + cos_angle;
+  return R;
+}
+
 }  // namespace
 
 BeamChain::BeamChain(const scene::Scene& scene)
@@ -326,7 +346,12 @@ int BeamChain::SolveElasticaChain(const std::array<BeamLoad, kMaxLoads>& loads, 
       const model::ElasticaTip& tip = seg.solution.tip;
       origin_H += R_HS * (L * tip.deflection * seg.bend_x_S +
                           L * (1.0 - tip.shortening) * Eigen::Vector3d::UnitZ());
-      const Eigen::Matrix3d tip_R_S = Eigen::AngleAxisd(tip.tip_angle_rad, y_S).toRotationMatrix();
+      // The tip angle's sine and cosine are kept in the solution: the nodes' samples
+      // (model::ElasticaSamples) turn their tangents by them too (~70 instructions a tick).
+      seg.solution.tip_sin = std::sin(tip.tip_angle_rad);
+      seg.solution.tip_cos = std::cos(tip.tip_angle_rad);
+      seg.solution.tip_trig_angle_rad = tip.tip_angle_rad;
+      const Eigen::Matrix3d tip_R_S = TurnMatrix(y_S, seg.solution.tip_sin, seg.solution.tip_cos);
       seg.tip_tangent_S = tip_R_S * Eigen::Vector3d::UnitZ();
       R_HS = R_HS * tip_R_S;
     } else {

@@ -1018,7 +1018,12 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
   }
   const FromRoot from_root(solution, load, root.along, root.across);
-  const double sin_tip = std::sin(tip.tip_angle_rad), cos_tip = std::cos(tip.tip_angle_rad);
+  // The tip angle's sine and cosine as the caller kept them (the core's chain), else formed.
+  double sin_tip = solution.tip_sin, cos_tip = solution.tip_cos;
+  if (!(solution.tip_trig_angle_rad == tip.tip_angle_rad)) {
+    sin_tip = std::sin(tip.tip_angle_rad);
+    cos_tip = std::cos(tip.tip_angle_rad);
+  }
   for (std::size_t j = 0; j < n; ++j) {
     const double s = s_of(j);
     xz_out[j] = from_root.At(s, xz_out[j].x(), xz_out[j].y());

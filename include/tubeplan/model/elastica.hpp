@@ -45,6 +45,12 @@ struct ElasticaSolution {
   /// solution and its shape evaluations take them instead of four sin calls each.
   double loading_psi_rad = std::numeric_limits<double>::quiet_NaN();
   double loading_s0 = 0.0, loading_c0 = 0.0, loading_cos_psi = 0.0, loading_sin_psi = 0.0;
+  /// std::sin and std::cos of tip.tip_angle_rad, valid while tip_trig_angle_rad equals it (NaN:
+  /// none; SolveElastica leaves them so): a caller that forms them anyway (the core's elastica
+  /// chain, turning the next clamp by the tip angle) keeps them here, and ElasticaSamples takes
+  /// them instead of another sine and cosine.
+  double tip_trig_angle_rad = std::numeric_limits<double>::quiet_NaN();
+  double tip_sin = 0.0, tip_cos = 1.0;
 };
 
 /// The largest load parameter SolveElastica accepts.
