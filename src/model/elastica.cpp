@@ -941,7 +941,13 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
   // ShapeFromTip.
   const double delta = sqrt_alpha * span / last;
   const double k = solution.modulus_k, kc = solution.modulus_kc, k_sq = k * k;
-  const double d_complete = k_sq * Rd(0.0, kc * kc, 1.0) / 3.0;  // D(K)
+  // D(K), formed when a reflection first needs it: an R_D, and the three-PC tick's samples (a
+  // whole segment whose root lies within K/2 of its tip) reflect none (~0.12 k instructions).
+  double d_complete_kept = -1.0;  // D(K) >= 0: negative while not formed
+  const auto d_complete = [&] {
+    if (d_complete_kept < 0.0) d_complete_kept = k_sq * Rd(0.0, kc * kc, 1.0) / 3.0;
+    return d_complete_kept;
+  };
   const double big_k = tau0 + sqrt_alpha;
   Stepped step;  // the step's functions, at delta <= K (beyond K/2 by reflection, n = 2 only)
   if (delta <= 0.5 * big_k) {
@@ -951,7 +957,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     Stepped other;
     other.j = JacobiFunctions(big_k - delta, chain);
     other.big_d = EpsilonDefect(k, other.j);
-    const Reflected r = Reflect(k, kc, other.j, other.big_d, d_complete);
+    const Reflected r = Reflect(k, kc, other.j, other.big_d, d_complete());
     step.j = r.at_w;
     step.big_d = r.big_d;
   }
@@ -984,7 +990,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     std::size_t& i = first_tip_side;
     for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
       if (i > 0) at_tau = advance(at_tau, tau0 + sqrt_alpha * s_of(i));
-      const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete);
+      const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete());
       store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d));
     }
   }
@@ -1012,7 +1018,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     Stepped at_root;
     at_root.j = JacobiFunctions(tau0, chain);
     at_root.big_d = EpsilonDefect(k, at_root.j);
-    const Reflected r = Reflect(k, kc, at_root.j, at_root.big_d, d_complete);
+    const Reflected r = Reflect(k, kc, at_root.j, at_root.big_d, d_complete());
     root = FromJacobi(k, kc, sqrt_alpha, 0.0, r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d);
   } else {
     root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
