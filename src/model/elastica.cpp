@@ -961,8 +961,10 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     step.j = r.at_w;
     step.big_d = r.big_d;
   }
-  // One step forward from `at`, or afresh at `argument` (<= K/2) when the walk since the last
-  // fresh evaluation has reached the anchor spacing (always, for steps longer than it).
+  // One step forward from `at`, or afresh at `argument()` (<= K/2) when the walk since the last
+  // fresh evaluation has reached the anchor spacing (always, for steps longer than it). The
+  // argument is formed only then (a sample's s with its division, a product and a sum: ~70
+  // instructions a tick, whose 16 steps re-anchor once or never).
   // Also afresh after kAnchorSteps steps: the step's own functions carry a relative error (~5e-14
   // in cn and dn near k = 1) that each step adds again, and a short range of many points (a
   // segment's mesh) walks hundreds of steps within one anchor spacing (2.6e-12 of the tangent
@@ -971,11 +973,11 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
   constexpr int kAnchorSteps = 16;
   double walked = 0.0;
   int steps = 0;
-  const auto advance = [&](const Stepped& at, double argument) {
+  const auto advance = [&](const Stepped& at, const auto& argument) {
     Stepped next = AddArgument(k_sq, at, step);
     walked += delta;
     if (walked >= kJacobiAnchor || ++steps > kAnchorSteps) {
-      next.j = JacobiFunctions(argument, chain);
+      next.j = JacobiFunctions(argument(), chain);
       walked = 0.0;
       steps = 0;
     }
@@ -989,7 +991,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     at_tau.big_d = EpsilonDefect(k, at_tau.j);
     std::size_t& i = first_tip_side;
     for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
-      if (i > 0) at_tau = advance(at_tau, tau0 + sqrt_alpha * s_of(i));
+      if (i > 0) at_tau = advance(at_tau, [&] { return tau0 + sqrt_alpha * s_of(i); });
       const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete());
       store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d));
     }
@@ -1003,7 +1005,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     at_w.big_d = EpsilonDefect(k, at_w.j);
   }
   for (std::size_t i = n; i-- > first_tip_side;) {
-    if (i + 1 < n) at_w = advance(at_w, sqrt_alpha * (1.0 - s_of(i)));
+    if (i + 1 < n) at_w = advance(at_w, [&] { return sqrt_alpha * (1.0 - s_of(i)); });
     store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
   }
   // As in ElasticaCentreline: positions from the root, the first sample's figures when it is
