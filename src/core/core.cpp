@@ -2623,8 +2623,9 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       const BeamLoad& at = m.beam_loads[std::size_t(i)];
       Eigen::Vector3d left_out_m = Eigen::Vector3d::Zero();
       for (int j = 0; j < beam_count; ++j) {
+        // (Copied only past the test: most loads share the clamp.)
+        if (!(m.beam_loads[std::size_t(j)].clamp_m > at.clamp_m)) continue;
         BeamLoad beyond = m.beam_loads[std::size_t(j)];
-        if (!(beyond.clamp_m > at.clamp_m)) continue;
         beyond.clamp_m = 0.0;
         left_out_m += m.beam.CentreDisplacement(at.s_m, beyond);
       }
