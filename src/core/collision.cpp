@@ -985,6 +985,17 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         tube_face_mask = part.face_mask_of_face[std::size_t(2 * o + (lo[o] > 0.0 ? 1 : 0))];
       }
     }
+    // A run's box on the axis o of a face it lies beyond (its bounds shifted into the part):
+    // whether it is out of the part's grown box there, and whether every capsule in it passes
+    // that face's broad phase (the run's step and the strip's loop over runs ask both).
+    // (The part's half sizes on o are passed in: the strip's loop holds them in registers.)
+    const auto run_out_of_reach = [&](double lo_o, double hi_o, double half_o,
+                                      double minus_half_o) {
+      return lo_o > 0.0 ? lo_o - grow > half_o : hi_o + grow < minus_half_o;
+    };
+    const auto run_all_pass = [&](double lo_o, double hi_o, double half_o, double minus_half_o) {
+      return lo_o > 0.0 ? !(hi_o - grow > half_o) : !(lo_o + grow < minus_half_o);
+    };
     int face_axis = -1, fast_end = -1, next_run = part.aligned ? k_begin : pieces;
     bool all_pass = false;
     std::uint8_t group_mask = 0;
@@ -1001,19 +1012,17 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
         // (the two-PC tick had forty capsules fail the broad phase one by one). Beyond one face,
         // within the other two slabs, only that face's axis can take it out.
         const bool out_of_reach =
-            face_axis >= 0
-                ? (lo_g[face_axis] > 0.0 ? lo_g[face_axis] - grow > part.half_m[face_axis]
-                                         : hi_g[face_axis] + grow < part.minus_half_m[face_axis])
-                : (((lo_g.array() - grow) > part.half_m.array()).any() ||
-                   ((hi_g.array() + grow) < part.minus_half_m.array()).any());
+            face_axis >= 0 ? run_out_of_reach(lo_g[face_axis], hi_g[face_axis],
+                                              part.half_m[face_axis], part.minus_half_m[face_axis])
+                           : (((lo_g.array() - grow) > part.half_m.array()).any() ||
+                              ((hi_g.array() + grow) < part.minus_half_m.array()).any());
         if (out_of_reach) {
           k = std::min(next_run, capsules) - 1;  // on to the next run, or the end piece
           continue;
         }
         if (face_axis >= 0) {
           const int o = face_axis;
-          all_pass = lo_g[o] > 0.0 ? !(hi_g[o] - grow > part.half_m[o])
-                                   : !(lo_g[o] + grow < part.minus_half_m[o]);
+          all_pass = run_all_pass(lo_g[o], hi_g[o], part.half_m[o], part.minus_half_m[o]);
           // That point's mask, kept with the part: clamped onto the part, the run's lower
           // corner lies on the face's plane (+half_m[o] when beyond it, where lo_g[o] >
           // half_m[o] >= 0; else -half_m[o]) and, along the other two axes, at lo_g, strictly
@@ -1035,7 +1044,8 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           // below, everything written back as they would have left it. (strip_next == k is a
           // strip of a face mask: group_mask is that mask.)
           const int o = face_axis;
-          const double half_o_m = part.half_m[o], p_o_m = part.p_PW[o];
+          const double half_o_m = part.half_m[o], minus_half_o_m = part.minus_half_m[o];
+          const double p_o_m = part.p_PW[o];
           const int k_first = k;
           const int k_room = k + (static_cast<int>(out.size()) - stood);
           int k_stop = std::min(fast_end, k_room);
@@ -1052,11 +1062,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
               if (k != fast_end || k != next_run || tube_face_axis < 0 || !(k < capsules)) break;
               const double lo_o = group_lo_W_[std::size_t(k / kGroup)][o] + p_o_m;
               const double hi_o = group_hi_W_[std::size_t(k / kGroup)][o] + p_o_m;
-              const bool out_of_reach =
-                  lo_o > 0.0 ? lo_o - grow > half_o_m : hi_o + grow < part.minus_half_m[o];
-              const bool run_passes =
-                  lo_o > 0.0 ? !(hi_o - grow > half_o_m) : !(lo_o + grow < part.minus_half_m[o]);
-              if (out_of_reach || !run_passes) break;
+              if (run_out_of_reach(lo_o, hi_o, half_o_m, minus_half_o_m) ||
+                  !run_all_pass(lo_o, hi_o, half_o_m, minus_half_o_m))
+                break;
               next_run = (k / kGroup + 1) * kGroup;
               fast_end = std::min(next_run, pieces - 2);
               k_stop = std::min(fast_end, k_room);
