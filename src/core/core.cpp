@@ -1713,10 +1713,11 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     const bool reduced = !torque_saturated;
     const int n = 3 * n_active + (reduced ? 0 : 6);
     const int ip = n - 6, iw = n - 3;  // columns of p and omega (full system)
-    // Load i's rows: F_i + sum_j (G W_ij - [stuck] Gt W_turn_ij) F_j (+ G / Kc_eff sum_j F_j
-    // when reduced) = rhs, and, for the full system, G and G Rx on p and omega.
+    // Load i's rows: F_i + sum_j (G W_ij - [stuck] Gt W_turn_ij) F_j + G_p sum_j F_j = rhs, and,
+    // for the full system, G and G Rx on p and omega. Reduced, p = (A + sum F) / Kc_eff adds
+    // G_p = G / Kc_eff to every force's column, and the held end's given turn and A go to rhs.
     struct Rows {
-      Eigen::Matrix3d G, Gt, Rx;
+      Eigen::Matrix3d G, Gt, Rx, G_p;
       Eigen::Vector3d rhs;
       bool stuck;
     };
@@ -1740,6 +1741,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       // The held end's turn omega moves the point by omega x r, r from the held end.
       rw.Rx = Skew(ld.x0_W - p_start_W);
       rw.rhs = b - Gn * ld.base_W - rw.Gt * ld.stick_base_W;
+      rw.G_p = reduced ? Eigen::Matrix3d(rw.G / Kc_eff) : Eigen::Matrix3d::Zero();
+      if (reduced) rw.rhs += rw.G * (rw.Rx * e_grip) - rw.G_p * A;
     };
     // Into a zeroed M and rhs of n rows: the dynamic system's, or a fixed-size one's (below).
     const auto assemble = [&](auto& M, auto& rhs) {
@@ -1750,8 +1753,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         const Eigen::Matrix3d& G = rw.G;
         const int r = 3 * si;
         M.template block<3, 3>(r, r) += Eigen::Matrix3d::Identity();
-        // Reduced: p = (A + sum F) / Kc_eff adds G / Kc_eff to every force's column.
-        const Eigen::Matrix3d G_p = reduced ? Eigen::Matrix3d(G / Kc_eff) : Eigen::Matrix3d::Zero();
+        const Eigen::Matrix3d& G_p = rw.G_p;
         for (int sj = 0; sj < slot_count; ++sj) {
           const int j = slot_load[std::size_t(sj)];
           const Eigen::Matrix3d& Wij = m.W[std::size_t(i)][std::size_t(j)];
@@ -1760,10 +1762,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
             M.template block<3, 3>(r, 3 * sj) -= rw.Gt * m.W_turn[std::size_t(i)][std::size_t(j)];
         }
         rhs.template segment<3>(r) = rw.rhs;
-        if (reduced) {
-          rhs.template segment<3>(r) += G * (rw.Rx * e_grip) - G_p * A;
-          continue;
-        }
+        if (reduced) continue;
         M.template block<3, 3>(r, ip) = G;
         M.template block<3, 3>(r, iw) = -G * rw.Rx;
         M.template block<3, 3>(ip, r) = -Eigen::Matrix3d::Identity();
@@ -1801,8 +1800,8 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
         for (int si = 0; si < slot_count; ++si) {
           const int i = slot_load[std::size_t(si)];
           rows_of(loads[std::size_t(i)], rw);
-          C[std::size_t(si)] = rw.G / Kc_eff;
-          b[std::size_t(si)] = rw.rhs + (rw.G * (rw.Rx * e_grip) - C[std::size_t(si)] * A);
+          C[std::size_t(si)] = rw.G_p;
+          b[std::size_t(si)] = rw.rhs;
           if (si != moving) continue;
           A_moving += rw.G * m.W[std::size_t(i)][std::size_t(i)];
           if (rw.stuck) A_moving -= rw.Gt * m.W_turn[std::size_t(i)][std::size_t(i)];
