@@ -483,16 +483,22 @@ void BeamChain::ElasticaNodes(const std::array<ElasticaSegment, kMaxLoads>& segm
     const Eigen::Vector3d x_H = seg.R_HS * seg.bend_x_S;
     const Eigen::Vector3d z_H = seg.R_HS.col(2);
     // The samples' points and unit tangents (d/ds of the position), each computed once: every
-    // node between two samples needs both samples'.
-    std::array<Eigen::Vector3d, n> point, tangent;
+    // node between two samples needs both samples'. A sample's point and tangent lie side by
+    // side, so that a node finds the four vectors it combines at fixed offsets from one address
+    // (from two arrays it formed four addresses: ~240 instructions a three-PC tick, 49 nodes).
+    // The same sums in the same order, so the same bits.
+    struct Sample {
+      Eigen::Vector3d point, tangent;
+    };
+    std::array<Sample, n> sample;
     for (std::size_t j = 0; j < std::size_t(n); ++j) {
-      point[j] = seg.origin_H + L * (xz[j].x() * x_H + xz[j].y() * z_H);
-      tangent[j] = tangent_xz[j].x() * x_H + tangent_xz[j].y() * z_H;
+      sample[j].point = seg.origin_H + L * (xz[j].x() * x_H + xz[j].y() * z_H);
+      sample[j].tangent = tangent_xz[j].x() * x_H + tangent_xz[j].y() * z_H;
     }
     const auto node = [&](const HermiteNode& w) {
-      const std::size_t i = std::size_t(w.j);
-      return Eigen::Vector3d(w.point0 * point[i] + w.tangent0_h * tangent[i] +
-                             w.point1 * point[i + 1] + w.tangent1_h * tangent[i + 1]);
+      const Sample* const at = &sample[std::size_t(w.j)];
+      return Eigen::Vector3d(w.point0 * at[0].point + w.tangent0_h * at[0].tangent +
+                             w.point1 * at[1].point + w.tangent1_h * at[1].tangent);
     };
     if (k == 0 && seg.clamp_m == 0.0 && L == length_m_ && count == full_node_count_) {
       for (; k < full_nodes_; ++k) nodes[std::size_t(k)] = node(full_hermite_[std::size_t(k)]);
