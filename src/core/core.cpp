@@ -578,7 +578,13 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // then in the tick's system with its distance linearised along its normal, so a fast hand
   // (2 m/s: 2 mm a tick) cannot carry the tube through a wall thinner than its step; at hand
   // speeds the growth is micrometres and costs nothing.
-  const double turn_bound_rad = Eigen::AngleAxisd(R_W_hand * R_WH.transpose()).angle();
+  // The hand's turn from the held end, log(R_hand R_held^T): made once here, for its angle, and
+  // read again as the grip's error in step 6 (R_hand and R_held do not change in between), which
+  // had made it again from the same matrices: a quaternion from their product and an AngleAxis
+  // from that, whose stableNorm a grip holding the hand's orientation takes (~300 instructions
+  // a three-PC tick).
+  const Eigen::AngleAxisd hand_turn(R_W_hand * R_WH.transpose());
+  const double turn_bound_rad = hand_turn.angle();
   const double sweep_m = (coupling_stiffness_ * (p_hand_W - m.p_held_prev_W) +
                           (coupling_damping_ / T) * (p_hand_W - m.p_hand_prev_W))
                                  .norm() /
@@ -1665,7 +1671,7 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
   // the contacts' moment about the held end would exceed the maximum torque; then the grip
   // carries exactly that torque and the contacts decide omega.
   const double max_torque = scene_.device.max_torque_Nm;
-  const Eigen::AngleAxisd error(R_W_hand * R_WH.transpose());
+  const Eigen::AngleAxisd& error = hand_turn;  // step 2's
   const Eigen::Vector3d e_hand = error.angle() * error.axis();
   bool torque_saturated = false;
   Eigen::Vector3d torque_sat_W = Eigen::Vector3d::Zero();  // the grip's torque on the tube
