@@ -1072,18 +1072,23 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
             }
             // NearerEndExcess's sums and choice.
             const double excess_b = std::abs(nodes_W[std::size_t(k) + 1][o] + p_o_m) - half_o_m;
-            const double axis_m = std::abs(std::min(excess_a, excess_b));
+            // The least, the greatest and the deepest with their operands ordered so that each
+            // result is formed in the register of the value it replaces, not through copies (five
+            // instructions a capsule, ~430 a three-PC tick). Each order differs from std::min's /
+            // std::max's only where neither operand is less: a NaN, which none is (the nodes and
+            // the part's bounds are finite; d passed 0 < d < band_m, and the strip's figures are
+            // such d), or equal values, the same bits but for +0 and -0 (the excesses' least is
+            // taken its absolute value; the figures are d > 0).
+            const double axis_m = std::abs(excess_a < excess_b ? excess_a : excess_b);
             const double d = axis_m - r1_m;
             if (!(d > 0.0 && d < band_m)) break;
             KeptDistance& kept_k = kept[k];
             kept_k.d_m = d;
             kept_k.a_W_m = nodes_W[std::size_t(k)];
             kept_k.b_W_m = nodes_W[std::size_t(k) + 1];
-            if (d < least_m) {
-              least_m = d;
-              strip_deepest = k;
-            }
-            farthest_m = std::max(farthest_m, d);
+            strip_deepest = d < least_m ? k : strip_deepest;
+            least_m = least_m < d ? least_m : d;
+            farthest_m = std::max(d, farthest_m);
             excess_a = excess_b;
           }
           const int joined = k - k_first;
