@@ -330,8 +330,12 @@ class Collision {
   // computed. Per part, kMaxCapsules pieces; sized at construction, so Query allocates nothing.
   static constexpr double kCoherenceMargin_m = 1e-9;  // collision.cpp, KeptBeyondBand
   struct KeptDistance {
-    Eigen::Vector3d a_W_m = Eigen::Vector3d::Zero(), b_W_m = Eigen::Vector3d::Zero();
+    // The axis's ends a and b, the columns of one 3 x 2 block: two consecutive nodes, contiguous
+    // in the query's span, are kept with three 16-byte copies (Query's capsules over a face).
+    Eigen::Matrix<double, 3, 2> ends_W_m = Eigen::Matrix<double, 3, 2>::Zero();
     double d_m = -std::numeric_limits<double>::infinity();  // none: never skips
+    Eigen::Vector3d a_W_m() const { return ends_W_m.col(0); }
+    Eigen::Vector3d b_W_m() const { return ends_W_m.col(1); }
   };
   mutable std::vector<KeptDistance> kept_;
   // A part's last evaluation as idle (LeaveOut), per part, and where the tube's nodes and its end
