@@ -688,6 +688,10 @@ bool Collision::AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eige
   const Eigen::Vector3d hi(hi_xy.x() + grow_m, hi_xy.y() + grow_m, hi_z + grow_m);
   const Eigen::Vector3d centre_H = 0.5 * (lo + hi), half_H = 0.5 * (hi - lo);
   const bool finite_pose = R_WH.allFinite() && p_WH.allFinite();
+  // The box turned by the pose (below) is the same for every part set square to the world: made
+  // at the first such part only (~45 instructions a tick, the groove's three parts square).
+  bool turned = false;
+  Eigen::Vector3d turned_centre_m, turned_reach_m;
   for (const Part& part : parts_) {
     // A node deeper than depth_m has |q| < half - depth_m along every axis of the part.
     const Eigen::Vector3d inner_m = part.half_m - Eigen::Vector3d::Constant(depth_m);
@@ -710,9 +714,18 @@ bool Collision::AxisThrough(std::span<const Eigen::Vector3d> nodes_H, const Eige
     const Eigen::Vector3d p_PH = part.aligned && finite_pose
                                      ? Eigen::Vector3d(p_WH + part.p_PW)
                                      : Eigen::Vector3d(part.R_PW * p_WH + part.p_PW);
-    const Eigen::Vector3d reach_P = R_PH.cwiseAbs() * half_H;
-    if ((((R_PH * centre_H + p_PH).cwiseAbs() - reach_P).array() >= reject_m.array()).any())
-      continue;
+    // (Each product formed on its own, as Eigen forms a small product within an expression:
+    // the same sums in the same order, so the same bits kept or made afresh.)
+    if (part.aligned && finite_pose && !turned) {
+      turned_centre_m = R_WH * centre_H;
+      turned_reach_m = R_WH.cwiseAbs() * half_H;
+      turned = true;
+    }
+    const Eigen::Vector3d centre_P =
+        part.aligned && finite_pose ? turned_centre_m : Eigen::Vector3d(R_PH * centre_H);
+    const Eigen::Vector3d reach_P =
+        part.aligned && finite_pose ? turned_reach_m : Eigen::Vector3d(R_PH.cwiseAbs() * half_H);
+    if ((((centre_P + p_PH).cwiseAbs() - reach_P).array() >= reject_m.array()).any()) continue;
     if (!sheet) {
       for (const Eigen::Vector3d& x : nodes_H) {
         const Eigen::Vector3d q = R_PH * x + p_PH;
