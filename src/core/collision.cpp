@@ -264,12 +264,14 @@ bool CylinderBoxFaceDistance(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
       // Outward normal n = side e_k. The support point in -n: the axis end with the smaller
       // n.x, then the rim point farthest along -n within the end's plane.
       const double n_u = side * u[k];
-      Eigen::Vector3d s = n_u > 0.0 ? a : b;
+      const Eigen::Vector3d& end = n_u > 0.0 ? a : b;
       // The support point lies within r of that end: a face whose plane the end is more than r
       // inside of (and a margin for the rounding of the point, a few ulp of r and of the
       // coordinate) is passed over before its root and quotient, as it would be below (most of
-      // the six: an end over one face of a part lies within the other five's planes).
-      if (side * s[k] + radius + 1e-9 * (radius + std::abs(s[k])) < half[k]) continue;
+      // the six: an end over one face of a part lies within the other five's planes). Before
+      // the end is copied into the support point, too (~30 instructions a tick, tip on the floor).
+      if (side * end[k] + radius + 1e-9 * (radius + std::abs(end[k])) < half[k]) continue;
+      Eigen::Vector3d s = end;
       Eigen::Vector3d radial = n_u * u;  // -(n - (n.u) u): the part of -n across the axis
       radial[k] -= side;
       const double radial_norm = radial.norm();
