@@ -793,9 +793,19 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
     // instructions a node). A tie of two values differs only for +0 and -0, where the box may now
     // hold the other zero: the boxes are only compared (shifted by the part's position at most),
     // and the zeros compare equal; the nodes are finite (the core commits only a finite shape).
-    for (std::size_t i = first + 1; i <= last; ++i) {
-      lo_g = nodes_W[i].cwiseMin(lo_g);
-      hi_g = nodes_W[i].cwiseMax(hi_g);
+    // A whole run (all but the last) in a loop of kGroup steps known when compiled, unrolled:
+    // without a count and a test a node (~150 instructions a tick); the same steps in the same
+    // order as the general loop's.
+    if (last - first == std::size_t(kGroup)) {
+      for (std::size_t j = 1; j <= std::size_t(kGroup); ++j) {
+        lo_g = nodes_W[first + j].cwiseMin(lo_g);
+        hi_g = nodes_W[first + j].cwiseMax(hi_g);
+      }
+    } else {
+      for (std::size_t i = first + 1; i <= last; ++i) {
+        lo_g = nodes_W[i].cwiseMin(lo_g);
+        hi_g = nodes_W[i].cwiseMax(hi_g);
+      }
     }
     group_lo_W_[std::size_t(g)] = lo_g;
     group_hi_W_[std::size_t(g)] = hi_g;
