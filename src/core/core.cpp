@@ -64,6 +64,18 @@ void TurnBlock(const Eigen::Matrix3d& R, Eigen::Matrix3d& W) {
   }
 }
 
+// Whether every entry of a block is zero (of either sign): the bits of each but its sign clear.
+// The same test as (B.array() == 0.0).all(), a NaN failing it too: its first entry compared (a
+// block that is not zero mostly fails there), then one OR of the other eight entries' bits
+// instead of a compare and branch each (~240 instructions a three-PC tick, nine pairs of blocks
+// in the structured solve's test, most of them zero).
+bool IsZeroBlock(const Eigen::Matrix3d& B) {
+  if (!(B(0, 0) == 0.0)) return false;
+  std::uint64_t bits = 0;
+  for (int k = 1; k < 9; ++k) bits |= std::bit_cast<std::uint64_t>(B.data()[k]);
+  return (bits << 1) == 0;
+}
+
 // f_k(N) = a + b N, tangent to mu_k N0 (N/N0)^beta at N (exact for beta = 1). At N = 0 with
 // beta < 1 the slope is infinite: the chord to N = 1e-9 N0 stands in for it. A load point of a
 // PC of several holds the share f_k(N_pc) N / N_pc (FrictionShare): its slope in its own N, the
@@ -1497,7 +1509,12 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
     // A load that is not a member: its column is not read (linear_compliance).
     for (int i = 0; i < load_count; ++i)
       for (int k = 0; k < member_count; ++k) {
-        TurnBlock(R_WH, m.W[std::size_t(i)][std::size_t(member_index[std::size_t(k)])]);
+        // A zero block (a load at the held end neither moves nor is moved) stays as it is: its
+        // turn would only give zeros of R's signs. Those reach nothing but sums with other terms
+        // (a zero's sign shows only in a sum of zeros), and two of three PCs' loads lie at the
+        // held end: 8 of its 9 blocks (~1 k instructions a tick).
+        Eigen::Matrix3d& W = m.W[std::size_t(i)][std::size_t(member_index[std::size_t(k)])];
+        if (!IsZeroBlock(W)) TurnBlock(R_WH, W);
       }
     // In a pass of its own, after the turns: read back right after it was written, a block's
     // column (24 bytes) straddles the 16-byte stores that wrote it, and such a load waits for
@@ -1805,25 +1822,14 @@ bool Core::Tick(double t_s, const Eigen::Isometry3d& X_W_hand, bool leave_out_id
       // as they are, not inferred: the structure holds exactly when they are zero.
       int moving = -1;
       bool split = n_active >= 2;
-      // A block is zero when every entry is (either sign): the bits of each but its sign clear.
-      // The same test as (B.array() == 0.0).all(), a NaN failing it too: its first entry
-      // compared, as before (a block that is not zero mostly fails there), then one OR of the
-      // other eight entries' bits instead of a compare and branch each (~240 instructions a
-      // three-PC tick, nine pairs of blocks, most of them zero).
-      const auto is_zero = [](const Eigen::Matrix3d& B) {
-        if (!(B(0, 0) == 0.0)) return false;
-        std::uint64_t bits = 0;
-        for (int k = 1; k < 9; ++k) bits |= std::bit_cast<std::uint64_t>(B.data()[k]);
-        return (bits << 1) == 0;
-      };
       for (int si = 0; si < slot_count && split; ++si) {
         const int i = slot_load[std::size_t(si)];
         const Load& ld = loads[std::size_t(i)];
         const bool stuck = ld.friction && !ld.sliding;
         for (int sj = 0; sj < slot_count && split; ++sj) {
           const int j = slot_load[std::size_t(sj)];
-          if (is_zero(m.W[std::size_t(i)][std::size_t(j)]) &&
-              (!stuck || is_zero(m.W_turn[std::size_t(i)][std::size_t(j)])))
+          if (IsZeroBlock(m.W[std::size_t(i)][std::size_t(j)]) &&
+              (!stuck || IsZeroBlock(m.W_turn[std::size_t(i)][std::size_t(j)])))
             continue;
           if (si != sj || moving >= 0)
             split = false;
