@@ -1189,7 +1189,9 @@ int Collision::Query(std::span<const Eigen::Vector3d> nodes_W, const Eigen::Vect
           // Kept as Keep would, without its finiteness test: 0 < d < band_m is finite (the test
           // and a second comparison with the band were a tenth of each such capsule's steps).
           kept_k.d_m = d;
-          kept_k.ends_W_m = Eigen::Map<const Eigen::Matrix<double, 3, 2>>(a_W.data());  // a_W, b_W
+          // a_W and b_W are nodes k and k + 1 of the span, contiguous: one 3 x 2 block, as in
+          // the strip's loop.
+          kept_k.ends_W_m = Eigen::Map<const Eigen::Matrix<double, 3, 2>>(a_W.data());
           if (group_mask != 0) {
             emit_deferred(k, d, group_mask);
           } else {
