@@ -264,13 +264,7 @@ bool SolveAmplitudeFrom(const Loading& load, double alpha, double t_near, double
   if (low ? !(t_near > 0.0) : !(y_near > 0.0 && y_near < gap)) return false;
   const double log_alpha = std::log(alpha);
   double v = low ? std::log(t_near) : -std::log(y_near);
-  // The upper bound log(gap) of p = log t (t < gap; y > 0 always) is formed when a step first
-  // goes up: v stays below it throughout (it starts at log t with t < gap / 2, and each step's
-  // end was checked against it), so a step's end at or below v passes the check without it. The
-  // same decisions, so the same bits; a logarithm saved in a solve whose steps all go down (~30
-  // instructions a three-PC tick).
-  double v_max = low ? 0.0 : 1e300;
-  bool v_max_formed = !low;
+  const double v_max = low ? std::log(gap) : 1e300;  // t < gap; y > 0 always
   const double v_min = low ? -1e300 : -std::log(gap);
   for (int i = 0; i < kWarmIterations; ++i) {
     double residual = 0.0, slope = 0.0;
@@ -284,14 +278,7 @@ bool SolveAmplitudeFrom(const Loading& load, double alpha, double t_near, double
     if (!(slope > 0.0) || !std::isfinite(residual)) return false;
     const double step = residual / slope;
     const double next = v - step;
-    if (!(next > v_min)) return false;
-    if (next > v) {
-      if (!v_max_formed) {
-        v_max = std::log(gap);
-        v_max_formed = true;
-      }
-      if (!(next < v_max)) return false;
-    }
+    if (!(next > v_min && next < v_max)) return false;
     // The same end as BracketedNewton's: after a step this small, the trial at the step's end.
     // Its residual and slope would not be used: only the trial is formed (the slope's three R_D
     // and the residual's logarithms are saved; the numbers are the same).
