@@ -62,7 +62,7 @@ nlohmann::json ToJson(const study::AccuracyReport& r) {
                          {"uncertainty", s.uncertainty},
                          {"time_ms_per_solve", s.time_ms}});
   return {{"scene", r.scene},
-          {"capsules", r.capsules},
+          {"elements", r.elements},
           {"rows", rows},
           {"references",
            {{"tip_loads",
@@ -81,7 +81,7 @@ std::string Sci(double v) {
 }
 
 void PrintText(const study::AccuracyReport& r, std::ostream& out) {
-  out << "accuracy of " << r.scene << " (the tube as " << r.capsules << " capsules)\n\n";
+  out << "accuracy of " << r.scene << " (the tube as " << r.elements << " rod elements)\n\n";
   out << "reference rod convergence:\n";
   for (const study::ConvergenceStudy& c : r.convergence) {
     out << "  " << c.problem << ", " << c.quantity << ", error against " << c.against << ":\n";

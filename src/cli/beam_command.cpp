@@ -44,7 +44,10 @@ int RunBeam(const BeamOptions& o, Streams io) {
     io.err << loaded.diagnostics.FormatAll();
     if (!loaded.scene) return kExitBadInput;
     spec = loaded.scene->tube;
-    beam_model = loaded.scene->model.beam;
+    // The rod's large-deflection limit is the elastica.
+    beam_model = loaded.scene->model.tube == scene::TubeModel::kLinear
+                      ? model::BeamModel::kLinear
+                      : model::BeamModel::kElastica;
   }
   std::vector<std::string> errors;
   auto quantity = [&](const std::string& text, const char* option, io::Dimension dim,

@@ -222,24 +222,15 @@ struct CoreRun {
   long tick = 0;
 };
 
-// Which model drew the tube in the core's last tick.
-std::string ShapeModel(const core::Core& core) {
-  const std::uint32_t flags = core.last().flags;
-  if (flags & core::kRodShape) return "rod";
-  if (flags & core::kLinearFallback) return "linear (fallback)";
-  return core.scene().model.beam == model::BeamModel::kElastica ? "elastica" : "linear";
-}
-
 Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string what,
                       Eigen::Isometry3d at,
                       std::function<Eigen::Isometry3d(const Eigen::Isometry3d&, long)> motion,
-                      bool mesh = false, bool leave_out_idle = true) {
+                      bool mesh = false) {
   auto runs = std::make_shared<std::array<CoreRun, kReplicas>>();
   const Eigen::Isometry3d start = scene.X_WH_start;
   const double T = scene.model.time_step_s;
   for (CoreRun& run : *runs) {
     run.core = std::make_shared<core::Core>(scene);
-    run.core->set_leave_out_idle_parts(leave_out_idle);
     for (int i = 0; i <= 800; ++i) {
       const double u = std::min(1.0, i / 500.0);
       const double w = u * u * (3.0 - 2.0 * u);
@@ -254,7 +245,7 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
   const auto step = [runs, at, motion, mesh, T](int replica) {
     CoreRun& run = (*runs)[std::size_t(replica)];
     const core::StepOutput& out = run.core->Step(run.t_s += T, motion(at, run.tick++));
-    double acc = out.force_W_N.x() + out.energy_J;
+    double acc = out.force_W_N.x() + out.energy_J + out.iterations;
     if (mesh) {
       std::array<Eigen::Vector3d, 21> centreline;
       run.core->Centreline(centreline);
@@ -270,11 +261,9 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
     const core::Core& core = *(*runs)[0].core;
     return nlohmann::json{{"cf", core.FormationText()},
                           {"pcs", core.last().contact_count},
-                          {"narrow_phase_calls", core.narrow_phase_calls()},
-                          {"idle_parts_left_out", core.idle_parts_left_out()},
-                          {"idle_retries", core.idle_retries()},
-                          {"shape", ShapeModel(core)},
-                          {"capsules", core.capsule_count()}};
+                          {"iterations", core.last().iterations},
+                          {"model", scene::ToString(core.scene().model.tube)},
+                          {"elements", core.element_count()}};
   };
   return s;
 }
@@ -313,13 +302,11 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
       CoreScenario(scene, "core.three_pcs",
                    "lying in the groove, turned to touch both walls: floor, left wall, right wall",
                    HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
-  // A line contact (the side lying along the floor, two load points on one cantilever): the
-  // elastica does not cover it and the rod shapes the tube.
+  // A line contact: the side lying along the floor, carried by every section on it.
   out.push_back(CoreScenario(scene, "core.side_on_floor",
-                             "lying along the floor, pressed onto it (a line contact: the rod)",
+                             "lying along the floor, pressed onto it (a line contact)",
                              HandPose(0.0, -0.090, 0.0076, 0.0, 0.0), dither));
-  // The leave-out effect: the same stuck tip without friction, with the shape asked for, and
-  // with the idle parts in.
+  // The leave-out effect: the same stuck tip without friction, and with the shape asked for.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
   for (scene::BoxPart& part : frictionless.parts) part.friction.reset();
@@ -328,13 +315,8 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   out.push_back(CoreScenario(scene, "core.end_stuck.mesh",
                              "core.end_stuck and the centreline (21 points) every tick", end_pose,
                              dither, true));
-  // And with every part in the band queried each tick: the groove's walls beside the centred
-  // tube, which the core leaves out while they cannot be reached (docs/core.md, "Idle parts").
-  out.push_back(CoreScenario(scene, "core.end_stuck.all_parts",
-                             "core.end_stuck with idle parts queried and in the tick's system",
-                             end_pose, dither, false, false));
   scene::Scene linear = scene;
-  linear.model.beam = model::BeamModel::kLinear;
+  linear.model.tube = scene::TubeModel::kLinear;
   out.push_back(CoreScenario(linear, "core.end_stuck.linear",
                              "core.end_stuck with the linear beam model", end_pose, dither));
   out.push_back(CoreScenario(linear, "core.three_pcs.linear",
@@ -445,8 +427,8 @@ int RunBench(const BenchOptions& o, Streams io) {
       }
       if (scenario.state) {
         const nlohmann::json state = scenario.state();
-        io.out << "   " << state["cf"].get<std::string>() << " (" << state["narrow_phase_calls"]
-               << " narrow-phase queries, " << state["shape"].get<std::string>() << ")";
+        io.out << "   " << state["cf"].get<std::string>() << " (" << state["elements"].get<int>()
+               << " elements, " << state["iterations"].get<int>() << " iterations)";
       }
       io.out << "\n";
     }

@@ -37,7 +37,7 @@ std::string Summary(const scene::Scene& s) {
     // What the core keeps of it: parts beyond the tube's reach from the workspace are left out.
     const core::Core core(s);
     out << " (" << core.reachable_parts().size() << " parts, " << core.elements().size()
-        << " elements within reach; the tube as " << core.capsule_count() << " capsules)";
+        << " elements within reach; the tube as " << core.element_count() << " rod elements)";
   }
   out << "; ";
   if (s.friction.IsFrictionless()) {
@@ -45,7 +45,7 @@ std::string Summary(const scene::Scene& s) {
   } else {
     out << "friction " << s.friction.static_coefficient << "/" << s.friction.kinetic_coefficient;
   }
-  out << "; " << model::ToString(s.model.beam) << " beam; goal " << states::ToString(s.goal)
+  out << "; " << scene::ToString(s.model.tube) << " model; goal " << states::ToString(s.goal)
       << "; alpha at 1 N: " << model::LoadParameter(t, 1.0);
   return out.str();
 }

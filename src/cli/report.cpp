@@ -41,9 +41,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                              {"energy_entry_J", v.energy_entry_J},
                              {"energy_exit_J", v.energy_exit_J},
                              {"beyond_linear_s", v.beyond_linear_s},
-                             {"shape_off_s", v.shape_off_s},
-                             {"held_s", v.held_s},
-                             {"segmentation_off_s", v.segmentation_off_s}});
+                             {"unconverged_s", v.unconverged_s}});
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -101,19 +99,10 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
       t << "      warning: for " << v.beyond_linear_s
         << " s the linear model drew the tube beyond its range (tip deflection above l/3): "
            "the verdict rests on a shape the tube cannot take\n";
-    if (v.shape_off_s > 0.0)
-      t << "      warning: for " << v.shape_off_s
-        << " s the tube's shape was off the points its contacts were solved at (flag shape_off): "
-           "the verdict rests on ticks the core did not resolve\n";
-    if (v.held_s > 0.0)
-      t << "      warning: for " << v.held_s
-        << " s the core held the tube back from going through a part (flag held): the tube did "
-           "not follow the plan's hand there\n";
-    if (v.segmentation_off_s > 0.0)
-      t << "      warning: for " << v.segmentation_off_s
-        << " s the segmented rule was outside its range (flag segmentation_off: it left out more "
-           "than eps/10 at a load point): the verdict rests on forces the coupled rule would "
-           "correct (multi_contact: coupled)\n";
+    if (v.unconverged_s > 0.0)
+      t << "      warning: for " << v.unconverged_s
+        << " s the core's solve stopped short of its tolerance (flag unconverged): the tube was "
+           "snapping through, or the hand jumped, and was between equilibria there\n";
   }
   t.precision(precision);
 }

@@ -52,20 +52,14 @@ std::string_view FlagName(std::uint32_t bit) {
       return "separated";
     case core::kContactsTruncated:
       return "truncated";
-    case core::kLinearFallback:
-      return "linear_fallback";
+    case core::kNotConverged:
+      return "unconverged";
     case core::kSolverFault:
       return "fault";
     case core::kBeyondLinearRange:
       return "beyond_linear";
-    case core::kRodShape:
-      return "rod";
-    case core::kShapeOffContacts:
-      return "shape_off";
-    case core::kHeldBack:
-      return "held";
-    case core::kSegmentationOff:
-      return "segmentation_off";
+    case core::kBuckled:
+      return "buckled";
     default:
       return "unknown";
   }

@@ -12,7 +12,7 @@ namespace tubeplan::cli {
 enum class SeriesFormat { kNone, kCsv, kJsonLines };
 
 /// Name of one StepFlag bit: "clamped", "penetration", "separated", "truncated",
-/// "linear_fallback", "fault", "beyond_linear", "rod", "shape_off", "held".
+/// "unconverged", "fault", "beyond_linear", "buckled".
 std::string_view FlagName(std::uint32_t bit);
 
 class SeriesWriter {

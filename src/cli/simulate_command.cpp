@@ -144,7 +144,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["ticks"] = tick_count;
     j["time_step_s"] = s.model.time_step_s;
     j["duration_s"] = duration_s;
-    j["capsules"] = core.capsule_count();
+    j["elements"] = core.element_count();
     nlohmann::json v = nlohmann::json::array();
     for (const Visit& visit : visits) v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
     j["visits"] = v;
@@ -171,8 +171,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   std::ostringstream text;
   text << std::setprecision(4);
   text << o.scene_path << " + " << o.trajectory_path << ": " << tick_count << " ticks of "
-       << s.model.time_step_s * 1e3 << " ms (" << duration_s << " s), " << core.capsule_count()
-       << " capsules\n";
+       << s.model.time_step_s * 1e3 << " ms (" << duration_s << " s), " << core.element_count()
+       << " rod elements\n";
   text << "contact formations, in order (t = entry time):\n";
   const std::size_t shown = std::min<std::size_t>(visits.size(), 40);
   for (std::size_t i = 0; i < shown; ++i)

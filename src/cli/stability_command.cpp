@@ -1,4 +1,4 @@
-// `tubeplan stability`: the sweep of stiff and extreme cases through the core (issue 7): a
+// `tubeplan stability`: the sweep of stiff and extreme cases through the core: a
 // pass/fail matrix, the first failing tick of each failure, exit 1 when any case fails.
 #include <algorithm>
 #include <iomanip>
@@ -47,17 +47,12 @@ int ReportStability(std::span<const study::StabilityResult> results, bool json, 
                           {"peak_force_N", r.peak_force_N}};
       j["first_failing_tick"] =
           r.first_failing_tick >= 0 ? nlohmann::json(r.first_failing_tick) : nlohmann::json();
-      j["first_shape_off_tick"] =
-          r.first_shape_off_tick >= 0 ? nlohmann::json(r.first_shape_off_tick) : nlohmann::json();
-      j["held_ticks"] = r.held_ticks;
-      j["first_held_tick"] =
-          r.first_held_tick >= 0 ? nlohmann::json(r.first_held_tick) : nlohmann::json();
+      j["unconverged_ticks"] = r.unconverged_ticks;
+      j["first_unconverged_tick"] = r.first_unconverged_tick >= 0
+                                        ? nlohmann::json(r.first_unconverged_tick)
+                                        : nlohmann::json();
       j["warning"] = r.warning.empty() ? nlohmann::json() : nlohmann::json(r.warning);
       j["outside_validity"] = r.outside;
-      j["judged_with"] = r.judged_coupled ? "coupled" : "as given";
-      j["first_segmentation_off_tick"] = r.first_segmentation_off_tick >= 0
-                                             ? nlohmann::json(r.first_segmentation_off_tick)
-                                             : nlohmann::json();
       cases.push_back(j);
     }
     io.out << nlohmann::json{{"cases", cases}, {"pass", all}}.dump(2) << "\n";
@@ -82,15 +77,11 @@ int ReportStability(std::span<const study::StabilityResult> results, bool json, 
         std::string text = "-";
         if (it != cell.end()) {
           const study::StabilityResult& r = *it->second;
-          // "coupled": judged with the coupled rule, the segmented one outside its range;
-          // "held": the core held the tube back from going through a part in some ticks;
-          // "shape off": a pass whose shape left the points its contacts held (a FAIL's line
-          // below says so): the checks passed a replay that is not the tube's motion there.
+          // "outside": beyond the model's validity; "snaps": some ticks' solves stopped short
+          // of their tolerance (the tube snapping through, or the hand jumping).
           std::string notes;
-          for (const auto& [on, note] :
-               {std::pair{r.judged_coupled, "coupled"}, std::pair{r.outside, "outside"},
-                std::pair{r.held_ticks > 0, "held"},
-                std::pair{r.pass && r.first_shape_off_tick >= 0, "shape off"}})
+          for (const auto& [on, note] : {std::pair{r.outside, "outside"},
+                                         std::pair{r.unconverged_ticks > 0, "snaps"}})
             if (on) notes += (notes.empty() ? "" : ", ") + std::string(note);
           text = (r.pass ? "pass" : "FAIL @" + std::to_string(r.first_failing_tick)) +
                  (notes.empty() ? "" : " (" + notes + ")");

@@ -1,45 +1,14 @@
-#include <array>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 
 #include <tubeplan/core/friction.hpp>
 
 namespace tubeplan::core {
-namespace {
-
-// std::pow(base, exponent), the last four results kept per thread. A tick asks for the same
-// power several times (a load point's static and kinetic shares, its PC's limit at the PC's load;
-// with several PCs their loads in turn, and each pass of the solve asks again), and pow costs a
-// hundred instructions or more. The same bits in, the same bits out: pow is a function of its
-// arguments alone. (Looking at the newest first, or keeping the last one apart, cost more than
-// the plain scan.)
-double LoadPower(double base, double exponent) {
-  struct Entry {
-    std::uint64_t base = 0, exponent = 0;
-    double power = 1.0;  // std::pow(0.0, 0.0), for the bits above
-  };
-  thread_local std::array<Entry, 4> cache{};
-  thread_local unsigned next = 0;  // the oldest, replaced next
-  const auto base_bits = std::bit_cast<std::uint64_t>(base);
-  const auto exponent_bits = std::bit_cast<std::uint64_t>(exponent);
-  for (const Entry& e : cache)
-    if (e.base == base_bits && e.exponent == exponent_bits) return e.power;
-  Entry& e = cache[next];
-  next = (next + 1) % cache.size();
-  e.base = base_bits;
-  e.exponent = exponent_bits;
-  e.power = std::pow(base, exponent);
-  return e.power;
-}
-
-}  // namespace
 
 double FrictionLimit(const scene::Friction& friction, double coefficient, double normal_N) {
   if (!(normal_N > 0.0)) return 0.0;
   if (friction.exponent == 1.0) return coefficient * normal_N;  // Coulomb: exact, no pow
   const double n0 = friction.reference_load_N;
-  return coefficient * n0 * LoadPower(normal_N / n0, friction.exponent);
+  return coefficient * n0 * std::pow(normal_N / n0, friction.exponent);
 }
 
 double FrictionShare(const scene::Friction& friction, double coefficient, double normal_N,

@@ -238,11 +238,10 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
 
   for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
-    if (out.flags & core::kHeldBack) {
-      // The core held the tube back: this tick would have carried it through a part (docs/
-      // core.md, "Through a part"). The tube cannot follow the hand further, and what a motion
-      // reaches after that it reaches only by snapping after the hand once the hold lets go, so
-      // the motion ends here (the held tick, which kept the last state, is not recorded).
+    if (out.flags & core::kProxySeparated) {
+      // The coupling is stretched beyond the device's force: the tube no longer follows the
+      // hand, and what the motion would reach beyond here no operator could, so it ends (the
+      // tick is not recorded).
       result.held_back = true;
       ++k;
       break;

@@ -262,47 +262,43 @@ void ReadDevice(Reader& r, const YAML::Node& node, scene::Device& d) {
 
 void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
   const std::string w = "model";
-  if (!r.ExpectMap(node, w, {"beam", "multi_contact", "slip", "time_step", "capsules"})) return;
+  if (!r.ExpectMap(node, w, {"beam", "elements", "time_step", "multi_contact", "slip", "capsules"}))
+    return;
+  // "elastica" is the rod's own limit: the discrete rod converges to it as elements are added.
   if (const YAML::Node n = r.Get(node, "beam", w, false); n.IsDefined())
-    if (const auto v = r.Choice<model::BeamModel>(
-            n, "model.beam",
-            {{"linear", model::BeamModel::kLinear}, {"elastica", model::BeamModel::kElastica}}))
-      m.beam = *v;
-  if (const YAML::Node n = r.Get(node, "multi_contact", w, false); n.IsDefined())
-    if (const auto v =
-            r.Choice<scene::MultiContactRule>(n, "model.multi_contact",
-                                              {{"segmented", scene::MultiContactRule::kSegmented},
-                                               {"coupled", scene::MultiContactRule::kCoupled}}))
-      m.multi_contact = *v;
-  if (const YAML::Node n = r.Get(node, "slip", w, false); n.IsDefined())
-    if (const auto v =
-            r.Choice<scene::SlipRule>(n, "model.slip",
-                                      {{"return-mapping", scene::SlipRule::kReturnMapping},
-                                       {"paper", scene::SlipRule::kPaper}}))
-      m.slip = *v;
+    if (const auto v = r.Choice<scene::TubeModel>(n, "model.beam",
+                                                  {{"rod", scene::TubeModel::kRod},
+                                                   {"elastica", scene::TubeModel::kRod},
+                                                   {"linear", scene::TubeModel::kLinear}}))
+      m.tube = *v;
+  // Options of an earlier core, which solved contacts one after another: the rod solves them
+  // together, so they no longer choose anything.
+  for (const char* gone : {"multi_contact", "slip", "capsules"})
+    if (const YAML::Node n = r.Get(node, gone, w, false); n.IsDefined())
+      r.Warning(n, std::string("model.") + gone +
+                       " has no effect: the core solves the rod and all its contacts together "
+                       "(model.elements sets the rod's resolution)");
   // Up to 10 ms: slower than 100 Hz is not haptics, and the contact spring needs small steps.
   if (r.Field(node, "time_step", w, dim::kTime, false, m.time_step_s) &&
       (m.time_step_s <= 0.0 || m.time_step_s > 0.010))
     r.Error(r.Get(node, "time_step", w, false),
             "model.time_step must be in (0, 10 ms], expected e.g. \"1 ms\" (1 kHz)");
-  // The chain's capsule count: "auto" (the core's choice) or a whole number the core supports.
-  if (const YAML::Node n = r.Get(node, "capsules", w, false); n.IsDefined()) {
+  // The rod's element count: "auto" (the core's default) or a whole number the core supports.
+  if (const YAML::Node n = r.Get(node, "elements", w, false); n.IsDefined()) {
     const std::string expected = "expected \"auto\" or a whole number from " +
-                                 std::to_string(core::kMinCapsules) + " to " +
-                                 std::to_string(core::kMaxCapsules);
+                                 std::to_string(core::kMinElementCount) + " to " +
+                                 std::to_string(core::kMaxElementCount);
     if (n.IsScalar() && n.Scalar() == "auto") {
-      m.capsules = 0;
+      m.elements = 0;
     } else if (!n.IsScalar()) {
-      r.Error(
-          n, "model.capsules must be a count, found " + std::string(KindName(n)) + ", " + expected);
-    } else if (const auto v = r.Quantity(n, "model.capsules", dim::kNone)) {
-      if (*v != std::floor(*v) || *v < core::kMinCapsules || *v > core::kMaxCapsules)
-        r.Error(n, "model.capsules " + Abbreviate(n.Scalar()) +
-                       " is not a count the core "
-                       "supports, " +
-                       expected);
+      r.Error(n, "model.elements must be a count, found " + std::string(KindName(n)) + ", " +
+                     expected);
+    } else if (const auto v = r.Quantity(n, "model.elements", dim::kNone)) {
+      if (*v != std::floor(*v) || *v < core::kMinElementCount || *v > core::kMaxElementCount)
+        r.Error(n, "model.elements " + Abbreviate(n.Scalar()) +
+                       " is not a count the core supports, " + expected);
       else
-        m.capsules = static_cast<int>(*v);
+        m.elements = static_cast<int>(*v);
     }
   }
 }

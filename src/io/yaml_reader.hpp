@@ -88,7 +88,18 @@ class Reader {
   void Error(const YAML::Node& node, const std::string& message, std::size_t column_offset = 0) {
     Error(node.Mark(), message, column_offset);
   }
-  std::size_t error_count() const { return diag_.all().size(); }
+  void Warning(const YAML::Node& node, const std::string& message) {
+    const YAML::Mark mark = node.Mark();
+    if (mark.line < 0)
+      diag_.Warning(file_, 0, 0, message);
+    else
+      diag_.Warning(file_, mark.line + 1, mark.column + 1, message);
+  }
+  std::size_t error_count() const {
+    std::size_t n = 0;
+    for (const Diagnostic& d : diag_.all()) n += d.severity == Severity::kError;
+    return n;
+  }
 
   /// Checks that `node` is a map whose keys are all in `allowed` (each once); reports unknown and
   /// duplicate keys. Returns false (after reporting) when the node is not a map.

@@ -72,9 +72,7 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
     const double force_N = out.force_W_N.norm();
     v.peak_force_N = std::max(v.peak_force_N, force_N);
     if (out.flags & core::kBeyondLinearRange) v.beyond_linear_s += step_s_;
-    if (out.flags & core::kShapeOffContacts) v.shape_off_s += step_s_;
-    if (out.flags & core::kHeldBack) v.held_s += step_s_;
-    if (out.flags & core::kSegmentationOff) v.segmentation_off_s += step_s_;
+    if (out.flags & core::kNotConverged) v.unconverged_s += step_s_;
     if (force_N > limits_.max_force_N && v.reason.empty())
       Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s));
     if (out.max_strain > limits_.max_strain && v.reason.empty())

@@ -2,6 +2,10 @@
 
 namespace tubeplan::scene {
 
+const char* ToString(TubeModel model) {
+  return model == TubeModel::kLinear ? "linear" : "rod";
+}
+
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index) {
   const auto& own = scene.parts.at(part_index).friction;
   return own ? *own : scene.friction;

@@ -72,7 +72,9 @@ void TipLoadRows(const scene::Scene& base, const AccuracyOptions& options, Accur
       row.setting = std::string(model::ToString(m));
       row.scenario = scenario;
       row.time_us = time_us;
-      row.is_default = m == base.model.beam;
+      // The rod's limit, as elements are added, is the elastica.
+      row.is_default = (m == model::BeamModel::kLinear) ==
+                       (base.model.tube == scene::TubeModel::kLinear);
       if (m == model::BeamModel::kLinear) {
         // Against the exact elastica (closed form).
         const TipError e =
@@ -232,16 +234,10 @@ struct CoreRun {
   double us_per_tick = 0.0;
   int ticks = 0;
   std::uint32_t flags = 0;
-  // First tick (from 1) the core flagged its shape off its contacts' points, and a tube and a
-  // part overlapping: where a row's error stops being the model's and becomes a failure.
-  int first_shape_off_tick = -1, first_penetration_tick = -1;
-  // First tick the paper's segmented rule was outside its range (core::kSegmentationOff), and the
-  // most it left out at a load point.
-  int first_segmentation_off_tick = -1;
-  double segmentation_error_m = 0.0;
-  // Ticks the core held the tube back from going through a part: their force is the coupling's,
-  // not the contacts' (docs/core.md, "Through a part").
-  int held_ticks = 0, first_held_tick = -1;
+  // First tick (from 1) a tube and a part overlapped, and ticks whose solve stopped short of its
+  // tolerance: where a row's error may stop being the model's.
+  int first_penetration_tick = -1;
+  int unconverged_ticks = 0;
 };
 
 Eigen::Isometry3d HandAt(const Vector2d& xz) {
@@ -267,17 +263,9 @@ CoreRun RunCore(const scene::Scene& s, const Scenario& sc) {
       spent += Clock::now() - t0;
       run.flags |= out.flags;
       ++run.ticks;
-      if ((out.flags & core::kShapeOffContacts) && run.first_shape_off_tick < 0)
-        run.first_shape_off_tick = run.ticks;
       if ((out.flags & core::kPenetration) && run.first_penetration_tick < 0)
         run.first_penetration_tick = run.ticks;
-      if ((out.flags & core::kSegmentationOff) && run.first_segmentation_off_tick < 0)
-        run.first_segmentation_off_tick = run.ticks;
-      run.segmentation_error_m = std::max(run.segmentation_error_m, out.segmentation_error_m);
-      if (out.flags & core::kHeldBack) {
-        if (run.first_held_tick < 0) run.first_held_tick = run.ticks;
-        ++run.held_ticks;
-      }
+      if (out.flags & core::kNotConverged) ++run.unconverged_ticks;
     }
     hand = target;
   };
@@ -383,22 +371,19 @@ ScenarioReference SolveReference(const scene::Scene& base, double coupling_N_per
 
 struct Setting {
   std::string name;
-  model::BeamModel beam = model::BeamModel::kLinear;
-  scene::MultiContactRule rule = scene::MultiContactRule::kSegmented;
+  scene::TubeModel tube = scene::TubeModel::kRod;
+  int elements = 0;  // 0: the scene's
   double dt_s = 1e-3;
   double K = 1e4, eps = 1e-3;
   bool vs_rigid = false;
   bool is_default = false;
-  int capsules = 0;  // 0: the core's choice
 };
 
-std::string SettingName(const Setting& s, const scene::Scene& base) {
-  std::string name = std::string(model::ToString(s.beam)) +
-                     (s.rule == scene::MultiContactRule::kSegmented ? " segmented" : " coupled");
+std::string SettingName(const Setting& s, const scene::Scene& base, int elements) {
+  std::string name = Fmt("%s N=%d", scene::ToString(s.tube), s.elements > 0 ? s.elements : elements);
   if (s.dt_s != base.model.time_step_s) name += Fmt(" dt=%gms", s.dt_s * 1e3);
   if (s.K != base.contact.stiffness_N_per_m || s.vs_rigid) name += Fmt(" K=%gN/m", s.K);
   if (s.eps != base.contact.threshold_m || s.vs_rigid) name += Fmt(" eps=%gmm", s.eps * 1e3);
-  if (s.capsules > 0) name += Fmt(" capsules=%d", s.capsules);
   return name;
 }
 
@@ -439,7 +424,7 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
   base.workspace.reset();
   {
     core::Core probe(base);
-    report.capsules = probe.capsule_count();
+    report.elements = probe.element_count();
     base.device.coupling_stiffness_N_per_m = probe.coupling_stiffness_N_per_m();
   }
   const double Kc = *base.device.coupling_stiffness_N_per_m;
@@ -450,30 +435,24 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
   const int N = options.quick ? 64 : 128;
   const std::vector<Scenario> scenarios = MakeScenarios(base, options.quick);
 
-  // The settings: both beams under both multi-contact rules; a finer time step; contact
-  // stiffness and threshold (these against the rigid contact: how far the penalty law itself is
-  // from a hard wall).
+  // The settings: the scene's model at its element count, and the rod at other counts (its
+  // convergence); the other model; a finer time step; contact stiffness and threshold (these
+  // against the rigid contact: how far the penalty law itself is from a hard wall).
   std::vector<Setting> settings;
   const double K0 = base.contact.stiffness_N_per_m, eps0 = base.contact.threshold_m;
-  for (const model::BeamModel b : {model::BeamModel::kLinear, model::BeamModel::kElastica})
-    for (const auto r : {scene::MultiContactRule::kSegmented, scene::MultiContactRule::kCoupled}) {
-      Setting s{"", b, r, base.model.time_step_s, K0, eps0, false, false};
-      s.is_default = b == base.model.beam && r == base.model.multi_contact;
-      settings.push_back(s);
-    }
-  settings.push_back({"", base.model.beam, base.model.multi_contact, base.model.time_step_s / 4, K0,
-                      eps0, false, false});
+  const double dt0 = base.model.time_step_s;
+  const scene::TubeModel own = base.model.tube;
+  settings.push_back({"", own, 0, dt0, K0, eps0, false, true});
+  for (const int n : {8, 12, 16, 32, 48})
+    if (n != report.elements) settings.push_back({"", scene::TubeModel::kRod, n, dt0, K0, eps0});
+  settings.push_back({"", own == scene::TubeModel::kRod ? scene::TubeModel::kLinear
+                                                        : scene::TubeModel::kRod,
+                      0, dt0, K0, eps0});
+  settings.push_back({"", own, 0, dt0 / 4, K0, eps0});
   for (const double k : {0.1, 1.0, 10.0})
     for (const double e : {0.1, 1.0})
-      settings.push_back({"", base.model.beam, base.model.multi_contact, base.model.time_step_s,
-                          k * K0, e * eps0, true, k == 1.0 && e == 1.0});
-  // Fewer capsules than the core chooses: a coarser chain (chord error up to epsilon / 10 at the
-  // device's force with the core's count, 4 times that at half the count) for a cheaper tick.
-  for (const int n : {8, 16, 32})
-    if (n < report.capsules)
-      settings.push_back({"", base.model.beam, base.model.multi_contact, base.model.time_step_s, K0,
-                          eps0, false, false, n});
-  for (Setting& s : settings) s.name = SettingName(s, base);
+      settings.push_back({"", own, 0, dt0, k * K0, e * eps0, true});
+  for (Setting& s : settings) s.name = SettingName(s, base, report.elements);
 
   for (const Scenario& sc : scenarios) {
     const ScenarioReference same = SolveReference(base, Kc, sc, {K0, eps0}, N, "same law");
@@ -484,12 +463,11 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
       scene::Scene s = base;
       s.parts = sc.parts;
       s.friction = sc.friction;
-      s.model.beam = st.beam;
-      s.model.multi_contact = st.rule;
+      s.model.tube = st.tube;
+      if (st.elements > 0) s.model.elements = st.elements;
       s.model.time_step_s = st.dt_s;
       s.contact.stiffness_N_per_m = st.K;
       s.contact.threshold_m = st.eps;
-      if (st.capsules > 0) s.model.capsules = st.capsules;
       const CoreRun run = RunCore(s, sc);
       const ScenarioReference& ref = st.vs_rigid ? rigid : same;
       double fmax = 0.0;
@@ -518,21 +496,13 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
                                      ref.step.size())
                                : std::string());
       if (ref.uncertainty >= 1.0) row.detail += "; REFERENCE NOT CONVERGED at some step";
-      if (run.flags & core::kLinearFallback) row.detail += "; linear fallback seen";
       if (run.flags & core::kSolverFault) row.detail += "; SOLVER FAULT seen";
       if (run.flags & core::kForceClamped) row.detail += "; force clamped";
-      if (run.first_shape_off_tick >= 0)
-        row.detail += Fmt("; SHAPE OFF ITS CONTACTS from tick %d", run.first_shape_off_tick);
       if (run.first_penetration_tick >= 0)
         row.detail += Fmt("; tube and part overlap from tick %d", run.first_penetration_tick);
-      if (run.first_segmentation_off_tick >= 0)
-        row.detail +=
-            Fmt("; SEGMENTED RULE OUT OF RANGE from tick %d (%.3g mm left out at most, "
-                "linear estimate)",
-                run.first_segmentation_off_tick, run.segmentation_error_m * 1e3);
-      if (run.held_ticks > 0)
-        row.detail += Fmt("; HELD BACK from going through a part in %d of %d ticks, from tick %d",
-                          run.held_ticks, run.ticks, run.first_held_tick);
+      if (run.unconverged_ticks > 0)
+        row.detail += Fmt("; the solve stopped short of its tolerance in %d of %d ticks",
+                          run.unconverged_ticks, run.ticks);
       report.rows.push_back(row);
     }
   }
@@ -560,10 +530,9 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
       c.order.push_back(std::log2(c.error[i - 1] / c.error[i]));
     report.convergence.push_back(c);
   }
-  report.notes.push_back("capsule count: chosen by the core from the scene (ChainCapsuleCount), " +
-                         std::to_string(report.capsules) +
-                         " here, unless the scene sets model.capsules; the 'capsules=N' rows use "
-                         "fewer");
+  report.notes.push_back("rod elements: " + std::to_string(report.elements) +
+                         " here (the scene's model.elements, or the core's default); the 'N=' "
+                         "rows show the rod's convergence in its element count");
   report.notes.push_back(
       "contact rows 'vs hard contact' compare with a contact at the geometric surface "
       "(reference K = 10 x the scene's, eps = 0: 0.1 mm in at 1 N on the rubber scene's K): "

@@ -30,7 +30,7 @@ scene::BoxPart Box(const std::string& name, const Vector3d& size, const Vector3d
 }
 
 // The rubber tube of scenes/groove.yaml (Table I material, the paper's K, eps and friction) with
-// the PHANToM Premium, the elastica and the segmented rule: the shipped default.
+// the PHANToM Premium and the rod: the shipped default.
 scene::Scene BaseScene() {
   scene::Scene s;
   s.name = "stability";
@@ -39,8 +39,6 @@ scene::Scene BaseScene() {
   s.friction = {0.7, 0.08, 2.0 / 3.0, 1.0};
   s.device.coupling_stiffness_N_per_m = 400.0;
   s.device.coupling_damping_Ns_per_m = 2.0;
-  s.model.beam = model::BeamModel::kElastica;
-  s.model.multi_contact = scene::MultiContactRule::kSegmented;
   return s;
 }
 
@@ -145,10 +143,7 @@ struct Run {
   int fail_finite = -1, fail_force = -1, fail_law = -1, fail_friction = -1, fail_passive = -1,
       fail_tunnel = -1, fail_fault = -1;
   int beyond_linear = -1;         // first tick the linear shape was beyond its range (not a check)
-  int shape_off = -1;             // first tick the shape was off its contacts' points (not a check)
-  int held = 0, first_held = -1;  // ticks held back from going through a part (not a check)
-  int segmentation_off = -1;      // first tick the segmented rule was outside its range
-  double segmentation_error_m = 0.0;  // the most it left out
+  int unconverged = 0, first_unconverged = -1;  // ticks the solve stopped short (not a check)
   std::string why_force, why_law, why_friction, why_passive, why_tunnel;
   double work_J = 0.0, stored_J = 0.0, initial_J = 0.0;
 };
@@ -187,12 +182,9 @@ Run Drive(const StabilityCase& c, bool check) {
     }
     if (o.flags & core::kSolverFault) Note(run.fail_fault, run.why_force, tick, run.why_force);
     if ((o.flags & core::kBeyondLinearRange) && run.beyond_linear < 0) run.beyond_linear = tick;
-    if ((o.flags & core::kShapeOffContacts) && run.shape_off < 0) run.shape_off = tick;
-    if ((o.flags & core::kSegmentationOff) && run.segmentation_off < 0) run.segmentation_off = tick;
-    run.segmentation_error_m = std::max(run.segmentation_error_m, o.segmentation_error_m);
-    if (o.flags & core::kHeldBack) {
-      ++run.held;
-      if (run.first_held < 0) run.first_held = tick;
+    if (o.flags & core::kNotConverged) {
+      ++run.unconverged;
+      if (run.first_unconverged < 0) run.first_unconverged = tick;
     }
     const Vector3d F = o.force_W_N, p = o.X_WH.translation();
     run.peak_force_N = std::max(run.peak_force_N, F.norm());
@@ -207,11 +199,11 @@ Run Drive(const StabilityCase& c, bool check) {
       Note(run.fail_force, run.why_force, tick,
            Fmt("|F| %.4g N against the device's %.4g N and the coupling's %.4g N", F.norm(),
                s.device.max_force_N, coupling_bound));
-    // The contact law: a PC of n load points carries at most n K (eps - d), d its smallest
-    // distance; 1 um of slack for the tick's linearisation of d in the motion.
+    // The contact law: a PC of n contact points carries at most n K (eps - d), d its smallest
+    // distance.
     double contact_energy_J = 0.0;
     for (const core::ContactState& pc : o.Contacts()) {
-      const double bound = std::max(0.0, pc.loads * K * (eps - pc.distance_m + 1e-6));
+      const double bound = std::max(0.0, pc.points * K * (eps - pc.distance_m));
       if (pc.normal_force_N > bound * (1 + 1e-6) + 1e-9)
         Note(run.fail_law, run.why_law, tick,
              Fmt("a contact carries %.4g N, its law allows %.4g N at d = %.4g m", pc.normal_force_N,
@@ -222,7 +214,7 @@ Run Drive(const StabilityCase& c, bool check) {
              Fmt("friction %.4g N beyond its limit %.4g N", pc.friction_W_N.norm(),
                  pc.friction_limit_N));
       // Lower bound of the penalty energy: n springs sharing N hold at least N^2 / (2 n K).
-      contact_energy_J += pc.normal_force_N * pc.normal_force_N / (2.0 * std::max(1, pc.loads) * K);
+      contact_energy_J += pc.normal_force_N * pc.normal_force_N / (2.0 * std::max(1, pc.points) * K);
     }
     // Passivity: what tube, proxy, contacts and coupling hold (a lower bound) never exceeds the
     // work the hand did on them. The hand pushes with -F; the work over the tick is integrated by
@@ -460,70 +452,31 @@ StabilityResult RunStabilityCase(const StabilityCase& c) {
   r.name = c.name;
   r.motion = ToString(c.motion);
   r.parameter = c.parameter;
-  const Run as_given = Drive(c, true);
-  const int as_given_bits = FirstDifferentTick(as_given, Drive(c, false));
-  // The paper's segmented rule outside its range (core::kSegmentationOff: it left out more than
-  // eps / 10 of displacement at a load point, a force error of K eps / 10): its answers there are
-  // not the tube's, and its one-way compliance can make energy. The case is judged with the
-  // coupled rule, the model valid there; the segmented run's safety checks still count, and what
-  // else it failed is reported.
-  r.first_segmentation_off_tick = as_given.segmentation_off;
-  r.judged_coupled = as_given.segmentation_off >= 0;
-  StabilityCase coupled = c;
-  coupled.scene.model.multi_contact = scene::MultiContactRule::kCoupled;
-  const Run first = r.judged_coupled ? Drive(coupled, true) : as_given;
-  const int bits =
-      r.judged_coupled ? FirstDifferentTick(first, Drive(coupled, false)) : as_given_bits;
+  const Run first = Drive(c, true);
+  const int bits = FirstDifferentTick(first, Drive(c, false));
   r.ticks = first.ticks;
-  r.peak_force_N = std::max(first.peak_force_N, as_given.peak_force_N);
+  r.peak_force_N = first.peak_force_N;
   constexpr int kNever = std::numeric_limits<int>::max();
   const std::string validity = Validity(c, first);
   r.outside = !validity.empty();
   const Verdict v = Judge(c, first, bits, r.outside ? 0 : kNever);
   r.pass = v.pass;
   r.first_failing_tick = v.first_failing_tick;
-  std::string failed = v.failed;
-  if (r.judged_coupled) {
-    // The segmented run: its safety checks count, and its physical ones where the rule was still
-    // in its range (before the flag) and the run within the model's validity.
-    const Verdict seg = Judge(c, as_given, as_given_bits,
-                              Validity(c, as_given).empty() ? as_given.segmentation_off : 0);
-    if (!seg.pass) {
-      r.pass = false;
-      if (r.first_failing_tick < 0 || seg.first_failing_tick < r.first_failing_tick)
-        r.first_failing_tick = seg.first_failing_tick;
-      failed +=
-          (failed.empty() ? "" : "; ") + std::string("under the segmented rule: ") + seg.failed;
-    }
-    r.warning = Fmt("the segmented rule outside its range from tick %d (it left out up to %.3g "
-                    "mm at a load point by the linear estimate, more than eps/10): judged with "
-                    "multi_contact: coupled",
-                    as_given.segmentation_off, as_given.segmentation_error_m * 1e3) +
-                (seg.warned.empty() ? "" : "; under the segmented rule: " + seg.warned);
-  }
   if (r.outside)
-    r.warning += std::string(r.warning.empty() ? "" : "; ") + "outside the model's validity (" +
-                 validity + ")" + (v.warned.empty() ? "" : "; there: " + v.warned);
+    r.warning = "outside the model's validity (" + validity + ")" +
+                (v.warned.empty() ? "" : "; there: " + v.warned);
   r.detail = r.pass ? Fmt("%d ticks, peak force %.3g N, largest strain %.3g", r.ticks,
                           r.peak_force_N, first.max_strain)
-                    : failed;
-  if (r.judged_coupled) r.detail += "; judged with the coupled rule";
-  // Where the failures usually start (docs/core.md): the linear shape drawn beyond its range.
+                    : v.failed;
+  // Where the linear beam was drawn beyond its range, and where the solve stopped short of its
+  // tolerance (a snap through, or a jump of the hand): shown, not judged.
   if (first.beyond_linear >= 0)
     r.detail += Fmt("; the linear shape beyond l/3 from tick %d", first.beyond_linear);
-  // And where the core's shape stopped following the contacts it solved (flag shape_off), in a
-  // pass too: such a pass is the checks' verdict on a replay that is not the tube's motion there
-  // (the 2 m/s slide passes with its shape off from tick 8, its rim 1.9 mm in the wall; review).
-  r.first_shape_off_tick = first.shape_off;
-  if (first.shape_off >= 0)
-    r.detail += Fmt("; the shape off its contacts from tick %d", first.shape_off);
-  // And where it held the tube back from going through a part: the tube then did not follow the
-  // hand (the operator felt the coupling's spring), which the checks above cannot see.
-  r.held_ticks = first.held;
-  r.first_held_tick = first.first_held;
-  if (first.held > 0)
-    r.detail += Fmt("; held back from going through a part in %d of %d ticks, from tick %d",
-                    first.held, first.ticks, first.first_held);
+  r.unconverged_ticks = first.unconverged;
+  r.first_unconverged_tick = first.first_unconverged;
+  if (first.unconverged > 0)
+    r.detail += Fmt("; the solve stopped short of its tolerance in %d of %d ticks, from tick %d",
+                    first.unconverged, first.ticks, first.first_unconverged);
   return r;
 }
 

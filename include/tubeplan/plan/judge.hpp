@@ -30,16 +30,9 @@ struct TransitionVerdict {
   /// Time the linear model drew the tube beyond its range (core flag beyond_linear: tip
   /// deflection above l/3): the verdict then rests on a shape the tube cannot take.
   double beyond_linear_s = 0.0;
-  /// Time the shape under the tick's loads was off the points the tick's contacts were solved
-  /// at (core flag shape_off): the verdict then rests on ticks the core did not resolve.
-  double shape_off_s = 0.0;
-  /// Time the core held the tube back from going through a part (core flag held): there the
-  /// tube did not follow the hand, and the operator felt the coupling's spring.
-  double held_s = 0.0;
-  /// Time the paper's segmented rule was outside its range (core flag segmentation_off: it left
-  /// out more than eps / 10 of displacement at a load point): the verdict then rests on forces
-  /// off by more than K eps / 10; the coupled rule has no such error.
-  double segmentation_off_s = 0.0;
+  /// Time the core's solve stopped short of its tolerance (core flag unconverged: the tube
+  /// snapping through, or the hand jumping): there the tube was between equilibria.
+  double unconverged_s = 0.0;
 };
 
 struct Observation {

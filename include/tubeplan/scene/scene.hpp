@@ -47,18 +47,21 @@ struct BoxPart {
   std::array<std::string, 6> face_names = {"top", "bottom", "xpos", "xneg", "ypos", "yneg"};
 };
 
-using model::BeamModel;
-enum class MultiContactRule { kSegmented, kCoupled };
-enum class SlipRule { kReturnMapping, kPaper };
+/// How the core models the tube's bending.
+enum class TubeModel {
+  kRod,     ///< a discrete Kirchhoff rod: large deflections, the elastica in the limit
+  kLinear,  ///< the paper's small-deflection beam (for comparison with the paper)
+};
+
+/// "rod" or "linear".
+const char* ToString(TubeModel model);
 
 struct ModelOptions {
-  BeamModel beam = BeamModel::kLinear;
-  MultiContactRule multi_contact = MultiContactRule::kSegmented;
-  SlipRule slip = SlipRule::kReturnMapping;
+  TubeModel tube = TubeModel::kRod;
   double time_step_s = 1.0e-3;  ///< the core's fixed step [s]
-  /// Capsules in the tube's chain; 0: chosen by the core from the tube and the device
-  /// (core::ChainCapsuleCount). Set to trade the chain's chord error for speed, or to study it.
-  int capsules = 0;
+  /// The rod's elements; 0: the core's default (core::ElementCount). More elements are more
+  /// accurate and slower (docs/accuracy.md).
+  int elements = 0;
 };
 
 /// The haptic device and the virtual coupling of the hand to the held end (physics.md).

@@ -1,5 +1,5 @@
 #pragma once
-// The accuracy study (issue 7): how wrong each model and setting of the core is, and what it costs.
+// The accuracy study: how wrong each model and setting of the core is, and what it costs.
 // Tip loads are judged against the exact elastica (closed form, model/elastica.hpp) and the
 // elastica itself against the independent reference rod (reference/planar_rod.hpp); contact
 // scenarios drive core::Core::Step with scenes built in memory and are judged against the
@@ -15,7 +15,7 @@
 namespace tubeplan::study {
 
 struct AccuracyRow {
-  std::string setting;      ///< e.g. "linear segmented dt=1ms K=1e4 eps=1mm"
+  std::string setting;      ///< e.g. "rod N=24 dt=0.25ms"
   std::string scenario;     ///< e.g. "tip load alpha=1", "side on an edge"
   std::string metric;       ///< what `error` measures
   double error = 0.0;       ///< relative [-]
@@ -52,7 +52,7 @@ struct ScenarioReference {
 
 struct AccuracyReport {
   std::string scene;
-  int capsules = 0;  ///< the core's chain for this scene (chosen by the core)
+  int elements = 0;  ///< the rod's elements for this scene
   std::vector<AccuracyRow> rows;
   std::vector<ConvergenceStudy> convergence;
   std::vector<ScenarioReference> references;

@@ -1,5 +1,5 @@
 #pragma once
-// The stability sweep (issue 7): stiff and extreme cases driven through core::Core::Step with
+// The stability sweep: stiff and extreme cases driven through core::Core::Step with
 // canonical motions, each checked for finite outputs, bounded forces, passivity, no tunnelling
 // and bit-identical repetition. docs/accuracy.md has the checks and their tolerances.
 
@@ -42,27 +42,17 @@ struct StabilityResult {
   std::string detail;           ///< what failed, first failing tick, or the figures of a pass
   std::string warning;          ///< outside validity, or a physical check failing there
   int first_failing_tick = -1;  ///< -1 when it passed
-  /// First tick the core flagged its shape off the points its contacts were solved at
-  /// (core::kShapeOffContacts), -1 if none: not a check, a pointer to where failures start.
-  int first_shape_off_tick = -1;
-  /// Ticks the core held the tube back from going through a part (core::kHeldBack), and the
-  /// first (-1 if none): a case that passes by being held is shown as such.
-  int held_ticks = 0;
-  int first_held_tick = -1;
+  /// Ticks whose solve stopped short of its tolerance (core::kNotConverged: a snap through, or
+  /// a jump of the hand), and the first (-1 if none): shown, not judged.
+  int unconverged_ticks = 0;
+  int first_unconverged_tick = -1;
   /// Outside the model's validity (a warning, not a failure, for the physical checks).
   bool outside = false;
-  /// First tick the paper's segmented rule left out more than eps / 10 of displacement at a load
-  /// point (core::kSegmentationOff), -1 if never. From there the rule is outside its range: the
-  /// case is then judged with the coupled rule (`judged_coupled`), and what the segmented run
-  /// failed goes into the warning. The segmented run's safety checks (finite, same bits, force
-  /// bounds, solver) still count, and so do its physical checks before that tick.
-  int first_segmentation_off_tick = -1;
-  bool judged_coupled = false;
   int ticks = 0;
   double peak_force_N = 0.0;
 };
 
-/// The base scene (the rubber tube of scenes/groove.yaml, elastica) and the sweep of issue 7 over
+/// The base scene (the rubber tube of scenes/groove.yaml) and the sweep over
 /// every motion: E, K, eps, r2/r1, l/r1, hand speed, mu, beta and alpha, one at a time. `quick`
 /// takes the extremes only and shorter motions.
 std::vector<StabilityCase> StabilityCases(bool quick);

@@ -1,0 +1,143 @@
+#pragma once
+// The core's changing data: the state a tick carries to the next (what a snapshot saves) and the
+// scratch it works in, all sized once from the model. Nothing here allocates during a tick.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/core/core.hpp>
+
+#include "core/banded.hpp"
+#include "core/model.hpp"
+
+namespace tubeplan::core {
+
+/// Where on the tube a contact point is.
+enum class SampleKind : std::uint8_t {
+  kSection,  ///< the side surface's section circle at an inner node
+  kRim,      ///< the free end's rim
+  kSide,     ///< the side surface between two nodes, against a part's edge
+  kEndFace,  ///< the free end's face, against a part's vertex
+};
+
+/// One contact point between the tube's surface and a part, with its derivatives. The point is a
+/// material point of the section at `node` (kSection, kRim, kEndFace) or of the segment from
+/// `node` (kSide), offset from the centreline by `offset_W`.
+struct Sample {
+  SampleKind kind = SampleKind::kSection;
+  std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
+  int part = 0;                ///< index into Model::parts
+  int node = 0;                ///< the section's node, or the segment's first node
+  int feature = 0;             ///< ring position (kRim), edge (kSide) or vertex (kEndFace)
+  double theta = 0.0;          ///< position along the segment (kSide), 0..1
+  double weight = 1.0;         ///< share of K it carries
+  double distance_m = 0.0;     ///< signed distance d of the point to the part
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();    ///< on the tube's surface
+  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();   ///< from the centreline to the point
+  /// d point / d (x_first, x_first+1, x_first+2), the nodes of its stencil.
+  Eigen::Matrix<double, 3, 9> jacobian = Eigen::Matrix<double, 3, 9>::Zero();
+  int first = 0;  ///< first node of the stencil
+  double normal_force_N = 0.0;
+  Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< on the tube
+  double friction_ratio = 0.0;   ///< |friction| / its static limit
+  double static_limit_N = 0.0;
+  double friction_work_J = 0.0;  ///< dissipated this tick
+  bool sliding = false;
+  int friction_point = -1;  ///< the friction point it carries, -1 for none
+};
+
+/// Friction carried by one contact point: its anchor on the part and whether it sticks.
+struct FrictionPoint {
+  SampleKind kind = SampleKind::kSection;
+  int part = 0;
+  int node = 0;
+  int feature = 0;
+  double theta = 0.0;
+  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();  ///< material offset at the tick's start
+  Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  ///< where the spring holds the point
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ(); ///< tangent plane of the tick
+  double limit_N = 0.0;   ///< the friction force it can carry this tick (static or kinetic)
+  double normal_N = 0.0;  ///< its normal force when the limit was set
+  bool sliding = false;
+  int sample = -1;        ///< the contact point that carries it this pass, -1 for none
+};
+
+inline constexpr int kMaxSamples = 512;
+inline constexpr int kMaxFrictionPoints = 256;
+
+/// What a tick carries to the next: the rod, the held end, the hand, friction.
+struct CarriedState {
+  std::vector<Eigen::Vector3d> x_W;  ///< nodes 0..N [m]
+  Eigen::Matrix3d R_WH = Eigen::Matrix3d::Identity();  ///< the held end's orientation
+  Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
+  std::array<FrictionPoint, kMaxFrictionPoints> friction{};
+  int friction_count = 0;
+  /// Per part: the last direction from the rim's centre to its nearest point (kept so that a
+  /// flat end, which has no nearest point, keeps its samples where they were).
+  std::vector<Eigen::Vector3d> rim_direction_W;
+  /// Per contact point of the last tick: the face it was pressed on, per (kind, node, part), so
+  /// that a point pushed inside a part keeps being pushed back out the way it came in.
+  std::vector<std::uint8_t> entry_mask;
+};
+
+/// The tick's working memory.
+struct Scratch {
+  std::vector<Eigen::Vector3d> x_trial_W;
+  std::vector<Eigen::Vector3d> x_start_W;  ///< the nodes at the tick's start
+  std::array<Sample, kMaxSamples> samples{};
+  int sample_count = 0;
+  bool samples_truncated = false;
+  Eigen::VectorXd unknowns, unknowns_trial;
+  Eigen::VectorXd gradient, step, direction, work;
+  BandMatrix hessian;
+  BandLdlt factor;
+  std::vector<std::uint8_t> parts_near;  ///< per part: within reach this tick
+  std::vector<std::uint8_t> entry_seen;  ///< per (part, node): a contact point there this tick
+  /// Friction points made at the tick's end, before they replace the carried ones.
+  std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
+};
+
+/// The tick's input and the quantities every stage reads.
+struct TickInput {
+  double t_s = 0.0;
+  Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d p_hand_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tangent_held_W = Eigen::Vector3d::UnitZ();  ///< the held end's axis
+  bool hand_valid = true;
+};
+
+/// How the tick's solve went.
+struct SolveReport {
+  int iterations = 0;  ///< Newton iterations over all friction passes
+  int friction_passes = 0;
+  double residual_N = 0.0;
+  bool converged = false;
+  bool indefinite = false;  ///< a direction of negative curvature was followed (buckling)
+};
+
+struct Data {
+  CarriedState state;
+  Scratch scratch;
+  TickInput input;
+  SolveReport solve;
+  StepOutput out;
+};
+
+/// What a snapshot keeps: the carried state and the last output.
+struct SnapshotData {
+  CarriedState state;
+  StepOutput out;
+  Eigen::Vector3d p_hand_W = Eigen::Vector3d::Zero();
+  int sample_count = 0;  ///< the last tick's contact points (0: the tube was free)
+};
+
+/// Sizes every buffer of `data` for `model` and puts the tube straight at the held pose X_WH.
+void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& data);
+
+}  // namespace tubeplan::core

@@ -1,0 +1,67 @@
+#pragma once
+// The core's constant model: everything a tick reads and never writes, built once from a scene
+// (docs/core.md has the derivations). The changing data is in data.hpp.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <tubeplan/scene/scene.hpp>
+
+#include "core/part_geometry.hpp"
+
+namespace tubeplan::core {
+
+/// Points on the free end's rim that carry a contact with one part: the nearest and the others
+/// equally spaced around it, so that a flat end on a face bears on its whole rim.
+inline constexpr int kRimSamples = 8;
+
+struct RodModel {
+  int elements = 0;                   ///< N segments, N + 1 nodes
+  double length_m = 0.0;              ///< l
+  double segment_m = 0.0;             ///< rest length l / N
+  double outer_radius_m = 0.0;        ///< r1
+  double inner_radius_m = 0.0;        ///< r2
+  double bending_stiffness_Nm2 = 0.0; ///< EI
+  double stretch_stiffness_N = 0.0;   ///< the axial stiffness EA the rod is given [N]
+  bool linear = false;                ///< the paper's small-deflection beam instead of the rod
+};
+
+struct ContactModel {
+  double stiffness_N_per_m = 0.0;  ///< K, per contact point
+  double threshold_m = 0.0;        ///< epsilon
+  double bend_threshold_m = 0.0;   ///< tip deflection above which the tube "bends"
+};
+
+struct CouplingModel {
+  double stiffness_N_per_m = 0.0;  ///< K_c
+  double damping_Ns_per_m = 0.0;   ///< B
+  double max_force_N = 0.0;        ///< the device's force: the spring saturates there
+  double max_torque_Nm = 0.0;
+  double time_step_s = 0.0;
+};
+
+struct SolverModel {
+  int max_iterations = 0;      ///< Newton iterations a tick at most
+  double tolerance_N = 0.0;    ///< converged when no generalised force exceeds it
+  double step_cap_m = 0.0;     ///< no point moves farther than this in one iteration
+};
+
+struct PartModel {
+  BoxGeometry geometry;
+  std::uint32_t scene_index = 0;
+  scene::Friction friction;
+  /// Element index (into Core::elements()) of each face mask; -1 where none.
+  std::array<int, 64> element_of{};
+};
+
+struct Model {
+  RodModel rod;
+  ContactModel contact;
+  CouplingModel coupling;
+  SolverModel solver;
+  std::vector<PartModel> parts;  ///< the parts the tube can reach, in scene order
+  bool frictionless = true;      ///< no part has friction: no friction state at all
+};
+
+}  // namespace tubeplan::core

@@ -1,0 +1,64 @@
+#pragma once
+// The rigid parts as the contact stage sees them: a signed distance with its gradient and the
+// element (face, edge, vertex) the nearest point lies on, and the sharp features (edges as
+// segments, vertices as points) that can poke into the tube between its sections. Boxes today;
+// any convex or meshed part offers the same three things.
+
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::core {
+
+/// The nearest point of a part to a query point.
+struct PartDistance {
+  double distance_m = 0.0;  ///< signed: negative inside the part [m]
+  /// Unit outward normal at the nearest point: the direction in which the distance grows.
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();  ///< nearest point on the part's surface
+  std::uint8_t face_mask = 0;  ///< faces the nearest point lies on (BoxFace bits)
+};
+
+struct PartEdge {
+  Eigen::Vector3d a_W = Eigen::Vector3d::Zero(), b_W = Eigen::Vector3d::Zero();
+  std::uint8_t face_mask = 0;
+};
+
+class BoxGeometry {
+ public:
+  BoxGeometry() = default;
+  explicit BoxGeometry(const scene::BoxPart& box);
+
+  /// Signed distance of p_W to the box. Inside, the distance is to the face given by
+  /// `entry_mask` when it names one (the face the point came in through: a thin part is not
+  /// crossed by pushing a point past its middle), else to the nearest face.
+  PartDistance Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask = 0) const;
+
+  const std::array<PartEdge, 12>& edges() const { return edges_; }
+  const std::array<Eigen::Vector3d, 8>& vertices_W() const { return vertices_W_; }
+  const std::array<std::uint8_t, 8>& vertex_masks() const { return vertex_masks_; }
+  const Eigen::Vector3d& min_W() const { return min_W_; }
+  const Eigen::Vector3d& max_W() const { return max_W_; }
+  /// The smallest of the box's three extents [m].
+  double thinnest_m() const { return 2.0 * half_m_.minCoeff(); }
+
+ private:
+  Eigen::Matrix3d R_WP_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d p_WP_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d half_m_ = Eigen::Vector3d::Zero();
+  std::array<PartEdge, 12> edges_{};
+  std::array<Eigen::Vector3d, 8> vertices_W_{};
+  std::array<std::uint8_t, 8> vertex_masks_{};
+  Eigen::Vector3d min_W_ = Eigen::Vector3d::Zero(), max_W_ = Eigen::Vector3d::Zero();
+};
+
+/// Bit of BoxFace `face` in a face mask.
+constexpr std::uint8_t FaceBit(scene::BoxFace face) {
+  return static_cast<std::uint8_t>(1u << static_cast<int>(face));
+}
+
+}  // namespace tubeplan::core

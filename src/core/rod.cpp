@@ -1,0 +1,216 @@
+#include "core/rod.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tubeplan::core {
+namespace {
+
+using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;
+
+// (I - a a^T) / length: the derivative of a unit vector a = v / |v| with respect to v.
+Mat3 UnitDerivative(const Vec3& a, double length) {
+  return (Mat3::Identity() - a * a.transpose()) / length;
+}
+
+// Maps a Hessian over the element vectors (e, f) = (x1 - x0, x2 - x1) to the three nodes.
+void EdgesToNodes(const Mat3& hee, const Mat3& hef, const Mat3& hff, const Vec3& ge,
+                  const Vec3& gf, StencilTerm& term) {
+  term.nodes = 3;
+  term.gradient.segment<3>(0) = -ge;
+  term.gradient.segment<3>(3) = ge - gf;
+  term.gradient.segment<3>(6) = gf;
+  const Mat3 hfe = hef.transpose();
+  auto H = [&](int r, int c) { return term.hessian.block<3, 3>(3 * r, 3 * c); };
+  H(0, 0) = hee;
+  H(0, 1) = -hee + hef;
+  H(0, 2) = -hef;
+  H(1, 1) = hee - hef - hfe + hff;
+  H(1, 2) = hef - hff;
+  H(2, 2) = hff;
+  H(1, 0) = (-hee + hef).transpose();
+  H(2, 0) = -hfe;
+  H(2, 1) = (hef - hff).transpose();
+}
+
+}  // namespace
+
+double BendingEnergy(const RodModel& rod, std::span<const Vec3> x_W, int i, StencilTerm* term) {
+  const double c = rod.bending_stiffness_Nm2 / rod.segment_m;
+  const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
+  const Vec3 f = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
+  const double le = e.norm(), lf = f.norm();
+  const Vec3 a = e / le, b = f / lf;
+  const double cos_phi = a.dot(b);
+  if (term != nullptr) {
+    // E = c (1 - a.b); with g_e = d(a.b)/de = (b - cos a) / |e| and likewise g_f:
+    const Vec3 ge = (b - cos_phi * a) / le, gf = (a - cos_phi * b) / lf;
+    const Mat3 I = Mat3::Identity();
+    const Mat3 dge_de = -(a * ge.transpose() + ge * a.transpose()) / le -
+                        cos_phi * (I - a * a.transpose()) / (le * le);
+    const Mat3 dgf_df = -(b * gf.transpose() + gf * b.transpose()) / lf -
+                        cos_phi * (I - b * b.transpose()) / (lf * lf);
+    const Mat3 dge_df = ((I - b * b.transpose()) / lf - a * gf.transpose()) / le;
+    term->first = i - 1;
+    EdgesToNodes(-c * dge_de, -c * dge_df, -c * dgf_df, -c * ge, -c * gf, *term);
+  }
+  return c * (1.0 - cos_phi);
+}
+
+double StretchEnergy(const RodModel& rod, std::span<const Vec3> x_W, int i, StencilTerm* term) {
+  const double k = rod.stretch_stiffness_N / rod.segment_m;
+  const Vec3 e = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
+  const double len = e.norm();
+  const double strain_m = len - rod.segment_m;
+  if (term != nullptr) {
+    const Vec3 a = e / len;
+    const Vec3 g = k * strain_m * a;
+    const Mat3 aa = a * a.transpose();
+    const Mat3 h = k * (aa + (1.0 - rod.segment_m / len) * (Mat3::Identity() - aa));
+    term->first = i;
+    term->nodes = 2;
+    term->gradient.segment<3>(0) = -g;
+    term->gradient.segment<3>(3) = g;
+    term->hessian.block<3, 3>(0, 0) = h;
+    term->hessian.block<3, 3>(3, 3) = h;
+    term->hessian.block<3, 3>(0, 3) = -h;
+    term->hessian.block<3, 3>(3, 0) = -h;
+  }
+  return 0.5 * k * strain_m * strain_m;
+}
+
+double LinearBendingEnergy(const RodModel& rod, const Mat3& R_WH, std::span<const Vec3> x_W,
+                           int i, StencilTerm* term) {
+  const double h = rod.segment_m;
+  const double c = rod.bending_stiffness_Nm2 / (h * h * h);
+  // Lateral projector of the held frame: the beam bends in its x and y only.
+  const Vec3 z = R_WH.col(2);
+  const Mat3 P = Mat3::Identity() - z * z.transpose();
+  const Vec3 b = P * (x_W[std::size_t(i + 1)] - 2.0 * x_W[std::size_t(i)] + x_W[std::size_t(i - 1)]);
+  if (term != nullptr) {
+    term->first = i - 1;
+    term->nodes = 3;
+    const double w[3] = {1.0, -2.0, 1.0};
+    for (int r = 0; r < 3; ++r) {
+      term->gradient.segment<3>(3 * r) = c * w[r] * b;
+      for (int s = 0; s < 3; ++s) term->hessian.block<3, 3>(3 * r, 3 * s) = c * w[r] * w[s] * P;
+    }
+  }
+  return 0.5 * c * b.squaredNorm();
+}
+
+double AxialHoldEnergy(const RodModel& rod, const Mat3& R_WH, std::span<const Vec3> x_W, int i,
+                       StencilTerm* term) {
+  // Element i's length along the held axis, held at h by the rod's axial stiffness.
+  const double k = rod.stretch_stiffness_N / rod.segment_m;
+  const Vec3 z = R_WH.col(2);
+  const double s = (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]).dot(z) - rod.segment_m;
+  if (term != nullptr) {
+    const Mat3 h = k * z * z.transpose();
+    term->first = i;
+    term->nodes = 2;
+    term->gradient.segment<3>(0) = -k * s * z;
+    term->gradient.segment<3>(3) = k * s * z;
+    term->hessian.block<3, 3>(0, 0) = h;
+    term->hessian.block<3, 3>(3, 3) = h;
+    term->hessian.block<3, 3>(0, 3) = -h;
+    term->hessian.block<3, 3>(3, 0) = -h;
+  }
+  return 0.5 * k * s * s;
+}
+
+Vec3 CarrierTangent(Carrier carrier, std::span<const Vec3> x_W, int i) {
+  switch (carrier) {
+    case Carrier::kInnerNode: {
+      const Vec3 a = (x_W[std::size_t(i)] - x_W[std::size_t(i - 1)]).normalized();
+      const Vec3 b = (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]).normalized();
+      return (a + b).normalized();
+    }
+    case Carrier::kEndNode:
+      return (x_W[std::size_t(i)] - x_W[std::size_t(i - 1)]).normalized();
+    case Carrier::kElement:
+      return (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]).normalized();
+  }
+  return Vec3::UnitZ();
+}
+
+Vec3 CarrierCentre(Carrier carrier, std::span<const Vec3> x_W, int i, double theta) {
+  if (carrier == Carrier::kElement)
+    return x_W[std::size_t(i)] + theta * (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]);
+  return x_W[std::size_t(i)];
+}
+
+MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double theta,
+                       const Vec3& offset0_W) {
+  MaterialPoint mp;
+  // d t / d x_k for the stencil's nodes, and d centre / d x_k.
+  std::array<Mat3, 3> dt{Mat3::Zero(), Mat3::Zero(), Mat3::Zero()};
+  std::array<double, 3> dc{0.0, 0.0, 0.0};
+  Vec3 t;
+  switch (carrier) {
+    case Carrier::kInnerNode: {
+      const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
+      const Vec3 f = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
+      const double le = e.norm(), lf = f.norm();
+      const Vec3 a = e / le, b = f / lf;
+      const Vec3 s = a + b;
+      const double ls = s.norm();
+      t = s / ls;
+      const Mat3 Pt = UnitDerivative(t, ls);
+      const Mat3 Ea = UnitDerivative(a, le), Eb = UnitDerivative(b, lf);
+      dt[0] = -Pt * Ea;
+      dt[1] = Pt * (Ea - Eb);
+      dt[2] = Pt * Eb;
+      dc[1] = 1.0;
+      mp.first = i - 1;
+      mp.nodes = 3;
+      break;
+    }
+    case Carrier::kEndNode: {
+      const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
+      const double le = e.norm();
+      t = e / le;
+      const Mat3 E = UnitDerivative(t, le);
+      dt[0] = -E;
+      dt[1] = E;
+      dc[1] = 1.0;
+      mp.first = i - 1;
+      mp.nodes = 2;
+      break;
+    }
+    case Carrier::kElement: {
+      const Vec3 e = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
+      const double le = e.norm();
+      t = e / le;
+      const Mat3 E = UnitDerivative(t, le);
+      dt[0] = -E;
+      dt[1] = E;
+      dc[0] = 1.0 - theta;
+      dc[1] = theta;
+      mp.first = i;
+      mp.nodes = 2;
+      break;
+    }
+  }
+  // The offset turned with the section: its part along the new tangent removed, length kept,
+  // o = |o0| v / |v| with v = (I - t t^T) o0, and its exact derivative through t.
+  const Vec3 v = offset0_W - offset0_W.dot(t) * t;
+  const double lv = v.norm(), l0 = offset0_W.norm();
+  mp.tangent_W = t;
+  mp.offset_W = lv > 0.0 ? Vec3(v * (l0 / lv)) : Vec3::Zero();
+  mp.point_W = CarrierCentre(carrier, x_W, i, theta) + mp.offset_W;
+  const Vec3 vh = lv > 0.0 ? Vec3(v / lv) : Vec3::Zero();
+  const Mat3 across = Mat3::Identity() - vh * vh.transpose();
+  const double scale = lv > 0.0 ? l0 / lv : 0.0;
+  const double along = t.dot(offset0_W);
+  for (int k = 0; k < mp.nodes; ++k) {
+    const Mat3& T = dt[std::size_t(k)];
+    mp.jacobian.block<3, 3>(0, 3 * k) =
+        dc[std::size_t(k)] * Mat3::Identity() -
+        scale * (along * across * T + t * (T.transpose() * offset0_W).transpose());
+  }
+  return mp;
+}
+
+}  // namespace tubeplan::core

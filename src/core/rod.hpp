@@ -1,0 +1,70 @@
+#pragma once
+// The discrete rod's energies and the material points on its surface, with their derivatives
+// (docs/core.md, "The rod"). Nodes x_0 .. x_N; x_0 is the held end and x_1 = x_0 + l/N t_H, so
+// the grip holds the first element's direction.
+
+#include <span>
+
+#include <Eigen/Core>
+
+#include "core/model.hpp"
+
+namespace tubeplan::core {
+
+/// An energy term's gradient and Hessian over a stencil of up to three consecutive nodes.
+struct StencilTerm {
+  int first = 0;  ///< the stencil's first node
+  int nodes = 0;  ///< 2 or 3
+  Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
+};
+
+/// Bending at inner node i (1 <= i <= N-1): (EI / h) (1 - cos phi_i), phi_i the angle between
+/// the elements on either side; its energy is returned and, when `term` is given, filled.
+double BendingEnergy(const RodModel& rod, std::span<const Eigen::Vector3d> x_W, int i,
+                     StencilTerm* term);
+
+/// Stretching of element i (from node i to i + 1): (EA / 2h) (|e_i| - h)^2. Its Hessian keeps the
+/// geometric term, negative for a shortened element: the softening that lets a column buckle.
+double StretchEnergy(const RodModel& rod, std::span<const Eigen::Vector3d> x_W, int i,
+                     StencilTerm* term);
+
+/// The paper's small-deflection beam (model.beam: linear) at inner node i: EI / (2 h^3) |b|^2
+/// with b the lateral part, in the held frame, of x_{i+1} - 2 x_i + x_{i-1}. Its elements keep
+/// their length along the held axis (`AxialHoldEnergy` of element i), not their length: the
+/// paper's beam has no axial response and stretches as it deflects.
+double LinearBendingEnergy(const RodModel& rod, const Eigen::Matrix3d& R_WH,
+                           std::span<const Eigen::Vector3d> x_W, int i, StencilTerm* term);
+double AxialHoldEnergy(const RodModel& rod, const Eigen::Matrix3d& R_WH,
+                       std::span<const Eigen::Vector3d> x_W, int i, StencilTerm* term);
+
+/// Where a point of the tube's surface sits on the rod: the centre it is offset from (a node, or
+/// a point of an element) and the tangent that carries its offset.
+enum class Carrier : unsigned char {
+  kInnerNode,  ///< node i, 1 <= i <= N-1, tangent bisecting its two elements
+  kEndNode,    ///< node N, tangent of the last element
+  kElement,    ///< the point theta of element i (nodes i, i+1), its tangent
+};
+
+/// A material point: the centre plus an offset perpendicular to the tangent, carried with the
+/// section as the tangent turns (no twist).
+struct MaterialPoint {
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d tangent_W = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();  ///< perpendicular to the tangent
+  int first = 0;                                       ///< first node of the stencil
+  int nodes = 0;
+  Eigen::Matrix<double, 3, 9> jacobian = Eigen::Matrix<double, 3, 9>::Zero();
+};
+
+/// The tangent at a carrier (unit).
+Eigen::Vector3d CarrierTangent(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i);
+Eigen::Vector3d CarrierCentre(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i,
+                              double theta);
+
+/// The material point whose offset was `offset0_W` (any length), turned into the plane normal to
+/// the carrier's current tangent, with d point / d nodes.
+MaterialPoint Material(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i, double theta,
+                       const Eigen::Vector3d& offset0_W);
+
+}  // namespace tubeplan::core

@@ -1,0 +1,192 @@
+#include "core/stick_slip.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <tubeplan/core/friction.hpp>
+
+#include "core/assemble.hpp"
+
+namespace tubeplan::core {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+bool Active(const Model& model, const Sample& s) {
+  return s.distance_m < model.contact.threshold_m &&
+         !model.parts[std::size_t(s.part)].friction.IsFrictionless();
+}
+
+bool SameKey(const FrictionPoint& f, const Sample& s) {
+  return f.part == s.part && f.kind == s.kind && f.node == s.node && f.feature == s.feature;
+}
+
+// Pairs contact points with friction points: the same point first, then, for a contact point
+// that moved along the tube (a section to the next, the rim's points around), the nearest
+// unpaired friction point of the same part within half an element.
+void Match(const Model& model, Data& data) {
+  Scratch& s = data.scratch;
+  CarriedState& st = data.state;
+  for (int k = 0; k < s.sample_count; ++k) s.samples[std::size_t(k)].friction_point = -1;
+  for (int f = 0; f < st.friction_count; ++f) st.friction[std::size_t(f)].sample = -1;
+  for (int k = 0; k < s.sample_count; ++k) {
+    Sample& smp = s.samples[std::size_t(k)];
+    if (!Active(model, smp)) continue;
+    for (int f = 0; f < st.friction_count; ++f) {
+      FrictionPoint& fp = st.friction[std::size_t(f)];
+      if (fp.sample < 0 && SameKey(fp, smp)) {
+        fp.sample = k;
+        smp.friction_point = f;
+        break;
+      }
+    }
+  }
+  const double reach_m = 0.5 * model.rod.segment_m;
+  for (int k = 0; k < s.sample_count; ++k) {
+    Sample& smp = s.samples[std::size_t(k)];
+    if (!Active(model, smp) || smp.friction_point >= 0) continue;
+    int best = -1;
+    double best_m = reach_m;
+    for (int f = 0; f < st.friction_count; ++f) {
+      const FrictionPoint& fp = st.friction[std::size_t(f)];
+      if (fp.sample >= 0 || fp.part != smp.part) continue;
+      const double d_m =
+          (FrictionMaterial(model, fp, st.x_W).point_W - smp.point_W).norm();
+      if (d_m < best_m) {
+        best_m = d_m;
+        best = f;
+      }
+    }
+    if (best >= 0) {
+      st.friction[std::size_t(best)].sample = k;
+      smp.friction_point = best;
+    }
+  }
+}
+
+// The normal force of every contact point's part element (its PC's share rule, friction.hpp).
+double GroupNormal(const Model& model, const Data& data, const Sample& of) {
+  double n = 0.0;
+  for (int k = 0; k < data.scratch.sample_count; ++k) {
+    const Sample& smp = data.scratch.samples[std::size_t(k)];
+    if (smp.part == of.part && smp.face_mask == of.face_mask &&
+        smp.distance_m < model.contact.threshold_m)
+      n += smp.normal_force_N;
+  }
+  return n;
+}
+
+struct Limits {
+  double static_N = 0.0, kinetic_N = 0.0;
+};
+
+Limits LimitsOf(const Model& model, const Data& data, const Sample& smp) {
+  const scene::Friction& fr = model.parts[std::size_t(smp.part)].friction;
+  const double group_N = GroupNormal(model, data, smp);
+  return {FrictionShare(fr, fr.static_coefficient, smp.normal_force_N, group_N),
+          FrictionShare(fr, fr.kinetic_coefficient, smp.normal_force_N, group_N)};
+}
+
+// The spring's stretch of a friction point at the solved nodes, in its tangent plane.
+Vec3 Stretch(const Model& model, const Data& data, const FrictionPoint& f) {
+  const Vec3 p = FrictionMaterial(model, f, data.state.x_W).point_W;
+  const Vec3 u = p - f.anchor_W;
+  return u - u.dot(f.normal_W) * f.normal_W;
+}
+
+}  // namespace
+
+bool ReturnFrictionToLimits(const Model& model, Data& data) {
+  if (model.frictionless) return false;
+  Match(model, data);
+  const double K = model.contact.stiffness_N_per_m;
+  bool changed = false;
+  for (int f = 0; f < data.state.friction_count; ++f) {
+    FrictionPoint& fp = data.state.friction[std::size_t(f)];
+    if (fp.sample < 0) {
+      // Its contact opened: the spring lets go.
+      if (!(fp.sliding && fp.limit_N == 0.0)) {
+        fp.sliding = true;
+        fp.limit_N = 0.0;
+        changed = true;
+      }
+      continue;
+    }
+    const Limits lim = LimitsOf(model, data, data.scratch.samples[std::size_t(fp.sample)]);
+    const double trial_N = K * Stretch(model, data, fp).norm();
+    if (!fp.sliding) {
+      if (trial_N > lim.static_N * (1.0 + 1e-9) + 1e-12) {
+        fp.sliding = true;
+        fp.limit_N = lim.kinetic_N;
+        changed = true;
+      }
+    } else if (std::abs(fp.limit_N - lim.kinetic_N) > 0.02 * lim.kinetic_N + 1e-6) {
+      fp.limit_N = lim.kinetic_N;
+      changed = true;
+    }
+  }
+  return changed;
+}
+
+void CarryFriction(const Model& model, Data& data) {
+  Scratch& s = data.scratch;
+  for (int k = 0; k < s.sample_count; ++k) {
+    Sample& smp = s.samples[std::size_t(k)];
+    smp.friction_W_N.setZero();
+    smp.friction_ratio = smp.static_limit_N = smp.friction_work_J = 0.0;
+    smp.sliding = false;
+  }
+  if (model.frictionless) {
+    data.state.friction_count = 0;
+    return;
+  }
+  Match(model, data);
+  const double K = model.contact.stiffness_N_per_m;
+  int next = 0;
+  for (int k = 0; k < s.sample_count && next < kMaxFrictionPoints; ++k) {
+    Sample& smp = s.samples[std::size_t(k)];
+    if (!Active(model, smp)) continue;
+    const Limits lim = LimitsOf(model, data, smp);
+    Vec3 stretch = Vec3::Zero();
+    bool sliding = false;
+    if (smp.friction_point >= 0) {
+      const FrictionPoint& fp = data.state.friction[std::size_t(smp.friction_point)];
+      const Vec3 u = Stretch(model, data, fp);
+      const double trial_N = K * u.norm();
+      // A sliding point slides on while its spring is at the kinetic limit; a stuck one once it
+      // passes the static limit. Sliding, the anchor is dragged to where the spring carries the
+      // kinetic force, and the slip dissipates that force times its length.
+      sliding = fp.sliding ? trial_N > lim.kinetic_N : trial_N > lim.static_N;
+      stretch = u;
+      if (sliding && trial_N > 0.0) {
+        stretch = u * (lim.kinetic_N / trial_N);
+        smp.friction_work_J = lim.kinetic_N * (u.norm() - stretch.norm());
+      }
+    }
+    // Re-anchored at the contact point as it is now, in its tangent plane, with the same stretch.
+    stretch -= stretch.dot(smp.normal_W) * smp.normal_W;
+    smp.friction_W_N = -K * stretch;
+    smp.sliding = sliding;
+    smp.static_limit_N = lim.static_N;
+    smp.friction_ratio =
+        lim.static_N > 0.0 ? std::min(1.0, smp.friction_W_N.norm() / lim.static_N) : 0.0;
+    FrictionPoint& nf = s.friction_next[std::size_t(next++)];
+    nf.kind = smp.kind;
+    nf.part = smp.part;
+    nf.node = smp.node;
+    nf.feature = smp.feature;
+    nf.theta = smp.theta;
+    nf.offset_W = smp.offset_W;
+    nf.anchor_W = smp.point_W - stretch;
+    nf.normal_W = smp.normal_W;
+    nf.sliding = sliding;
+    nf.limit_N = sliding ? lim.kinetic_N : lim.static_N;
+    nf.normal_N = smp.normal_force_N;
+    nf.sample = -1;
+  }
+  std::copy_n(s.friction_next.begin(), next, data.state.friction.begin());
+  data.state.friction_count = next;
+}
+
+}  // namespace tubeplan::core

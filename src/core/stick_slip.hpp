@@ -1,0 +1,21 @@
+#pragma once
+// The friction stage (docs/core.md, "Friction"): after a solve, which contact points stick and
+// which slide; at the tick's end, the anchors the next tick's friction springs start from.
+
+#include "core/data.hpp"
+#include "core/model.hpp"
+
+namespace tubeplan::core {
+
+/// Pairs the solved contact points with the carried friction points and checks each against its
+/// limit at the solved normal forces: a stuck point whose spring carries more than the static
+/// limit starts sliding, a sliding point takes the kinetic limit of its new load, a point whose
+/// contact opened lets go. True when anything changed: the equilibrium must be solved again.
+bool ReturnFrictionToLimits(const Model& model, Data& data);
+
+/// After the last solve: the friction force and work of every contact point, and the friction
+/// points the next tick carries (stuck points keep their anchor, sliding points drag theirs to
+/// the kinetic limit, new contacts start stuck where they are).
+void CarryFriction(const Model& model, Data& data);
+
+}  // namespace tubeplan::core
