@@ -60,8 +60,6 @@ class Assembler {
   bool derivatives_;
 };
 
-int NodesOfSample(SampleKind kind) { return kind == SampleKind::kSection ? 3 : 2; }
-
 }  // namespace
 
 int UnknownCount(const Model& model) { return 3 * model.rod.elements; }
@@ -80,17 +78,9 @@ void UnknownsOf(const Model& model, std::span<const Vec3> x_W, Eigen::VectorXd& 
 }
 
 MaterialPoint FrictionMaterial(const Model& model, const FrictionPoint& f,
-                               std::span<const Vec3> x_W) {
-  switch (f.kind) {
-    case SampleKind::kSection:
-      return Material(Carrier::kInnerNode, x_W, f.node, 0.0, f.offset_W);
-    case SampleKind::kSide:
-      return Material(Carrier::kElement, x_W, f.node, f.theta, f.offset_W);
-    case SampleKind::kRim:
-    case SampleKind::kEndFace:
-      break;
-  }
-  return Material(Carrier::kEndNode, x_W, model.rod.elements, 0.0, f.offset_W);
+                               std::span<const Vec3> x_W, bool jacobian) {
+  (void)model;
+  return Material(CarrierOf(f.kind), x_W, f.node, f.theta, f.offset_W, jacobian);
 }
 
 CouplingTerm Coupling(const Model& model, const Data& data, const Vec3& p_held_W) {
@@ -161,22 +151,26 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
     const double kw = K * smp.weight;
     energy += 0.5 * kw * depth * depth;
     smp.normal_force_N = kw * depth;
-    a.AddAtPoint(smp.jacobian, smp.first, NodesOfSample(smp.kind), -kw * depth * smp.normal_W,
+    if (!derivatives) continue;
+    const MaterialPoint mp =
+        Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
+    a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * smp.normal_W * smp.normal_W.transpose());
   }
 
   // Friction: a spring from each friction point to its anchor in the tangent plane, stiffness
-  // K; a sliding point's spring gives way at its kinetic limit (a Huber potential).
+  // K, that gives way at the point's limit (a Huber potential): the static limit while it
+  // sticks, the kinetic one once it slides, at the normal force its limit was last set for.
   for (int k = 0; k < data.state.friction_count; ++k) {
     const FrictionPoint& f = data.state.friction[std::size_t(k)];
-    const MaterialPoint mp = FrictionMaterial(model, f, x_W);
+    const MaterialPoint mp = FrictionMaterial(model, f, x_W, derivatives);
     const Mat3 P = Mat3::Identity() - f.normal_W * f.normal_W.transpose();
     const Vec3 u = P * (mp.point_W - f.anchor_W);
     const double lu = u.norm();
     const double u_limit = f.limit_N / K;
     Vec3 g;
     Mat3 H;
-    if (!f.sliding || lu <= u_limit) {
+    if (lu <= u_limit) {
       energy += 0.5 * K * lu * lu;
       g = K * u;
       H = K * P;

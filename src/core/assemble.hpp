@@ -40,6 +40,6 @@ double BendingEnergyOf(const Model& model, const Data& data, std::span<const Eig
 
 /// The material point of a friction point at the nodes x_W.
 MaterialPoint FrictionMaterial(const Model& model, const FrictionPoint& f,
-                               std::span<const Eigen::Vector3d> x_W);
+                               std::span<const Eigen::Vector3d> x_W, bool jacobian = false);
 
 }  // namespace tubeplan::core

@@ -5,13 +5,13 @@
 namespace tubeplan::core {
 
 void BandMatrix::AddBlock(int bi, int bj, const Eigen::Matrix3d& block) {
-  const int i0 = 3 * bi, j0 = 3 * bj;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) {
-      const int i = i0 + r, j = j0 + c;
-      // Only the lower triangle is stored; a diagonal block adds its lower half.
-      if (j <= i) (*this)(i, j) += block(r, c);
-    }
+  // Row i of the band holds columns i - kBandWidth .. i; a diagonal block adds its lower half.
+  for (int r = 0; r < 3; ++r) {
+    const int i = 3 * bi + r;
+    double* row = &a_[Index(i, 3 * bj)];
+    const int columns = bi == bj ? r + 1 : 3;
+    for (int c = 0; c < columns; ++c) row[c] += block(r, c);
+  }
 }
 
 void BandMatrix::AddDiagonal(double lambda) {

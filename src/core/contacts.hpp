@@ -16,7 +16,14 @@ namespace tubeplan::core {
 void FindPartsNear(const Model& model, std::span<const Eigen::Vector3d> x_W, double reach_m,
                    Data& data);
 
+/// Where a contact point sits on the tube is chosen when the point is first found in a tick and
+/// kept for the tick. At a trial point of the line search the new choices are pending until the
+/// point is taken (CommitContactChoices), so that a rejected trial leaves nothing behind.
+enum class Choices { kKeep, kPending };
+
 /// Fills data.scratch.samples with the contact points at the nodes x_W.
-void FindContacts(const Model& model, std::span<const Eigen::Vector3d> x_W, Data& data);
+void FindContacts(const Model& model, std::span<const Eigen::Vector3d> x_W, Data& data,
+                  Choices choices = Choices::kKeep);
+void CommitContactChoices(Data& data);
 
 }  // namespace tubeplan::core

@@ -57,7 +57,7 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   const int n = model.rod.elements;
   const std::size_t nodes = std::size_t(n) + 1, parts = model.parts.size();
   d.state.x_W.assign(nodes, Eigen::Vector3d::Zero());
-  d.state.rim_direction_W.assign(parts, X_WH.linear().col(0));
+  d.state.section_direction_W.assign(parts * nodes, X_WH.linear().col(0));
   d.state.entry_mask.assign(parts * nodes, 0);
   d.scratch.x_trial_W.assign(nodes, Eigen::Vector3d::Zero());
   d.scratch.x_start_W.assign(nodes, Eigen::Vector3d::Zero());
@@ -69,6 +69,9 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.scratch.factor = BandLdlt(unknowns);
   d.scratch.parts_near.assign(parts, 0);
   d.scratch.entry_seen.assign(parts * nodes, 0);
+  d.scratch.section_chosen.assign(parts * nodes, 0);
+  d.scratch.section_side_W.assign(parts * nodes, Eigen::Vector3d::Zero());
+  d.scratch.side_chosen_count = 0;
   // The tube straight along the held end's z, the hand at the held end.
   for (int k = 0; k <= n; ++k)
     d.state.x_W[std::size_t(k)] =
@@ -152,8 +155,10 @@ Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<M
   // No point moves more than a quarter of the tube's radius or of the thinnest part in one
   // iteration: a point pushed into a part meets its penalty before it could pass its middle.
   m.solver.step_cap_m = 0.25 * thinnest;
-  m.solver.max_iterations = 40;
-  m.solver.tolerance_N = 1e-7;
+  // A tick's Newton iterations at most, over its friction passes: a snap through spreads over
+  // ticks (each moving every point at most this many step caps) instead of stalling one.
+  m.solver.max_iterations = 24;
+  m.solver.tolerance_N = 1e-6;
   data_ = std::make_unique<Data>();
   InitData(m, scene_.X_WH_start, *data_);
 }
@@ -219,7 +224,8 @@ bool Core::Restore(const Snapshot& snapshot) {
   if (!snapshot.data_) return false;
   const SnapshotData& s = *snapshot.data_;
   if (s.state.x_W.size() != data_->state.x_W.size() ||
-      s.state.entry_mask.size() != data_->state.entry_mask.size())
+      s.state.entry_mask.size() != data_->state.entry_mask.size() ||
+      s.state.section_direction_W.size() != data_->state.section_direction_W.size())
     return false;
   data_->state = s.state;
   data_->out = s.out;

@@ -13,6 +13,7 @@
 
 #include "core/banded.hpp"
 #include "core/model.hpp"
+#include "core/rod.hpp"
 
 namespace tubeplan::core {
 
@@ -24,9 +25,10 @@ enum class SampleKind : std::uint8_t {
   kEndFace,  ///< the free end's face, against a part's vertex
 };
 
-/// One contact point between the tube's surface and a part, with its derivatives. The point is a
-/// material point of the section at `node` (kSection, kRim, kEndFace) or of the segment from
-/// `node` (kSide), offset from the centreline by `offset_W`.
+/// One contact point between the tube's surface and a part. The point is a material point of the
+/// section at `node` (kSection, kRim, kEndFace) or of the element from `node` (kSide), offset
+/// from the centreline by `offset_W`; its distance moves with the material point whose offset
+/// was `moving_offset_W` (Material), whose derivatives the assembly takes.
 struct Sample {
   SampleKind kind = SampleKind::kSection;
   std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
@@ -39,9 +41,7 @@ struct Sample {
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();    ///< on the tube's surface
   Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();   ///< from the centreline to the point
-  /// d point / d (x_first, x_first+1, x_first+2), the nodes of its stencil.
-  Eigen::Matrix<double, 3, 9> jacobian = Eigen::Matrix<double, 3, 9>::Zero();
-  int first = 0;  ///< first node of the stencil
+  Eigen::Vector3d moving_offset_W = Eigen::Vector3d::Zero();
   double normal_force_N = 0.0;
   Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< on the tube
   double friction_ratio = 0.0;   ///< |friction| / its static limit
@@ -50,6 +50,20 @@ struct Sample {
   bool sliding = false;
   int friction_point = -1;  ///< the friction point it carries, -1 for none
 };
+
+/// The rod carrier of a contact point of this kind.
+inline Carrier CarrierOf(SampleKind kind) {
+  switch (kind) {
+    case SampleKind::kSection:
+      return Carrier::kInnerNode;
+    case SampleKind::kSide:
+      return Carrier::kElement;
+    case SampleKind::kRim:
+    case SampleKind::kEndFace:
+      break;
+  }
+  return Carrier::kEndNode;
+}
 
 /// Friction carried by one contact point: its anchor on the part and whether it sticks.
 struct FrictionPoint {
@@ -61,7 +75,7 @@ struct FrictionPoint {
   Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();  ///< material offset at the tick's start
   Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  ///< where the spring holds the point
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ(); ///< tangent plane of the tick
-  double limit_N = 0.0;   ///< the friction force it can carry this tick (static or kinetic)
+  double limit_N = 0.0;   ///< the force its spring carries at most this pass (static or kinetic)
   double normal_N = 0.0;  ///< its normal force when the limit was set
   bool sliding = false;
   int sample = -1;        ///< the contact point that carries it this pass, -1 for none
@@ -78,9 +92,9 @@ struct CarriedState {
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
   std::array<FrictionPoint, kMaxFrictionPoints> friction{};
   int friction_count = 0;
-  /// Per part: the last direction from the rim's centre to its nearest point (kept so that a
-  /// flat end, which has no nearest point, keeps its samples where they were).
-  std::vector<Eigen::Vector3d> rim_direction_W;
+  /// Per (part, node): the direction from the node's section centre to its point nearest the
+  /// part, as the last tick found it (a section facing a part squarely keeps it).
+  std::vector<Eigen::Vector3d> section_direction_W;
   /// Per contact point of the last tick: the face it was pressed on, per (kind, node, part), so
   /// that a point pushed inside a part keeps being pushed back out the way it came in.
   std::vector<std::uint8_t> entry_mask;
@@ -99,6 +113,27 @@ struct Scratch {
   BandLdlt factor;
   std::vector<std::uint8_t> parts_near;  ///< per part: within reach this tick
   std::vector<std::uint8_t> entry_seen;  ///< per (part, node): a contact point there this tick
+  /// Where on the tube each contact point sits is chosen once a tick, when it is first found, and
+  /// kept for the tick's iterations (so that the potential they minimise does not change under
+  /// them): per (part, node), whether its section's direction is this tick's; and the side's
+  /// points found so far (part, element, edge, position along the element).
+  std::vector<std::uint8_t> section_chosen;
+  std::vector<Eigen::Vector3d> section_side_W;  ///< tangent x direction, when it was chosen
+  struct SideChoice {
+    int part = 0, element = 0, edge = 0;
+    double theta = 0.0;
+  };
+  std::array<SideChoice, 128> side_chosen{};
+  int side_chosen_count = 0;
+  /// Choices a trial point of the line search made, kept if the point is taken.
+  struct SectionChoice {
+    std::size_t index = 0;
+    Eigen::Vector3d direction_W = Eigen::Vector3d::Zero(), side_W = Eigen::Vector3d::Zero();
+  };
+  std::array<SectionChoice, 128> section_pending{};
+  int section_pending_count = 0;
+  std::array<SideChoice, 128> side_pending{};
+  int side_pending_count = 0;
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
 };

@@ -42,7 +42,11 @@ BoxGeometry::BoxGeometry(const scene::BoxPart& box)
       PartEdge& edge = edges_[std::size_t(e++)];
       edge.a_W = vertices_W_[std::size_t(corner)];
       edge.b_W = vertices_W_[std::size_t(corner | bit)];
-      edge.face_mask = vertex_masks_[std::size_t(corner)] & vertex_masks_[std::size_t(corner | bit)];
+      edge.a_mask = vertex_masks_[std::size_t(corner)];
+      edge.b_mask = vertex_masks_[std::size_t(corner | bit)];
+      edge.face_mask = edge.a_mask & edge.b_mask;
+      edge.min_W = edge.a_W.cwiseMin(edge.b_W);
+      edge.max_W = edge.a_W.cwiseMax(edge.b_W);
     }
   }
 }

@@ -25,7 +25,9 @@ struct PartDistance {
 
 struct PartEdge {
   Eigen::Vector3d a_W = Eigen::Vector3d::Zero(), b_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d min_W = Eigen::Vector3d::Zero(), max_W = Eigen::Vector3d::Zero();  ///< its box
   std::uint8_t face_mask = 0;
+  std::uint8_t a_mask = 0, b_mask = 0;  ///< the vertices it ends in
 };
 
 class BoxGeometry {

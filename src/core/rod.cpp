@@ -142,8 +142,17 @@ Vec3 CarrierCentre(Carrier carrier, std::span<const Vec3> x_W, int i, double the
 }
 
 MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double theta,
-                       const Vec3& offset0_W) {
+                       const Vec3& offset0_W, bool jacobian) {
   MaterialPoint mp;
+  if (!jacobian) {
+    const Vec3 t = CarrierTangent(carrier, x_W, i);
+    const Vec3 v = offset0_W - offset0_W.dot(t) * t;
+    const double lv = v.norm();
+    mp.tangent_W = t;
+    mp.offset_W = lv > 0.0 ? Vec3(v * (offset0_W.norm() / lv)) : Vec3::Zero();
+    mp.point_W = CarrierCentre(carrier, x_W, i, theta) + mp.offset_W;
+    return mp;
+  }
   // d t / d x_k for the stencil's nodes, and d centre / d x_k.
   std::array<Mat3, 3> dt{Mat3::Zero(), Mat3::Zero(), Mat3::Zero()};
   std::array<double, 3> dc{0.0, 0.0, 0.0};

@@ -63,8 +63,8 @@ Eigen::Vector3d CarrierCentre(Carrier carrier, std::span<const Eigen::Vector3d> 
                               double theta);
 
 /// The material point whose offset was `offset0_W` (any length), turned into the plane normal to
-/// the carrier's current tangent, with d point / d nodes.
+/// the carrier's current tangent, with d point / d nodes when `jacobian` is set.
 MaterialPoint Material(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i, double theta,
-                       const Eigen::Vector3d& offset0_W);
+                       const Eigen::Vector3d& offset0_W, bool jacobian = true);
 
 }  // namespace tubeplan::core

@@ -23,22 +23,22 @@ double LargestMove(const Eigen::VectorXd& step) {
   return m;
 }
 
-// Factors H + lambda I with the smallest lambda >= 0 (0, then growing from a small fraction of
-// the diagonal) that is positive definite. Returns lambda, or -1 if none was found.
-double FactorShifted(Scratch& s) {
+// Factors H + (shift + lambda) I with the smallest lambda >= 0 (0, then growing from a small
+// fraction of the diagonal) that is positive definite. Returns lambda, or -1 if none was found.
+double FactorShifted(Scratch& s, double shift) {
   double diag = 0.0;
   for (int i = 0; i < s.hessian.size(); ++i) diag = std::max(diag, std::abs(s.hessian(i, i)));
   const double min_pivot = 1e-13 * diag;
-  if (s.factor.Factor(s.hessian, min_pivot)) return 0.0;
-  double lambda = 1e-7 * diag;
-  for (int attempt = 0; attempt < 40; ++attempt) {
-    s.hessian.AddDiagonal(lambda);
-    const bool ok = s.factor.Factor(s.hessian, min_pivot);
-    s.hessian.AddDiagonal(-lambda);
-    if (ok) return lambda;
-    lambda *= 4.0;
+  s.hessian.AddDiagonal(shift);
+  double lambda = 0.0;
+  bool ok = s.factor.Factor(s.hessian, min_pivot);
+  for (double add = 1e-7 * diag; !ok && add < 1e3 * diag; add *= 4.0) {
+    s.hessian.AddDiagonal(add - lambda);
+    lambda = add;
+    ok = s.factor.Factor(s.hessian, min_pivot);
   }
-  return -1.0;
+  s.hessian.AddDiagonal(-shift - lambda);
+  return ok ? lambda : -1.0;
 }
 
 // A direction of negative curvature of H, given the factors of H + lambda I: inverse iteration
@@ -57,86 +57,102 @@ double NegativeCurvature(Scratch& s, Eigen::VectorXd& v) {
   return v.dot(s.work);
 }
 
+enum class Outcome { kStep, kConverged, kFailed };
+
+// The Newton step of the assembled system, damped by `damping` [N/m] on every unknown; at a
+// saddle (a straight column past its buckling load, where the gradient vanishes) it also leaves
+// along the direction in which the energy falls, as far as one iteration may move.
+Outcome NewtonStep(const Model& model, Data& data, double damping) {
+  Scratch& s = data.scratch;
+  const double lambda = FactorShifted(s, damping);
+  if (lambda < 0.0) return Outcome::kFailed;
+  const bool balanced = data.solve.residual_N <= model.solver.tolerance_N;
+  if (balanced && lambda == 0.0) return Outcome::kConverged;
+  s.step = -s.gradient;
+  s.factor.Solve(s.step);
+  if (lambda > 0.0) {
+    const double curvature = NegativeCurvature(s, s.direction);
+    if (curvature < 0.0) {
+      data.solve.indefinite = true;
+      const double sign = s.direction.dot(s.gradient) > 0.0 ? -1.0 : 1.0;
+      s.step += sign * (model.solver.step_cap_m / std::max(LargestMove(s.direction), 1e-300)) *
+                s.direction;
+    } else if (balanced) {
+      return Outcome::kConverged;
+    }
+  }
+  return Outcome::kStep;
+}
+
+// Moves the unknowns along the step, capped so that no point moves farther than the step cap
+// (contacts are found again before a part could be crossed), halving it while the energy does
+// not fall enough (Armijo). True, with the nodes, contacts and energy of the new point, when one
+// was taken.
+bool LineSearch(const Model& model, Data& data, double& energy) {
+  Scratch& s = data.scratch;
+  std::span<Vec3> trial(s.x_trial_W);
+  const double move = LargestMove(s.step);
+  double alpha = move > model.solver.step_cap_m ? model.solver.step_cap_m / move : 1.0;
+  const double slope = s.gradient.dot(s.step);
+  for (int halving = 0; halving < 8; ++halving, alpha *= 0.5) {
+    s.unknowns_trial = s.unknowns + alpha * s.step;
+    NodesOf(model, data, s.unknowns_trial, trial);
+    FindContacts(model, trial, data, Choices::kPending);
+    // The first trial is taken most often: its derivatives are assembled with its energy.
+    const double e = Assemble(model, data, trial, halving == 0);
+    // With room for the rounding of a sum of terms near equilibrium.
+    if (e <= energy + 1e-4 * alpha * std::min(slope, 0.0) + 1e-13 * std::abs(energy)) {
+      CommitContactChoices(data);
+      s.unknowns = s.unknowns_trial;
+      std::copy(trial.begin(), trial.end(), data.state.x_W.begin());
+      energy = halving == 0 ? e : Assemble(model, data, data.state.x_W, true);
+      return true;
+    }
+  }
+  // None taken: the contacts and derivatives of where the search started.
+  FindContacts(model, data.state.x_W, data);
+  energy = Assemble(model, data, data.state.x_W, true);
+  return false;
+}
+
 }  // namespace
 
 void SolveEquilibrium(const Model& model, Data& data) {
   Scratch& s = data.scratch;
   SolveReport& report = data.solve;
   std::span<Vec3> x(data.state.x_W);
-  std::span<Vec3> trial(s.x_trial_W);
-  Eigen::VectorXd& q = s.unknowns;
-  Eigen::VectorXd& q_trial = s.unknowns_trial;
-  UnknownsOf(model, x, q);
-
+  UnknownsOf(model, x, s.unknowns);
   FindContacts(model, x, data);
   double energy = Assemble(model, data, x, true);
-  const int max_iterations = model.solver.max_iterations;
   report.converged = false;
-  for (int it = 0; it < max_iterations; ++it) {
+  // The iterations left of the tick's budget, which its friction passes share.
+  while (report.iterations < model.solver.max_iterations) {
     report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
-    const double lambda = FactorShifted(s);
-    if (lambda < 0.0) break;
-    const bool small = report.residual_N <= model.solver.tolerance_N;
-    // Converged at a minimum: balanced and stable.
-    if (small && lambda == 0.0) {
-      report.converged = true;
-      break;
-    }
-    s.step = -s.gradient;
-    s.factor.Solve(s.step);
+    Outcome o = NewtonStep(model, data, 0.0);
+    if (o == Outcome::kConverged) report.converged = true;
+    if (o != Outcome::kStep) break;
+    ++report.iterations;
     // Converged when the Newton step would change the energy by less than the rounding of its
     // stiff axial terms (their lengths cancel to ~1e-18 m): what is left is below any figure.
-    if (lambda == 0.0 && -s.gradient.dot(s.step) < kDecrementFloor_J) {
-      q += s.step;
-      NodesOf(model, data, q, x);
+    if (!report.indefinite && -s.gradient.dot(s.step) < kDecrementFloor_J) {
+      s.unknowns += s.step;
+      NodesOf(model, data, s.unknowns, x);
       FindContacts(model, x, data);
       energy = Assemble(model, data, x, true);
-      ++report.iterations;
       report.converged = true;
       break;
     }
-    // At a saddle (a straight column past its buckling load) the gradient vanishes: leave along
-    // the direction in which the energy falls, as far as one step may go.
-    if (lambda > 0.0) {
-      const double curvature = NegativeCurvature(s, s.direction);
-      if (curvature < 0.0) {
-        report.indefinite = true;
-        double sign = s.direction.dot(s.gradient) > 0.0 ? -1.0 : 1.0;
-        s.step += sign * (model.solver.step_cap_m / std::max(LargestMove(s.direction), 1e-300)) *
-                  s.direction;
-      } else if (small) {
-        report.converged = true;
-        break;
-      }
+    // Where the full step does not lower the energy (a contact it did not foresee), damped
+    // steps, shorter and nearer the gradient (Levenberg-Marquardt), from the contact stiffness
+    // up.
+    bool moved = LineSearch(model, data, energy);
+    if (std::getenv("TP_DEBUG")) std::fprintf(stderr, "  it %d E=%.17g res=%.3e moved=%d samples=%d fp=%d\n", report.iterations, energy, report.residual_N, moved, s.sample_count, data.state.friction_count);
+    for (double damping = model.contact.stiffness_N_per_m; !moved && damping < 1e5 * model.contact.stiffness_N_per_m; damping *= 10.0) {
+      if (NewtonStep(model, data, damping) != Outcome::kStep) break;
+      moved = LineSearch(model, data, energy);
     }
-    // No point moves farther than the cap: contacts are found again before a part is crossed.
-    const double move = LargestMove(s.step);
-    double alpha = move > model.solver.step_cap_m ? model.solver.step_cap_m / move : 1.0;
-    const double slope = s.gradient.dot(s.step);
-    bool accepted = false;
-    for (int ls = 0; ls < 12; ++ls) {
-      q_trial = q + alpha * s.step;
-      NodesOf(model, data, q_trial, trial);
-      FindContacts(model, trial, data);
-      const double e = Assemble(model, data, trial, false);
-      // Armijo's condition, with room for rounding in a sum of terms near equilibrium.
-      if (e <= energy + 1e-4 * alpha * std::min(slope, 0.0) + 1e-13 * std::abs(energy)) {
-        accepted = true;
-        break;
-      }
-      alpha *= 0.5;
-    }
-    ++report.iterations;
-    if (std::getenv("TP_DEBUG")) std::fprintf(stderr, "  it %d E=%.17g res=%.3e lambda=%.3e slope=%.3e alpha=%.3e acc=%d samples=%d\n", it, energy, report.residual_N, lambda, slope, alpha, accepted, s.sample_count);
-    if (!accepted) {
-      // Nothing lowers the energy along this direction: the last state stands.
-      FindContacts(model, x, data);
-      energy = Assemble(model, data, x, true);
-      break;
-    }
-    q = q_trial;
-    std::copy(trial.begin(), trial.end(), x.begin());
-    energy = Assemble(model, data, x, true);
+    // Nothing lowers the energy: the last state stands.
+    if (!moved) break;
   }
   report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
 }

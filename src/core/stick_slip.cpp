@@ -115,15 +115,20 @@ bool ReturnFrictionToLimits(const Model& model, Data& data) {
     }
     const Limits lim = LimitsOf(model, data, data.scratch.samples[std::size_t(fp.sample)]);
     const double trial_N = K * Stretch(model, data, fp).norm();
-    if (!fp.sliding) {
-      if (trial_N > lim.static_N * (1.0 + 1e-9) + 1e-12) {
-        fp.sliding = true;
-        fp.limit_N = lim.kinetic_N;
+    // A point's limit follows its load with a tick's lag unless the load moved it by more than
+    // a tenth (a contact closing or opening): then the tick is solved again.
+    const auto follow = [&](double limit_N) {
+      if (std::abs(fp.limit_N - limit_N) > 0.1 * limit_N + 1e-4) {
+        fp.limit_N = limit_N;
         changed = true;
       }
-    } else if (std::abs(fp.limit_N - lim.kinetic_N) > 0.02 * lim.kinetic_N + 1e-6) {
+    };
+    if (!fp.sliding && trial_N > lim.static_N * (1.0 + 1e-9) + 1e-12) {
+      fp.sliding = true;
       fp.limit_N = lim.kinetic_N;
       changed = true;
+    } else {
+      follow(fp.sliding ? lim.kinetic_N : lim.static_N);
     }
   }
   return changed;

@@ -44,10 +44,9 @@ bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand
   st.R_WH = R_new;
   data.input.tangent_held_W = R_new.col(2);
   st.x_W[1] = st.x_W[0] + h * data.input.tangent_held_W;
-  // Parts within reach of the tube and of how far this tick may move it.
-  const double reach = (p_hand - st.x_W[0]).norm() + model.solver.step_cap_m;
-  FindPartsNear(model, st.x_W, reach, data);
   data.solve = SolveReport{};
+  std::fill(s.section_chosen.begin(), s.section_chosen.end(), 0);
+  s.side_chosen_count = 0;
   data.out.flags = 0;
   return true;
 }
