@@ -36,6 +36,13 @@ std::optional<std::vector<double>> ParseQuantityList(std::string_view option, st
   return values;
 }
 
+bool OutputsApart(std::string_view command, const std::vector<io::RolePath>& outputs,
+                  const std::vector<io::RolePath>& inputs, std::ostream& err) {
+  const std::string problem = io::CheckOutputsApart(outputs, inputs);
+  if (!problem.empty()) err << "tubeplan " << command << ": error: " << problem << "\n";
+  return problem.empty();
+}
+
 int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "tubeplan: feasibility of assembly motion plans for an elastic tube going into a rigid "

@@ -176,6 +176,9 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   // Plans are judged and reported in file order, whatever the order given.
   std::sort(files.begin(), files.end());
   files.erase(std::unique(files.begin(), files.end()), files.end());
+  // Every plan named is an input an output must not replace, in this shard or another.
+  std::vector<io::RolePath> inputs;
+  for (const std::string& f : files) inputs.push_back({"the plan", f});
   if (!o.shard.empty()) {
     // "I/N": the plans whose place in file order is I-1 modulo N, the same split on every
     // machine given the same files.
@@ -202,6 +205,14 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     ok = ok && loaded.back().plan.has_value();
   }
   if (!ok) return kExitBadInput;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::filesystem::path directory = std::filesystem::path(files[i]).parent_path();
+    inputs.push_back({"the scene of " + files[i], directory / loaded[i].plan->scene});
+    inputs.push_back({"the trajectory of " + files[i], directory / loaded[i].plan->trajectory});
+  }
+  if (!OutputsApart("evaluate", {{"--report", o.report_path}, {"--html", o.html_path}}, inputs,
+                    io.err))
+    return kExitBadInput;
 
   // Graphviz is checked before the replays: a missing `dot` should not cost a batch.
   if (o.html_graph) {
@@ -434,6 +445,9 @@ int RunMerge(const MergeOptions& o, Streams io) {
     }
   }
   if (!ok) return kExitBadInput;
+  std::vector<io::RolePath> inputs;
+  for (const std::string& path : o.reports) inputs.push_back({"the report", path});
+  if (!OutputsApart("merge", {{"--report", o.report_path}}, inputs, io.err)) return kExitBadInput;
   const nlohmann::json merged = Report(std::move(plans));
   if (!o.report_path.empty()) {
     if (const std::string e = io::WriteTextFileAtomically(o.report_path, merged.dump(1) + "\n");

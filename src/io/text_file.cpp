@@ -157,6 +157,69 @@ std::string Abbreviate(std::string_view text, std::size_t max_bytes) {
   return std::string(text.substr(0, cut)) + "...";
 }
 
+namespace {
+
+// What makes two paths one file: its device and inode when it exists, else its canonical path
+// (an output not written yet, or an input that is missing).
+struct FileIdentity {
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  std::string canonical;
+};
+
+FileIdentity IdentityOf(const std::filesystem::path& path) {
+  FileIdentity id;
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    id.exists = true;
+    id.device = info.st_dev;
+    id.inode = info.st_ino;
+  }
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  id.canonical = (ec ? absolute.lexically_normal() : canonical).string();
+  return id;
+}
+
+bool SameFile(const FileIdentity& a, const FileIdentity& b) {
+  if (a.exists && b.exists) return a.device == b.device && a.inode == b.inode;
+  return a.canonical == b.canonical;
+}
+
+// "--out T.csv" or "the trajectory T.csv".
+std::string Named(const RolePath& p) { return p.role + " " + p.path.string(); }
+
+// When the two spellings differ, how they can be one file.
+std::string Through(const RolePath& a, const RolePath& b) {
+  return a.path == b.path ? "" : " (through a link or another spelling of its path)";
+}
+
+}  // namespace
+
+std::string CheckOutputsApart(const std::vector<RolePath>& outputs,
+                              const std::vector<RolePath>& inputs) {
+  std::vector<FileIdentity> input_ids;
+  for (const RolePath& in : inputs) input_ids.push_back(IdentityOf(in.path));
+  std::vector<FileIdentity> output_ids;
+  for (const RolePath& out : outputs) {
+    output_ids.push_back(out.path.empty() ? FileIdentity{} : IdentityOf(out.path));
+    if (out.path.empty()) continue;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      if (inputs[i].path.empty() || !SameFile(output_ids.back(), input_ids[i])) continue;
+      return Named(out) + " is the same file as " + Named(inputs[i]) + Through(out, inputs[i]) +
+             ": writing it would replace the input, expected another file for the output";
+    }
+    for (std::size_t j = 0; j + 1 < output_ids.size(); ++j) {
+      if (outputs[j].path.empty() || !SameFile(output_ids.back(), output_ids[j])) continue;
+      return Named(out) + " is the same file as " + Named(outputs[j]) + Through(out, outputs[j]) +
+             ": one would replace the other, expected a file of its own for each output";
+    }
+  }
+  return {};
+}
+
 void InputTextCheck::Feed(std::string_view piece) {
   size_ += piece.size();
   if (blank_ && piece.find_first_not_of(" \t\r\n") != std::string_view::npos) blank_ = false;

@@ -180,3 +180,91 @@ TEST_CASE("SIGINT during a batch evaluation stops it and writes no report", "[cl
   CHECK(Entries(dir) == std::vector<std::string>{"report.json"});
   std::filesystem::remove_all(Scratch());
 }
+
+TEST_CASE("Every command refuses an output that is one of its inputs, and writes nothing",
+          "[cli][outputs]") {
+  namespace fs = std::filesystem;
+  const auto dir = Scratch() / "same";
+  fs::create_directories(dir / "plans");
+  fs::create_directories(dir / "scenes");
+  // A copy of a shipped plan with its scene and trajectory, so that overwriting would be seen.
+  fs::copy_file(SourcePath("scenes/groove.yaml"), dir / "scenes" / "groove.yaml");
+  fs::copy_file(SourcePath("plans/groove-insert.csv"), dir / "plans" / "groove-insert.csv");
+  fs::copy_file(SourcePath("plans/groove-insert-coarse.yaml"), dir / "plans" / "coarse.yaml");
+  const std::string scene = (dir / "scenes" / "groove.yaml").string();
+  const std::string trajectory = (dir / "plans" / "groove-insert.csv").string();
+  const std::string plan = (dir / "plans" / "coarse.yaml").string();
+  fs::create_symlink(trajectory, dir / "link.csv");
+  const std::string link = (dir / "link.csv").string();
+  std::ofstream(dir / "report.json") << "{}\n";
+  const std::string report = (dir / "report.json").string();
+  const std::vector<std::string> before = {ReadFile(scene), ReadFile(trajectory), ReadFile(plan)};
+  const auto run = [](std::vector<std::string> args) {
+    std::ostringstream out, err;
+    const int code = tubeplan::cli::Run(args, out, err);
+    return Outcome{code, err.str()};
+  };
+  const auto same = [](const std::string& command, const std::string& option,
+                       const std::string& output, const std::string& role,
+                       const std::string& input) {
+    return "tubeplan " + command + ": error: " + option + " " + output + " is the same file as " +
+           role + " " + input +
+           (output == input ? "" : " (through a link or another spelling of its path)") +
+           ": writing it would replace the input, expected another file for the output\n";
+  };
+  struct Case {
+    std::vector<std::string> args;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {{"simulate", scene, trajectory, "--out", trajectory},
+       same("simulate", "--out", trajectory, "the trajectory", trajectory)},
+      {{"simulate", scene, trajectory, "--out", link},
+       same("simulate", "--out", link, "the trajectory", trajectory)},
+      {{"evaluate", plan, "--report", plan}, same("evaluate", "--report", plan, "the plan", plan)},
+      {{"evaluate", plan, "--html", scene},
+       same("evaluate", "--html", scene, "the scene of " + plan,
+            (dir / "plans" / "../scenes/groove.yaml").string())},
+      {{"evaluate", plan, "--report", link},
+       same("evaluate", "--report", link, "the trajectory of " + plan,
+            (dir / "plans" / "groove-insert.csv").string())},
+      {{"graph", scene, "--json", scene}, same("graph", "--json", scene, "the scene", scene)},
+      {{"graph", scene, "--dot", report, "--verdicts", report},
+       same("graph", "--dot", report, "--verdicts", report)},
+      {{"graph", scene, "--dot", report, "--json", report},
+       "tubeplan graph: error: --json " + report + " is the same file as --dot " + report +
+           ": one would replace the other, expected a file of its own for each output\n"},
+      {{"live", plan, "--device", "emulator:fast", "--record", trajectory},
+       same("live", "--record", trajectory, "the plan's trajectory",
+            (dir / "plans" / "groove-insert.csv").string())},
+      {{"live", plan, "--device", "emulator:" + link + ",fast", "--record", link},
+       same("live", "--record", link, "the plan's trajectory",
+            (dir / "plans" / "groove-insert.csv").string())},
+      {{"accuracy", scene, "--svg", scene}, same("accuracy", "--svg", scene, "the scene", scene)},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    const Outcome r = run(c.args);
+    CHECK(r.exit_code == 2);
+    CHECK(r.err == c.expected);
+  }
+  // plans: its candidate's name is the scene's own file.
+  fs::copy_file(scene, dir / "scenes" / "groove-candidate-1.yaml");
+  const std::string candidate = (dir / "scenes" / "groove-candidate-1.yaml").string();
+  const Outcome plans = run({"plans", candidate, "--out-dir", (dir / "scenes").string()});
+  CHECK(plans.exit_code == 2);
+  CHECK(plans.err == same("plans", "the plan file", candidate, "the scene", candidate));
+  // merge: a report merged into itself (a valid one, so the check is what refuses it).
+  const Outcome evaluated = run({"evaluate", plan, "--jobs", "1", "--report", report});
+  REQUIRE(evaluated.exit_code == 0);
+  const std::string merged_before = ReadFile(report);
+  const Outcome merged = run({"merge", report, "--report", report});
+  CHECK(merged.exit_code == 2);
+  CHECK(merged.err == same("merge", "--report", report, "the report", report));
+  CHECK(ReadFile(report) == merged_before);
+  // Nothing was touched, and no temporary is left anywhere.
+  CHECK(std::vector<std::string>{ReadFile(scene), ReadFile(trajectory), ReadFile(plan)} == before);
+  for (const auto& entry : fs::recursive_directory_iterator(dir))
+    CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
+  fs::remove_all(Scratch());
+}

@@ -267,3 +267,4 @@ TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
   // Most damage must be caught (comments and spaces are harmless, most other bytes are not).
   CHECK(rejected > loaded_count);
 }
+

@@ -3,6 +3,7 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -31,6 +32,46 @@ TEST_CASE("Atomic writes replace the file whole and leave no temporary behind", 
   const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "no" / "x.txt", "z");
   CHECK_THAT(error, Catch::StartsWith("cannot create"));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("An output that is an input's file is refused, through links too", "[files]") {
+  using tubeplan::io::CheckOutputsApart;
+  namespace fs = std::filesystem;
+  const auto dir = ScratchDir();
+  const fs::path input = dir / "t.csv";
+  std::ofstream(input) << "t,px,py,pz,qw,qx,qy,qz\n";
+  const std::vector<tubeplan::io::RolePath> inputs = {{"the scene", dir / "s.yaml"},
+                                                      {"the trajectory", input}};
+  // The same spelling.
+  CHECK(CheckOutputsApart({{"--out", input}}, inputs) ==
+        "--out " + input.string() + " is the same file as the trajectory " + input.string() +
+            ": writing it would replace the input, expected another file for the output");
+  // A symbolic link, a hard link and another spelling of the path: the same file.
+  fs::create_symlink(input, dir / "link.csv");
+  fs::create_hard_link(input, dir / "hard.csv");
+  for (const fs::path& other :
+       {dir / "link.csv", dir / "hard.csv", dir / "sub" / ".." / "t.csv", dir / "." / "t.csv"}) {
+    fs::create_directories(dir / "sub");
+    CAPTURE(other.string());
+    CHECK(CheckOutputsApart({{"--out", other}}, inputs) ==
+          "--out " + other.string() + " is the same file as the trajectory " + input.string() +
+              " (through a link or another spelling of its path): writing it would replace the "
+              "input, expected another file for the output");
+  }
+  // An input that does not exist yet, named twice: the canonical paths decide.
+  CHECK_THAT(CheckOutputsApart({{"--report", dir / "sub" / ".." / "s.yaml"}}, inputs),
+             Catch::StartsWith("--report " + (dir / "sub" / ".." / "s.yaml").string() +
+                               " is the same file as the scene "));
+  // Two outputs to one file: one would replace the other.
+  CHECK(CheckOutputsApart({{"--dot", dir / "g"}, {"--json", dir / "g"}}, inputs) ==
+        "--json " + (dir / "g").string() + " is the same file as --dot " + (dir / "g").string() +
+            ": one would replace the other, expected a file of its own for each output");
+  // Files apart, and options not given (empty paths), pass.
+  CHECK(CheckOutputsApart({{"--out", dir / "series.csv"}, {"--json", ""}}, inputs).empty());
+  // A copy is another file, whatever it holds.
+  fs::copy_file(input, dir / "copy.csv");
+  CHECK(CheckOutputsApart({{"--out", dir / "copy.csv"}}, inputs).empty());
+  fs::remove_all(dir);
 }
 
 TEST_CASE("Reading: empty files are empty text, directories and missing files are nothing",

@@ -143,6 +143,20 @@ class InputLineReader {
 /// UTF-8 sequence) and "...", so a 1 MB field does not become a 1 MB message.
 std::string Abbreviate(std::string_view text, std::size_t max_bytes = 40);
 
+/// A file a command reads or writes, with what it is to the user: "the scene", "--out".
+struct RolePath {
+  std::string role;
+  std::filesystem::path path;
+};
+
+/// Refuses an output that is the very file of an input, or of another output: the same device
+/// and inode when the output exists (a symlink or a hard link to the input included), else the
+/// same canonical path. An empty string when every output is a file apart; else the message,
+/// naming both paths ("--out T.csv is the same file as the trajectory T.csv, ..."), which the
+/// command prints with exit code 2 before it writes anything. Empty roles and paths are skipped.
+std::string CheckOutputsApart(const std::vector<RolePath>& outputs,
+                              const std::vector<RolePath>& inputs);
+
 /// A file written whole or not at all, for outputs too large to hold in memory: the text goes
 /// to a temporary file next to `path` as it comes (Write), and Commit flushes it to the disk and
 /// renames it over `path`. Destroyed without a successful Commit (an error, an exception, an
