@@ -1,6 +1,7 @@
 #include <exception>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
 #include "commands.hpp"
@@ -74,8 +75,13 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
     return kExitBadInput;
   }
   try {
-    for (const Command& command : commands)
-      if (command.app->parsed()) return command.run();
+    for (const Command& command : commands) {
+      if (!command.app->parsed()) continue;
+      io::SetInterruptMessage("tubeplan " + command.app->get_name() +
+                              ": interrupted; outputs not finished were not written (their "
+                              "temporary files are removed)");
+      return command.run();
+    }
   } catch (const io::InputChanged& e) {
     // A trajectory rewritten between its check and its replay: bad input, not a bug.
     err << e.what() << "\n";

@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/text_file.hpp>
 
 namespace tubeplan::io {
@@ -376,22 +377,50 @@ bool CheckInputText(std::string_view text, const std::string& display_name,
   return check.Finish(display_name, expected, diagnostics);
 }
 
-AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
-  // Same directory, so the rename is atomic (same file system); the pid and a counter keep two
-  // writers of one path (processes or threads) from sharing a temporary file.
+namespace {
+
+// `path` + ".tmp.PID.N": in the same directory, so the rename is atomic (same file system); the
+// pid and a counter keep two writers of one path (processes or threads) from sharing one.
+std::filesystem::path TemporaryFor(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
-  temporary_ = path_;
-  temporary_ += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  return temporary;
+}
+
+// Creates the temporary file for `path`, and the directories above it when they are missing (a
+// fresh checkout has no build/); -1 and `error` set when it cannot.
+int CreateTemporary(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                    int& slot, std::string& error) {
+  constexpr int kFlags = O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC;
+  int fd = CreateRegistered(temporary.c_str(), kFlags, 0666, slot);
+  if (fd < 0 && errno == ENOENT && path.has_parent_path()) {
+    std::error_code ec;
+    std::filesystem::create_directories(path.parent_path(), ec);
+    if (ec) {
+      error = "cannot create the directory " + path.parent_path().string() + ": " + ec.message();
+      return -1;
+    }
+    fd = CreateRegistered(temporary.c_str(), kFlags, 0666, slot);
+  }
+  if (fd < 0) error = "cannot create " + temporary.string() + ": " + std::strerror(errno);
+  return fd;
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path path)
+    : path_(std::move(path)), temporary_(TemporaryFor(path_)) {
   // A write past RLIMIT_FSIZE raises SIGXFSZ, whose default action kills the process and leaves
   // the temporary behind; ignored, the write fails with EFBIG and is reported like a full disk.
   std::signal(SIGXFSZ, SIG_IGN);
-  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd_ < 0) error_ = "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+  fd_ = CreateTemporary(path_, temporary_, slot_, error_);
 }
 
 AtomicFile::~AtomicFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!committed_ && (fd_ >= 0 || !error_.empty())) ::unlink(temporary_.c_str());
+  if (!committed_ && fd_ >= 0) ::unlink(temporary_.c_str());
+  ForgetTemporary(slot_);
 }
 
 void AtomicFile::Fail(const char* what, int error) {
@@ -400,6 +429,8 @@ void AtomicFile::Fail(const char* what, int error) {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
   ::unlink(temporary_.c_str());
+  ForgetTemporary(slot_);
+  slot_ = -1;
 }
 
 bool AtomicFile::Write(std::string_view text) {
@@ -440,9 +471,10 @@ std::string AtomicFile::Commit() {
       }
     }
   }
+  // Nothing asked to be written yet (the temporary could not be created): no room to name.
   return error_ + "; nothing was written (" + path_.string() +
-         " is as it was), expected a writable directory with room for " + std::to_string(bytes_) +
-         " bytes";
+         " is as it was), expected a writable directory" +
+         (bytes_ > 0 ? " with room for " + std::to_string(bytes_) + " bytes" : std::string());
 }
 
 std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text) {
@@ -452,19 +484,27 @@ std::string WriteTextFileAtomically(const std::filesystem::path& path, std::stri
 }
 
 StreamingTextFile::~StreamingTextFile() {
-  if (file_ == nullptr) return;
-  std::fclose(file_);
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    std::error_code ignored;
+    std::filesystem::remove(temporary_, ignored);
+  }
+  ForgetTemporary(slot_);
 }
 
 std::string StreamingTextFile::Open(const std::filesystem::path& path) {
   path_ = path;
-  temporary_ = path;
-  temporary_ += ".tmp." + std::to_string(::getpid());
-  file_ = std::fopen(temporary_.c_str(), "wb");
-  if (file_ == nullptr) return "cannot create " + temporary_.string() + ": " + std::strerror(errno);
-  return {};
+  temporary_ = TemporaryFor(path);
+  std::string error;
+  const int fd = CreateTemporary(path_, temporary_, slot_, error);
+  if (fd < 0) return error;
+  file_ = ::fdopen(fd, "wb");
+  if (file_ == nullptr) {
+    error = "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+    ::close(fd);
+    ::unlink(temporary_.c_str());
+  }
+  return error;
 }
 
 void StreamingTextFile::Append(std::string_view text) {
@@ -494,6 +534,8 @@ std::string StreamingTextFile::Commit() {
           "cannot rename " + temporary_.string() + " to " + path_.string() + ": " + ec.message();
   }
   if (!error.empty()) std::filesystem::remove(temporary_, ec);
+  ForgetTemporary(slot_);
+  slot_ = -1;
   return error;
 }
 

@@ -28,9 +28,26 @@ TEST_CASE("Atomic writes replace the file whole and leave no temporary behind", 
   int files = 0;
   for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir)) ++files;
   CHECK(files == 1);
-  // A write into a directory that does not exist fails with a message and changes nothing.
-  const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "no" / "x.txt", "z");
-  CHECK_THAT(error, Catch::StartsWith("cannot create"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("An output's missing directories are made; one that cannot be made is said", "[files]") {
+  const auto dir = ScratchDir();
+  // A fresh checkout has no build/: the directory and its parents are made as mkdir -p does.
+  REQUIRE(tubeplan::io::WriteTextFileAtomically(dir / "no" / "deeper" / "x.txt", "z").empty());
+  CHECK(tubeplan::io::ReadTextFile(dir / "no" / "deeper" / "x.txt") ==
+        std::optional<std::string>("z"));
+  // A parent that is a file: the message names the temporary it could not create and, since
+  // nothing was asked to be written yet, speaks of no room ("room for 0 bytes").
+  std::ofstream(dir / "plain") << "a file\n";
+  const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "plain" / "x.txt", "");
+  CHECK_THAT(error, Catch::StartsWith("cannot create " + (dir / "plain" / "x.txt").string() +
+                                      ".tmp."));
+  CHECK_THAT(error, Catch::EndsWith(": Not a directory; nothing was written (" +
+                                    (dir / "plain" / "x.txt").string() +
+                                    " is as it was), expected a writable directory"));
+  tubeplan::io::AtomicFile never(dir / "plain" / "y.txt");
+  CHECK_THAT(never.Commit(), Catch::EndsWith("expected a writable directory"));
   std::filesystem::remove_all(dir);
 }
 

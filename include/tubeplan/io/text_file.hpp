@@ -158,9 +158,10 @@ std::string CheckOutputsApart(const std::vector<RolePath>& outputs,
                               const std::vector<RolePath>& inputs);
 
 /// A file written whole or not at all, for outputs too large to hold in memory: the text goes
-/// to a temporary file next to `path` as it comes (Write), and Commit flushes it to the disk and
-/// renames it over `path`. Destroyed without a successful Commit (an error, an exception, an
-/// interruption), it removes the temporary file and `path` stays as it was.
+/// to a temporary file next to `path` (`NAME.tmp.PID.N`) as it comes (Write), and Commit flushes
+/// it to the disk and renames it over `path`. Destroyed without a successful Commit (an error,
+/// an exception), it removes the temporary file and `path` stays as it was; so does SIGINT or
+/// SIGTERM (io/interrupt.hpp). Missing parent directories of `path` are created.
 class AtomicFile {
  public:
   explicit AtomicFile(std::filesystem::path path);
@@ -179,6 +180,7 @@ class AtomicFile {
   void Fail(const char* what, int error);
   std::filesystem::path path_, temporary_;
   int fd_ = -1;
+  int slot_ = -1;  // the temporary's registration for the signal handler
   std::uintmax_t bytes_ = 0;
   bool committed_ = false;
   std::string error_;
@@ -191,10 +193,11 @@ class AtomicFile {
 /// or a missing directory all come back here as a message, never as a partial file.
 std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text);
 
-/// A file written as it goes (a live recording): into a temporary file next to `path`, flushed
-/// to the operating system on every Flush(), and renamed over `path` by Commit(). A crash leaves
-/// `path` as it was (and the partial data in the temporary file); destroying it uncommitted
-/// removes the temporary file.
+/// A file written as it goes (a live recording): into a temporary file next to `path`
+/// (`NAME.tmp.PID.N`), flushed to the operating system on every Flush(), and renamed over `path`
+/// by Commit(). A crash or SIGKILL leaves `path` as it was (and the partial data in the
+/// temporary file); destroying it uncommitted, SIGINT or SIGTERM remove the temporary file.
+/// Missing parent directories of `path` are created.
 class StreamingTextFile {
  public:
   StreamingTextFile() = default;
@@ -213,6 +216,7 @@ class StreamingTextFile {
  private:
   std::filesystem::path path_, temporary_;
   std::FILE* file_ = nullptr;
+  int slot_ = -1;
   bool failed_ = false;
 };
 
