@@ -21,6 +21,7 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
+#include <tubeplan/scene/geometry.hpp>
 
 #include "yaml_reader.hpp"
 
@@ -80,37 +81,16 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   return ok ? std::optional(f) : std::nullopt;
 }
 
-// Separating-axis test of two oriented boxes: true when they share a volume thicker than
-// `tolerance_m` along every axis (boxes that only touch do not overlap).
-bool BoxesOverlap(const scene::BoxPart& a, const scene::BoxPart& b, double tolerance_m) {
-  const Eigen::Matrix3d& Ra = a.X_WP.linear();
-  const Eigen::Matrix3d& Rb = b.X_WP.linear();
-  const Eigen::Vector3d ha = a.size_m / 2.0;
-  const Eigen::Vector3d hb = b.size_m / 2.0;
-  const Eigen::Vector3d d_W = b.X_WP.translation() - a.X_WP.translation();
-  std::vector<Eigen::Vector3d> axes;
-  for (int i = 0; i < 3; ++i) {
-    axes.push_back(Ra.col(i));
-    axes.push_back(Rb.col(i));
-    for (int j = 0; j < 3; ++j) {
-      const Eigen::Vector3d c = Ra.col(i).cross(Rb.col(j));
-      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges give no new axis
-    }
-  }
-  for (const Eigen::Vector3d& n : axes) {
-    const double ra = (Ra.transpose() * n).cwiseAbs().dot(ha);
-    const double rb = (Rb.transpose() * n).cwiseAbs().dot(hb);
-    if (std::abs(d_W.dot(n)) >= ra + rb - tolerance_m) return false;  // a separating axis
-  }
-  return true;
-}
-
 bool PointInside(const scene::BoxPart& box, const Eigen::Vector3d& p_W, double tolerance_m) {
   const Eigen::Vector3d p_P = box.X_WP.inverse() * p_W;
   return ((box.size_m / 2.0).array() - p_P.cwiseAbs().array() > tolerance_m).all();
 }
 
 constexpr double kGeometryTolerance_m = 1e-9;
+
+// The most parts a scene may hold (docs/scene-format.md): the core compares the tube with every
+// part within its reach each tick, and a scene of a thousand parts is far beyond a task's fixture.
+constexpr std::size_t kMaxParts = 1000;
 
 void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok) {
   if (!node.IsSequence() || node.size() == 0) {
@@ -119,7 +99,17 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
     parts_ok = false;
     return;
   }
-  std::vector<YAML::Node> position_nodes;
+  if (node.size() > kMaxParts) {
+    r.Error(node[kMaxParts], "parts[" + std::to_string(kMaxParts) + "] is one part too many: " +
+                                 std::to_string(node.size()) + " parts, expected at most " +
+                                 std::to_string(kMaxParts) + " (docs/scene-format.md says why)");
+    parts_ok = false;
+    return;
+  }
+  // Where each part is, for a message about it; kept as marks: a YAML::Node assigned to another
+  // merges the whole document's node set into its own, once a part (quadratic in the parts).
+  std::vector<YAML::Mark> position_marks;
+  std::set<std::string> names;
   for (std::size_t i = 0; i < node.size(); ++i) {
     const YAML::Node part_node = node[i];
     const std::string where = "parts[" + std::to_string(i) + "]";
@@ -136,13 +126,11 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           r.Error(n, where + ".name '" + part.name +
                          "' must start with a letter and hold only letters, digits and '_'");
         }
-        for (const scene::BoxPart& other : s.parts) {
-          if (other.name == part.name)
-            r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
-        }
+        if (!names.insert(part.name).second)
+          r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
       }
     }
-    YAML::Node position_node(YAML::NodeType::Undefined);
+    YAML::Mark position_mark = YAML::Mark::null_mark();
     if (const YAML::Node box = r.Get(part_node, "box", where, true); box.IsDefined()) {
       const std::string bw = where + ".box";
       if (r.ExpectMap(box, bw, {"size", "position", "rpy"})) {
@@ -154,11 +142,11 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           }
         }
         Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
-        position_node = r.Get(box, "position", bw, false);
-        if (position_node.IsDefined()) {
-          if (const auto p = r.Vector(position_node, bw + ".position", dim::kLength)) position = *p;
+        if (const YAML::Node n = r.Get(box, "position", bw, false); n.IsDefined()) {
+          position_mark = n.Mark();
+          if (const auto p = r.Vector(n, bw + ".position", dim::kLength)) position = *p;
         } else {
-          position_node = box;
+          position_mark = box.Mark();
         }
         if (const YAML::Node n = r.Get(box, "rpy", bw, false); n.IsDefined())
           if (const auto a = r.Vector(n, bw + ".rpy", dim::kAngle)) rpy = *a;
@@ -194,17 +182,13 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
       part.friction = ReadFriction(r, f, where + ".friction");
     if (r.error_count() != errors) parts_ok = false;
     s.parts.push_back(part);
-    position_nodes.push_back(position_node);
+    position_marks.push_back(position_mark);
   }
   if (!parts_ok) return;
-  for (std::size_t i = 0; i < s.parts.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (BoxesOverlap(s.parts[j], s.parts[i], kGeometryTolerance_m)) {
-        r.Error(position_nodes[i], "part '" + s.parts[i].name + "' overlaps part '" +
-                                       s.parts[j].name + "', expected parts that at most touch");
-        parts_ok = false;
-      }
-    }
+  for (const auto& [i, j] : scene::OverlappingParts(s.parts, kGeometryTolerance_m)) {
+    r.Error(position_marks[i], "part '" + s.parts[i].name + "' overlaps part '" + s.parts[j].name +
+                                   "', expected parts that at most touch");
+    parts_ok = false;
   }
 }
 

@@ -268,3 +268,21 @@ TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
   CHECK(rejected > loaded_count);
 }
 
+TEST_CASE("A scene of more than 1000 parts is refused at the part too many", "[scene]") {
+  std::string parts;
+  for (int i = 0; i < 1001; ++i)
+    parts += "  - {name: p" + std::to_string(i) + ", box: {size: [1 mm, 1 mm, 1 mm], position: [" +
+             std::to_string(2 * (i % 40)) + " mm, " + std::to_string(2 * (i / 40)) +
+             " mm, 100 mm]}}\n";
+  const std::string head = kMinimal.substr(0, kMinimal.find("start:"));
+  const std::string tail = kMinimal.substr(kMinimal.find("start:"));
+  CHECK(LoadSceneText(head + parts + tail, "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:1008:5: error: parts[1000] is one part too many: 1003 parts, expected at most "
+        "1000 (docs/scene-format.md says why)\n");
+  // A thousand load, and one overlapping pair among them is found and named.
+  std::string overlapping = parts.substr(0, parts.find("  - {name: p997,"));
+  overlapping += "  - {name: q, box: {size: [1 mm, 1 mm, 1 mm], position: [0.5 mm, 0, 100 mm]}}\n";
+  const auto loaded = LoadSceneText(head + overlapping + tail, "t.yaml");
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:1007:57: error: part 'q' overlaps part 'p0', expected parts that at most touch\n");
+}
