@@ -48,7 +48,7 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     return result;
   YAML::Node root;
   try {
-    root = YAML::Load(std::string(yaml_text));
+    root = LoadOneDocument(r, std::string(yaml_text), "a plan file");
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
     r.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +

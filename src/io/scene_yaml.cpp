@@ -458,7 +458,7 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
   if (!CheckInputText(yaml_text, display_name, "a YAML scene file", result.diagnostics))
     return result;
   try {
-    const YAML::Node root = YAML::Load(std::string(yaml_text));
+    const YAML::Node root = LoadOneDocument(reader, std::string(yaml_text), "a scene file");
     if (CheckYamlShape(reader, root, "a scene file")) ReadScene(reader, root, s);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".

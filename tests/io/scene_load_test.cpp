@@ -268,6 +268,20 @@ TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
   CHECK(rejected > loaded_count);
 }
 
+TEST_CASE("A second YAML document and YAML tags are errors, not ignored", "[scene]") {
+  CHECK(LoadSceneText(kMinimal + "---\nname: other\n", "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:12:1: error: a second YAML document starts here, expected a scene file as one "
+        "document (no '---' after its start)\n");
+  // An invalid later document is reported, not skipped.
+  const auto broken = LoadSceneText(kMinimal + "---\nname: [\n", "t.yaml");
+  CHECK_FALSE(broken.scene);
+  CHECK_THAT(broken.diagnostics.FormatAll(), Catch::Contains("expected valid YAML"));
+  CHECK(LoadSceneText(WithLine(2, "name: !custom t"), "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:2:7: error: unknown tag '!custom', expected a scene file without tags (plain "
+        "values such as 5 mm or \"5 mm\")\n");
+  CHECK_FALSE(LoadSceneText(WithLine(2, "name: !!str t"), "t.yaml").scene);
+}
+
 TEST_CASE("A scene of more than 1000 parts is refused at the part too many", "[scene]") {
   std::string parts;
   for (int i = 0; i < 1001; ++i)
