@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <exception>
 
 #include <tubeplan/cli/app.hpp>
@@ -60,6 +61,22 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
       AddLiveCommand(app, streams),     AddAccuracyCommand(app, streams),
       AddStabilityCommand(app, streams)};
 
+  // A word where the command belongs that names none: said with the list (CLI11's own words
+  // are "A subcommand is required" for both this and a missing command).
+  const std::vector<CLI::App*> known = app.get_subcommands([](CLI::App*) { return true; });
+  const bool first_is_word = !args.empty() && !args.front().empty() && args.front()[0] != '-';
+  if (args.empty() ||
+      (first_is_word && std::none_of(known.begin(), known.end(), [&](const CLI::App* c) {
+         return c->get_name() == args.front();
+       }))) {
+    std::string names;
+    for (const CLI::App* c : known) names += (names.empty() ? "" : ", ") + c->get_name();
+    err << "tubeplan: error: "
+        << (args.empty() ? std::string("no command given")
+                         : "unknown command '" + args.front() + "'")
+        << "; the commands are " << names << " (tubeplan --help says what each does)\n";
+    return kExitBadInput;
+  }
   // CLI11 wants argv order reversed when given a vector.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {

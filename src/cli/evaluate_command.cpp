@@ -459,7 +459,8 @@ int RunMerge(const MergeOptions& o, Streams io) {
              << (p["feasible"].get<bool>() ? "FEASIBLE" : "INFEASIBLE") << "\n";
     io.out << "summary: " << merged["summary"]["plans"] << " plans, "
            << merged["summary"]["feasible"] << " feasible, " << merged["summary"]["infeasible"]
-           << " infeasible (merged from " << o.reports.size() << " reports)\n";
+           << " infeasible (merged from " << o.reports.size()
+           << (o.reports.size() == 1 ? " report)\n" : " reports)\n");
   }
   return all_feasible ? kExitOk : kExitNegative;
 }

@@ -57,7 +57,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
       format = SeriesFormat::kJsonLines;
     } else {
       io.err << o.out_path << ": error: unknown output format \"" << ext
-             << "\", and expected a file name ending in .csv or .jsonl\n";
+             << "\", expected a file name ending in .csv or .jsonl\n";
       return kExitBadInput;
     }
   }

@@ -65,7 +65,7 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   if (f.static_coefficient < 0.0) fail("static", "must be zero or more");
   if (f.kinetic_coefficient < 0.0) {
     fail("kinetic", "must be zero or more");
-  } else if (f.kinetic_coefficient > f.static_coefficient) {
+  } else if (f.static_coefficient >= 0.0 && f.kinetic_coefficient > f.static_coefficient) {
     std::ostringstream m;
     m << "(" << f.kinetic_coefficient << ") must not exceed static (" << f.static_coefficient
       << "): sliding friction is at most the friction that holds";
@@ -304,6 +304,27 @@ void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {
   }
 }
 
+// The model's message on a tube key, "outer_radius (-0.008) must be ...", with each key's value
+// in it as the file wrote it: "outer_radius (-8 mm) must be ...".
+std::string TubeValuesAsWritten(Reader& r, const YAML::Node& tube, std::string problem) {
+  constexpr std::array<std::pair<const char*, const char*>, 5> kUnits = {{{"outer_radius", "m"},
+                                                                          {"inner_radius", "m"},
+                                                                          {"length", "m"},
+                                                                          {"youngs_modulus", "Pa"},
+                                                                          {"poisson_ratio", ""}}};
+  for (const auto& [key, unit] : kUnits) {
+    const std::string opening = std::string(key) + " (";
+    const std::size_t at = problem.find(opening);
+    if (at == std::string::npos || (at > 0 && problem[at - 1] != ' ')) continue;
+    const std::size_t from = at + opening.size();
+    const std::size_t to = problem.find(')', from);
+    const YAML::Node value = r.Get(tube, key, "tube", false);
+    if (to == std::string::npos || !value.IsScalar()) continue;
+    problem.replace(from, to - from, AsWritten(value, unit));
+  }
+  return problem;
+}
+
 void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
                                         "friction", "parts", "start",     "goal",
@@ -352,7 +373,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
           if (read.count(key) == 0) continue;
           // r2 >= r1 is only meaningful when r1 itself was read.
           if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
-          r.Error(at, "tube." + problem);
+          r.Error(at, "tube." + TubeValuesAsWritten(r, t, problem));
         } else if (read.size() == 5) {
           r.Error(t, "tube " + problem);  // about the section as a whole
         }

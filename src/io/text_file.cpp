@@ -266,6 +266,21 @@ void InputTextCheck::Scan(std::string_view data, bool last) {
   };
   for (std::size_t i = 0; i < n;) {
     const auto c = static_cast<unsigned char>(data[i]);
+    // A CR ends a line only with a LF after it: one alone means the file's lines end in CR.
+    if (cr_pending_) {
+      cr_pending_ = false;
+      if (c != '\n' && !lone_cr_) {
+        findings_.push_back({Kind::kLoneCr, cr_line_, cr_column_});
+        lone_cr_ = true;
+      }
+    }
+    if (c == '\r') {
+      cr_pending_ = true;
+      cr_line_ = line_;
+      cr_column_ = column(i);
+      ++i;
+      continue;
+    }
     if (c == '\n') {
       if (open_long_ != SIZE_MAX) EndLongLine(base_ + i);
       ++line_;
@@ -358,7 +373,16 @@ bool InputTextCheck::Finish(const std::string& display_name, std::string_view ex
             std::string("invalid UTF-8 (byte ") + hex + "), expected UTF-8 text: " + expect);
         break;
       }
+      case Kind::kLoneCr:
+        diagnostics.Error(display_name, f.line, f.column,
+                          "a carriage return (CR) with no line feed after it: the lines end in "
+                          "CR alone (as classic Mac OS saved text), expected LF or CRLF line "
+                          "endings in " +
+                              expect);
+        break;
       case Kind::kLong:
+        // The lines of a file that ends them in CR alone are one line here: said above.
+        if (lone_cr_) break;
         diagnostics.Error(display_name, f.line, 1,
                           "line " + std::to_string(f.line) + " is " + std::to_string(f.length) +
                               " bytes long, expected at most " + std::to_string(kMaxLineBytes) +

@@ -60,6 +60,16 @@ inline std::string Join(const std::vector<std::string>& words) {
   return text;
 }
 
+/// A scalar's value for a message as the file wrote it, a plain number with its SI unit
+/// (`-0.008 m`, `5 mm`), never a bare SI number the user did not write.
+inline std::string AsWritten(const YAML::Node& node, std::string_view si_unit) {
+  if (!node.IsScalar()) return "?";
+  const QuantityResult q = ParseQuantity(node.Scalar());
+  std::string text = Abbreviate(node.Scalar());
+  if (q.quantity && !q.quantity->has_unit && !si_unit.empty()) text += " " + std::string(si_unit);
+  return text;
+}
+
 inline const char* KindName(const YAML::Node& node) {
   switch (node.Type()) {
     case YAML::NodeType::Map:

@@ -369,6 +369,16 @@ TEST_CASE("Every command refuses an output that is one of its inputs, and writes
   CHECK(merged.exit_code == 2);
   CHECK(merged.err == same("merge", "--report", report, "the report", report));
   CHECK(ReadFile(report) == merged_before);
+  // One report is "1 report".
+  std::ostringstream merged_out, merged_err;
+  CHECK(tubeplan::cli::Run(std::vector<std::string>{"merge", report}, merged_out, merged_err) == 0);
+  CHECK_THAT(merged_out.str(), Catch::EndsWith("(merged from 1 report)\n"));
+  // simulate's output format: no stray "and" before "expected".
+  const Outcome format = run({"simulate", scene, trajectory, "--out", (dir / "x.yaml").string()});
+  CHECK(format.exit_code == 2);
+  CHECK(format.err == (dir / "x.yaml").string() +
+                          ": error: unknown output format \".yaml\", expected a file name ending "
+                          "in .csv or .jsonl\n");
   // Nothing was touched, and no temporary is left anywhere.
   CHECK(std::vector<std::string>{ReadFile(scene), ReadFile(trajectory), ReadFile(plan)} == before);
   for (const auto& entry : fs::recursive_directory_iterator(dir))

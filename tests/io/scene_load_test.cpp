@@ -235,7 +235,7 @@ TEST_CASE("Every problem in a file is reported at once", "[scene]") {
         "t.yaml:3:42: error: tube.inner_radius (6 mm) must be smaller than outer_radius (5 mm)\n"
         "t.yaml:3:58: error: tube.length: has a unit of force (N), expected a length such as "
         "\"5 mm\"\n"
-        "t.yaml:3:77: error: tube.youngs_modulus (-3e+06) must be a finite number greater than "
+        "t.yaml:3:77: error: tube.youngs_modulus (-3 MPa) must be a finite number greater than "
         "zero\n"
         "t.yaml:12:1: error: unknown key 'colour' in 'scene' (expected one of: tubeplan, name, "
         "tube, contact, friction, parts, start, goal, device, model, workspace, heuristics)\n");
@@ -280,6 +280,22 @@ TEST_CASE("A second YAML document and YAML tags are errors, not ignored", "[scen
         "t.yaml:2:7: error: unknown tag '!custom', expected a scene file without tags (plain "
         "values such as 5 mm or \"5 mm\")\n");
   CHECK_FALSE(LoadSceneText(WithLine(2, "name: !!str t"), "t.yaml").scene);
+}
+
+TEST_CASE("Friction and tube messages say one thing each, with the values as written", "[scene]") {
+  // A negative static friction is one error, with no follow-on about the kinetic one.
+  CHECK(LoadSceneText(WithLine(4, "friction: {static: -0.1, kinetic: 0.08}"), "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:4:20: error: friction.static must be zero or more\n");
+  // Values as the file wrote them, a plain number with its SI unit.
+  CHECK(LoadSceneText(WithLine(3,
+                               "tube: {outer_radius: -0.008, inner_radius: 4 mm, length: "
+                               "-150 mm, youngs_modulus: 3 MPa, poisson_ratio: 0.5}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:3:22: error: tube.outer_radius (-0.008 m) must be a finite number greater than "
+        "zero\n"
+        "t.yaml:3:58: error: tube.length (-150 mm) must be a finite number greater than zero\n");
 }
 
 TEST_CASE("A scene of more than 1000 parts is refused at the part too many", "[scene]") {

@@ -91,6 +91,26 @@ TEST_CASE("An output that is an input's file is refused, through links too", "[f
   fs::remove_all(dir);
 }
 
+TEST_CASE("A file whose lines end in a carriage return alone is one clear error", "[files]") {
+  tubeplan::io::Diagnostics d;
+  // Classic Mac OS line ends: the whole file would be one line (and a YAML comment).
+  CHECK_FALSE(tubeplan::io::CheckInputText("# comment\rtubeplan: 1\rname: x\r", "s.yaml",
+                                           "a YAML scene file", d));
+  CHECK(d.FormatAll() ==
+        "s.yaml:1:10: error: a carriage return (CR) with no line feed after it: the lines end in "
+        "CR alone (as classic Mac OS saved text), expected LF or CRLF line endings in a YAML "
+        "scene file\n");
+  // CRLF, and a CR as the last byte, are fine; a CR cut from its LF by a chunk's end too.
+  tubeplan::io::Diagnostics fine;
+  CHECK(tubeplan::io::CheckInputText("a: 1\r\nb: 2\r\n", "s.yaml", "a YAML scene file", fine));
+  CHECK(tubeplan::io::CheckInputText("a: 1\r\nb: 2\r", "s.yaml", "a YAML scene file", fine));
+  tubeplan::io::InputTextCheck pieces;
+  pieces.Feed("a: 1\r");
+  pieces.Feed("\nb: 2\n");
+  CHECK(pieces.Finish("s.yaml", "a YAML scene file", fine));
+  CHECK(fine.FormatAll() == "");
+}
+
 TEST_CASE("Reading: empty files are empty text, directories and missing files are nothing",
           "[files]") {
   const auto dir = ScratchDir();

@@ -40,7 +40,8 @@ ReadResult ReadInputFile(const std::filesystem::path& path,
 std::optional<std::string> ReadTextFile(const std::filesystem::path& path);
 
 /// Checks that `text` is text a person or a recorder wrote: not empty, not binary (a NUL byte),
-/// not UTF-16 or UTF-32 (a byte-order mark), valid UTF-8, no line longer than kMaxLineBytes. Each
+/// not UTF-16 or UTF-32 (a byte-order mark), valid UTF-8, no line longer than kMaxLineBytes, no
+/// line ending in a carriage return alone (classic Mac OS; LF and CRLF are the line ends). Each
 /// kind of problem is reported once, at its first place, as "what, and `expected`" (e.g. "a YAML
 /// scene file"). Returns false when the text must not be parsed. A UTF-8 byte-order mark is fine.
 bool CheckInputText(std::string_view text, const std::string& display_name,
@@ -58,7 +59,7 @@ class InputTextCheck {
   bool failing() const { return wide_ != nullptr || !findings_.empty(); }
 
  private:
-  enum class Kind { kNul, kUtf8, kLong };
+  enum class Kind { kNul, kUtf8, kLong, kLoneCr };
   struct Finding {
     Kind kind;
     int line = 0;
@@ -75,7 +76,9 @@ class InputTextCheck {
   bool blank_ = true;           // only " \t\r\n" so far
   bool bom_checked_ = false;
   const char* wide_ = nullptr;  // "UTF-16" or "UTF-32" when a byte-order mark says so
-  bool nul_ = false, utf8_ = false, long_ = false;
+  bool nul_ = false, utf8_ = false, long_ = false, lone_cr_ = false;
+  bool cr_pending_ = false;  // the last byte seen was a CR: a line feed may follow
+  int cr_line_ = 0, cr_column_ = 0;
   std::size_t open_long_ = SIZE_MAX;  // index of the kLong finding whose line has not ended
   int line_ = 1;
   std::uint64_t line_start_ = 0;
