@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -40,6 +42,25 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& position_m, const Eigen::Vector3d&
   X.linear() = scene::RotationFromRpy(rpy_rad);
   X.translation() = position_m;
   return X;
+}
+
+// Roll, pitch and yaw: finite and within a turn either way. A larger angle is a slip of the
+// unit or the sign (-1e20 deg turns a part nowhere a person meant), not an orientation.
+constexpr double kMaxAngle_rad = 2.0 * std::numbers::pi;
+
+std::optional<Eigen::Vector3d> ReadRpy(Reader& r, const YAML::Node& node, const std::string& what) {
+  std::optional<Eigen::Vector3d> rpy = r.Vector(node, what, dim::kAngle);
+  if (!rpy) return rpy;
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) {
+    // A turn and a hair: 360 deg written in radians rounds either way.
+    if (std::abs((*rpy)[i]) <= kMaxAngle_rad * (1.0 + 1e-12)) continue;
+    const YAML::Node item = node[std::size_t(i)];
+    r.Error(item, what + "[" + std::to_string(i) + "] " + AsWritten(item, "rad") +
+                      " is out of range, expected an angle from -360 deg to 360 deg");
+    ok = false;
+  }
+  return ok ? rpy : std::nullopt;
 }
 
 // The exponent of the friction law is physics.md's [2/3, 1]; files write 2/3 as 0.6667 or 0.667,
@@ -149,7 +170,7 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           position_mark = box.Mark();
         }
         if (const YAML::Node n = r.Get(box, "rpy", bw, false); n.IsDefined())
-          if (const auto a = r.Vector(n, bw + ".rpy", dim::kAngle)) rpy = *a;
+          if (const auto a = ReadRpy(r, n, bw + ".rpy")) rpy = *a;
         part.X_WP = Pose(position, rpy);
       }
     }
@@ -325,6 +346,48 @@ std::string TubeValuesAsWritten(Reader& r, const YAML::Node& tube, std::string p
   return problem;
 }
 
+// "[1, -90, 40] mm" for a position in metres.
+std::string Millimetres(const Eigen::Vector3d& p_m) {
+  std::ostringstream text;
+  text << std::setprecision(6) << "[" << p_m.x() * 1e3 << ", " << p_m.y() * 1e3 << ", "
+       << p_m.z() * 1e3 << "] mm";
+  return text.str();
+}
+
+// The start the scene gives the tube: the held end inside the workspace, and the tube's body
+// (straight from the held end along its +z) clear of every part, as the core takes it at t = 0.
+// A part the held end is inside of is reported already.
+void CheckStart(Reader& r, const scene::Scene& s, const YAML::Mark& at, bool body_known,
+                const std::vector<bool>& held_end_inside) {
+  const Eigen::Vector3d p_m = s.X_WH_start.translation();
+  if (s.workspace && ((p_m.array() < s.workspace->min_W_m.array()).any() ||
+                      (p_m.array() > s.workspace->max_W_m.array()).any())) {
+    r.Error(at, "start.position " + Millimetres(p_m) + " is outside the workspace (min " +
+                    Millimetres(s.workspace->min_W_m) + ", max " +
+                    Millimetres(s.workspace->max_W_m) +
+                    "), expected the held end's start inside it");
+  }
+  if (!body_known) return;
+  const model::TubeSpec& tube = s.tube;
+  for (std::size_t i = 0; i < s.parts.size(); ++i) {
+    if (held_end_inside[i]) continue;
+    const std::optional<double> depth_m = scene::StraightTubeOverlap(
+        s.X_WH_start, tube.outer_radius_m, tube.length_m, s.parts[i], kGeometryTolerance_m);
+    if (!depth_m) continue;
+    std::ostringstream m;
+    m << std::setprecision(3) << "the tube at its start goes into part '" << s.parts[i].name
+      << "' ";
+    if (*depth_m >= tube.outer_radius_m)
+      m << "across its axis";
+    else
+      m << "by " << *depth_m * 1e3 << " mm";
+    m << " (the straight tube from start.position along its own +z, " << tube.length_m * 1e3
+      << " mm long, outer radius " << tube.outer_radius_m * 1e3
+      << " mm), expected the tube's body clear of every part at the start";
+    r.Error(at, m.str());
+  }
+}
+
 void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
                                         "friction", "parts", "start",     "goal",
@@ -348,6 +411,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       if (s.name.empty()) r.Error(n, "name must not be empty");
     }
   }
+  bool tube_ok = false;  // every tube key read and valid: its body can be placed
   if (const YAML::Node t = r.Get(root, "tube", "scene", true); t.IsDefined()) {
     const std::string w = "tube";
     if (r.ExpectMap(
@@ -366,7 +430,9 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       field("youngs_modulus", dim::kPressure, spec.youngs_modulus_Pa);
       field("poisson_ratio", dim::kNone, spec.poisson_ratio);
       // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
-      for (const std::string& problem : model::ValidateTubeSpec(spec)) {
+      const std::vector<std::string> problems = model::ValidateTubeSpec(spec);
+      tube_ok = read.size() == 5 && problems.empty();
+      for (const std::string& problem : problems) {
         const std::string key = problem.substr(0, problem.find(' '));
         const YAML::Node at = r.Get(t, key, w, false);
         if (at.IsDefined()) {
@@ -401,20 +467,30 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   } else {
     parts_ok = false;
   }
+  // Where the start's position is written, once it and the start's turn were read cleanly.
+  std::optional<YAML::Mark> start_mark;
+  std::vector<bool> held_end_inside(s.parts.size(), false);
   if (const YAML::Node st = r.Get(root, "start", "scene", true); st.IsDefined()) {
     const std::string w = "start";
     if (r.ExpectMap(st, w, {"position", "rpy"})) {
       Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
-      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined())
-        if (const auto a = r.Vector(n, "start.rpy", dim::kAngle)) rpy = *a;
+      bool rpy_ok = true;
+      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined()) {
+        const auto a = ReadRpy(r, n, "start.rpy");
+        if (a) rpy = *a;
+        rpy_ok = a.has_value();
+      }
       if (const YAML::Node n = r.Get(st, "position", w, true); n.IsDefined()) {
         if (const auto p = r.Vector(n, "start.position", dim::kLength)) {
           s.X_WH_start = Pose(*p, rpy);
+          if (rpy_ok) start_mark = n.Mark();
           if (parts_ok) {
-            for (const scene::BoxPart& part : s.parts)
-              if (PointInside(part, *p, kGeometryTolerance_m))
-                r.Error(n, "start.position is inside part '" + part.name +
-                               "', expected the held end outside every part");
+            for (std::size_t i = 0; i < s.parts.size(); ++i) {
+              if (!PointInside(s.parts[i], *p, kGeometryTolerance_m)) continue;
+              held_end_inside[i] = true;
+              r.Error(n, "start.position is inside part '" + s.parts[i].name +
+                             "', expected the held end outside every part");
+            }
           }
         }
       }
@@ -461,6 +537,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       }
     }
   }
+  if (start_mark) CheckStart(r, s, *start_mark, tube_ok && parts_ok, held_end_inside);
 }
 
 }  // namespace

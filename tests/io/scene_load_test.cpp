@@ -268,6 +268,40 @@ TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
   CHECK(rejected > loaded_count);
 }
 
+TEST_CASE("The tube's body at the start must be clear of every part", "[scene]") {
+  const auto load = [](const std::string& start) {
+    return LoadSceneText(WithLine(10, start), "t.yaml").diagnostics.FormatAll();
+  };
+  const std::string body =
+      " (the straight tube from start.position along its own +z, 150 mm long, outer radius 5 mm), "
+      "expected the tube's body clear of every part at the start\n";
+  // Along +y, 3 mm above the floor: its lower side 2 mm into it (only the held end was checked).
+  CHECK(load("start: {position: [0, -90 mm, 3 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: the tube at its start goes into part 'floor' by 2 mm" + body);
+  // Resting on the floor (touching) is fine.
+  CHECK(load("start: {position: [0, -90 mm, 5 mm], rpy: [-90 deg, 0, 0]}") == "");
+  // Pushed end first into the wall's near face: across the axis; its flat tip exactly on the
+  // face is fine (a capsule's round end would be 5 mm into the wall).
+  CHECK(load("start: {position: [15 mm, -249 mm, 10 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: the tube at its start goes into part 'wall' across its axis" + body);
+  CHECK(load("start: {position: [15 mm, -250 mm, 10 mm], rpy: [-90 deg, 0, 0]}") == "");
+  // The held end inside a part is said once, as before, not again for the body.
+  CHECK(load("start: {position: [15 mm, 0, 10 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: start.position is inside part 'wall', expected the held end outside "
+        "every part\n");
+}
+
+TEST_CASE("A start outside the workspace is an error", "[scene]") {
+  const std::string text =
+      kMinimal + "workspace: {min: [-100 mm, -100 mm, -10 mm], max: [100 mm, 100 mm, 30 mm]}\n";
+  CHECK(LoadSceneText(text, "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:10:19: error: start.position [0, -90, 40] mm is outside the workspace (min [-100, "
+        "-100, -10] mm, max [100, 100, 30] mm), expected the held end's start inside it\n");
+  const std::string inside =
+      kMinimal + "workspace: {min: [-100 mm, -100 mm, -10 mm], max: [100 mm, 100 mm, 50 mm]}\n";
+  CHECK(LoadSceneText(inside, "t.yaml").diagnostics.FormatAll() == "");
+}
+
 TEST_CASE("A second YAML document and YAML tags are errors, not ignored", "[scene]") {
   CHECK(LoadSceneText(kMinimal + "---\nname: other\n", "t.yaml").diagnostics.FormatAll() ==
         "t.yaml:12:1: error: a second YAML document starts here, expected a scene file as one "
@@ -280,6 +314,26 @@ TEST_CASE("A second YAML document and YAML tags are errors, not ignored", "[scen
         "t.yaml:2:7: error: unknown tag '!custom', expected a scene file without tags (plain "
         "values such as 5 mm or \"5 mm\")\n");
   CHECK_FALSE(LoadSceneText(WithLine(2, "name: !!str t"), "t.yaml").scene);
+}
+
+TEST_CASE("Angles are finite and within a turn either way", "[scene]") {
+  CHECK(LoadSceneText(WithLine(10, "start: {position: [0, -90 mm, 40 mm], rpy: [-1e20 deg, 0, 7]}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:10:45: error: start.rpy[0] -1e20 deg is out of range, expected an angle from "
+        "-360 deg to 360 deg\n"
+        "t.yaml:10:59: error: start.rpy[2] 7 rad is out of range, expected an angle from -360 deg "
+        "to 360 deg\n");
+  CHECK(LoadSceneText(WithLine(10, "start: {position: [0, -90 mm, 40 mm], rpy: [360 deg, 0, 0]}"),
+                      "t.yaml")
+            .scene);
+  CHECK(LoadSceneText(WithLine(9,
+                               "    box: {size: [10 mm, 200 mm, 20 mm], position: [15 mm, 0, "
+                               "10 mm], rpy: [0, 0, 361 deg]}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:9:82: error: parts[1].box.rpy[2] 361 deg is out of range, expected an angle from "
+        "-360 deg to 360 deg\n");
 }
 
 TEST_CASE("Friction and tube messages say one thing each, with the values as written", "[scene]") {

@@ -1,5 +1,6 @@
 // The geometry a scene is checked with: the broad phase finds exactly the overlapping pairs a
-// comparison of every pair finds.
+// comparison of every pair finds, and the straight tube's overlap with a box is exact against
+// figures worked by hand.
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -47,3 +48,29 @@ TEST_CASE("The broad phase finds exactly the pairs every pair's test finds", "[s
   CHECK(tubeplan::scene::OverlappingParts(parts, 1e-9) == every);
 }
 
+TEST_CASE("The straight tube's overlap with a box is exact", "[scene]") {
+  using tubeplan::scene::StraightTubeOverlap;
+  // The tube along world +y from the origin: roll -90 deg turns the held frame's z onto +y.
+  Eigen::Isometry3d X_WH = Eigen::Isometry3d::Identity();
+  X_WH.linear() = tubeplan::scene::RotationFromRpy({-std::numbers::pi / 2, 0.0, 0.0});
+  const double r = 0.008, l = 0.150;
+  // A floor whose top is 5 mm below the axis: 3 mm into the tube.
+  CHECK(StraightTubeOverlap(X_WH, r, l, Box({0.1, 0.3, 0.01}, {0, 0, -0.010}), 1e-9).value() ==
+        Approx(0.003).margin(1e-12));
+  // Its top exactly at the tube's side: touching, not overlapping.
+  CHECK_FALSE(StraightTubeOverlap(X_WH, r, l, Box({0.1, 0.3, 0.01}, {0, 0, -0.013}), 1e-9));
+  // A box beyond the tip's flat end (but within a capsule's round end) does not reach it; one
+  // behind the held end neither.
+  CHECK_FALSE(StraightTubeOverlap(X_WH, r, l, Box({0.02, 0.02, 0.02}, {0, 0.161, 0}), 1e-9));
+  CHECK_FALSE(StraightTubeOverlap(X_WH, r, l, Box({0.02, 0.02, 0.02}, {0, -0.0101, 0}), 1e-9));
+  // A box the axis passes through: the whole radius.
+  CHECK(StraightTubeOverlap(X_WH, r, l, Box({0.02, 0.02, 0.02}, {0, 0.1, 0}), 1e-9).value() == r);
+  // A bar turned 45 deg about the axis, an edge towards it and 6 mm from it: 2 mm into the tube.
+  const double half_diagonal = 0.005 * std::sqrt(2.0);
+  const BoxPart turned =
+      Box({0.01, 0.3, 0.01}, {0.006 + half_diagonal, 0, 0}, {0.0, std::numbers::pi / 4, 0.0});
+  CHECK(StraightTubeOverlap(X_WH, r, l, turned, 1e-9).value() == Approx(0.002).margin(1e-12));
+  // Only a corner region of a box near the tip counts: its piece between the end planes.
+  CHECK(StraightTubeOverlap(X_WH, r, l, Box({0.02, 0.02, 0.02}, {0, 0.150 + 0.0099, 0.015}), 1e-9)
+            .value() == Approx(0.003).margin(1e-12));
+}
