@@ -145,6 +145,8 @@ std::string MakeSvg(const study::AccuracyReport& r) {
 }
 
 int RunAccuracy(const AccuracyOptions& o, Streams io) {
+  if (!OutputsApart("accuracy", {{"--svg", o.svg_path}}, {{"the scene", o.scene_path}}, io.err))
+    return kExitBadInput;
   const io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
   io.err << loaded.diagnostics.FormatAll();
   if (!loaded.scene) return kExitBadInput;

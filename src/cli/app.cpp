@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <exception>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
 #include "commands.hpp"
@@ -36,6 +38,13 @@ std::optional<std::vector<double>> ParseQuantityList(std::string_view option, st
   return values;
 }
 
+bool OutputsApart(std::string_view command, const std::vector<io::RolePath>& outputs,
+                  const std::vector<io::RolePath>& inputs, std::ostream& err) {
+  const std::string problem = io::CheckOutputsApart(outputs, inputs);
+  if (!problem.empty()) err << "tubeplan " << command << ": error: " << problem << "\n";
+  return problem.empty();
+}
+
 int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err) {
   CLI::App app{
       "tubeplan: feasibility of assembly motion plans for an elastic tube going into a rigid "
@@ -52,6 +61,22 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
       AddLiveCommand(app, streams),     AddAccuracyCommand(app, streams),
       AddStabilityCommand(app, streams)};
 
+  // A word where the command belongs that names none: said with the list (CLI11's own words
+  // are "A subcommand is required" for both this and a missing command).
+  const std::vector<CLI::App*> known = app.get_subcommands([](CLI::App*) { return true; });
+  const bool first_is_word = !args.empty() && !args.front().empty() && args.front()[0] != '-';
+  if (args.empty() ||
+      (first_is_word && std::none_of(known.begin(), known.end(), [&](const CLI::App* c) {
+         return c->get_name() == args.front();
+       }))) {
+    std::string names;
+    for (const CLI::App* c : known) names += (names.empty() ? "" : ", ") + c->get_name();
+    err << "tubeplan: error: "
+        << (args.empty() ? std::string("no command given")
+                         : "unknown command '" + args.front() + "'")
+        << "; the commands are " << names << " (tubeplan --help says what each does)\n";
+    return kExitBadInput;
+  }
   // CLI11 wants argv order reversed when given a vector.
   std::vector<std::string> reversed(args.rbegin(), args.rend());
   try {
@@ -67,8 +92,13 @@ int Run(std::span<const std::string> args, std::ostream& out, std::ostream& err)
     return kExitBadInput;
   }
   try {
-    for (const Command& command : commands)
-      if (command.app->parsed()) return command.run();
+    for (const Command& command : commands) {
+      if (!command.app->parsed()) continue;
+      io::SetInterruptMessage("tubeplan " + command.app->get_name() +
+                              ": interrupted; outputs not finished were not written (their "
+                              "temporary files are removed)");
+      return command.run();
+    }
   } catch (const io::InputChanged& e) {
     // A trajectory rewritten between its check and its replay: bad input, not a bug.
     err << e.what() << "\n";

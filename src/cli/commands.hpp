@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 
 namespace tubeplan::study {
@@ -46,6 +47,12 @@ Command AddStabilityCommand(CLI::App& app, Streams streams);
 /// `tubeplan stability`'s report of its results: the pass/fail matrix, a line per failure and the
 /// warnings (or, with json, one document); returns 1 if any case failed, else 0.
 int ReportStability(std::span<const study::StabilityResult> results, bool json, Streams io);
+
+/// False after saying "tubeplan COMMAND: error: ..." on `err` when an output is the very file of
+/// an input or of another output (io::CheckOutputsApart); every command that writes files asks
+/// before it writes anything.
+bool OutputsApart(std::string_view command, const std::vector<io::RolePath>& outputs,
+                  const std::vector<io::RolePath>& inputs, std::ostream& err);
 
 /// Parses "a,b,c" of quantities of one dimension (each a plain SI number or with a unit) with
 /// between min_count and max_count items. On failure returns nullopt and sets `error` to a

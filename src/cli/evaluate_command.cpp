@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -25,6 +24,7 @@
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/verdicts.hpp>
+#include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
@@ -84,43 +84,6 @@ std::uint64_t PlanSeed(std::uint64_t seed, const std::string& file) {
   return h;
 }
 
-// Ctrl-C (SIGINT) or SIGTERM during a batch: the plans being judged finish, no new one starts,
-// and no report is written (a report is complete or absent, never half of a batch). A second
-// signal takes the default action at once (SA_RESETHAND), for a user who does not want to wait.
-std::atomic<bool> g_interrupted{false};
-extern "C" void OnInterrupt(int) { g_interrupted.store(true); }
-
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    g_interrupted.store(false);
-    struct sigaction action {};
-    action.sa_handler = OnInterrupt;
-    action.sa_flags = SA_RESETHAND;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, &old_int_);
-    sigaction(SIGTERM, &action, &old_term_);
-    // A signal sent while it was blocked (by a parent's mask, inherited) is delivered now.
-    sigset_t set;
-    sigemptyset(&set);
-    sigaddset(&set, SIGINT);
-    sigaddset(&set, SIGTERM);
-    pthread_sigmask(SIG_UNBLOCK, &set, &old_mask_);
-  }
-  ~InterruptGuard() {
-    pthread_sigmask(SIG_SETMASK, &old_mask_, nullptr);
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-  sigset_t old_mask_{};
-};
-
 // The graph section of the HTML report: each scene's pruned contact-state graph, explored with the
 // core as `tubeplan graph SCENE` does (same defaults), coloured by this run's verdicts, drawn by
 // Graphviz's dot. On failure returns false after saying why on `err`.
@@ -176,6 +139,9 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   // Plans are judged and reported in file order, whatever the order given.
   std::sort(files.begin(), files.end());
   files.erase(std::unique(files.begin(), files.end()), files.end());
+  // Every plan named is an input an output must not replace, in this shard or another.
+  std::vector<io::RolePath> inputs;
+  for (const std::string& f : files) inputs.push_back({"the plan", f});
   if (!o.shard.empty()) {
     // "I/N": the plans whose place in file order is I-1 modulo N, the same split on every
     // machine given the same files.
@@ -202,6 +168,14 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     ok = ok && loaded.back().plan.has_value();
   }
   if (!ok) return kExitBadInput;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    const std::filesystem::path directory = std::filesystem::path(files[i]).parent_path();
+    inputs.push_back({"the scene of " + files[i], directory / loaded[i].plan->scene});
+    inputs.push_back({"the trajectory of " + files[i], directory / loaded[i].plan->trajectory});
+  }
+  if (!OutputsApart("evaluate", {{"--report", o.report_path}, {"--html", o.html_path}}, inputs,
+                    io.err))
+    return kExitBadInput;
 
   // Graphviz is checked before the replays: a missing `dot` should not cost a batch.
   if (o.html_graph) {
@@ -222,11 +196,15 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   const bool progress = isatty(STDERR_FILENO) != 0 && !o.json;
   std::atomic<std::size_t> done{0};
   std::atomic<std::size_t> judged{0};
-  const InterruptGuard interrupt_guard;
+  // Ctrl-C (SIGINT) or SIGTERM during the batch: the plans being judged finish, no new one
+  // starts, and no report is written (a report is complete or absent, never half of a batch).
+  // A second signal ends the process at once (io/interrupt.hpp).
+  std::optional<io::DeferInterrupts> defer_interrupts;
+  defer_interrupts.emplace();
   std::mutex changed_mutex;
   std::vector<std::string> changed_errors;  // trajectory files rewritten during their replay
   auto work = [&] {
-    for (std::size_t i = next++; i < files.size() && !g_interrupted.load(); i = next++) {
+    for (std::size_t i = next++; i < files.size() && !io::Interrupted(); i = next++) {
       const io::PlanLoadResult& l = loaded[i];
       // With --html the judged replay is recorded as it runs (no second replay).
       ReplayRecorder recorder;
@@ -254,7 +232,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       e.robust.assign(e.judgement.transitions.size(), 0);
       e.replayed_s = e.judgement.replayed_s;
       e.run_s = e.judgement.run_s;
-      for (int r = 0; r < o.monte_carlo && !g_interrupted.load(); ++r) {
+      for (int r = 0; r < o.monte_carlo && !io::Interrupted(); ++r) {
         const plan::Judgement jr = plan::Judge(
             *l.scene,
             plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(o.seed, files[i]), r),
@@ -264,7 +242,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
         e.replayed_s += jr.replayed_s;
         e.run_s += jr.run_s;
       }
-      if (g_interrupted.load()) break;  // a Monte Carlo series cut short is not a result
+      if (io::Interrupted()) break;  // a Monte Carlo series cut short is not a result
       results[i] = std::move(e);
       ++judged;
       if (progress) {
@@ -291,21 +269,27 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
            << "\n";
     return kExitBadInput;
   }
-  if (judged.load() < files.size()) {
+  if (judged.load() < files.size() || io::Interrupted()) {
     io.err << "tubeplan evaluate: interrupted after " << judged.load() << " of " << files.size()
            << " plans; no report written"
            << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
            << "\n";
     return kExitInterrupted;
   }
+  // From here a signal ends the process at once (the page and the graphs take seconds); the
+  // outputs are made in memory and written last, so an interruption leaves none of them.
+  std::string left_as_it_was;
+  if (!o.report_path.empty() || !o.html_path.empty())
+    left_as_it_was = " (" +
+                     (o.report_path.empty() ? o.html_path
+                      : o.html_path.empty() ? o.report_path
+                                            : o.report_path + " and " + o.html_path) +
+                     (o.report_path.empty() || o.html_path.empty() ? " is left as it was)"
+                                                                   : " are left as they were)");
+  io::SetInterruptMessage("tubeplan evaluate: interrupted; no report written" + left_as_it_was);
+  defer_interrupts.reset();
   const nlohmann::json report = ToJson(results);
-  if (!o.report_path.empty()) {
-    if (const std::string e = io::WriteTextFileAtomically(o.report_path, report.dump(1) + "\n");
-        !e.empty()) {
-      io.err << o.report_path << ": error: " << e << "\n";
-      return kExitBadInput;
-    }
-  }
+  std::string html_text;
   if (!o.html_path.empty()) {
     HtmlOptions html;
     html.command = "tubeplan evaluate";
@@ -322,11 +306,32 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     for (std::size_t i = 0; i < results.size(); ++i)
       pages.push_back(
           {&results[i], &*loaded[i].scene, loaded[i].plan->scene, std::move(recordings[i])});
-    if (const std::string e =
-            io::WriteTextFileAtomically(o.html_path, FormatHtmlReport(pages, html));
-        !e.empty()) {
-      io.err << o.html_path << ": error: " << e << "\n";
-      return kExitBadInput;
+    html_text = FormatHtmlReport(pages, html);
+  }
+  // Both files in their temporaries, then renamed one after the other: a signal while they are
+  // written ends the process with neither; one while they are renamed comes too late to stop
+  // them (deferred, and then ignored), so there is never one without the other.
+  std::vector<std::pair<std::string, std::unique_ptr<io::AtomicFile>>> outputs;
+  if (!o.report_path.empty()) {
+    outputs.emplace_back(o.report_path, std::make_unique<io::AtomicFile>(o.report_path));
+    outputs.back().second->Write(report.dump(1) + "\n");
+  }
+  if (!o.html_path.empty()) {
+    outputs.emplace_back(o.html_path, std::make_unique<io::AtomicFile>(o.html_path));
+    outputs.back().second->Write(html_text);
+  }
+  for (const auto& [path, file] : outputs) {
+    if (file->error().empty()) continue;
+    io.err << path << ": error: " << file->Commit() << "\n";
+    return kExitBadInput;
+  }
+  {
+    const io::DeferInterrupts too_late;
+    for (const auto& [path, file] : outputs) {
+      if (const std::string e = file->Commit(); !e.empty()) {
+        io.err << path << ": error: " << e << "\n";
+        return kExitBadInput;
+      }
     }
   }
   const bool all_feasible = std::all_of(results.begin(), results.end(),
@@ -434,6 +439,9 @@ int RunMerge(const MergeOptions& o, Streams io) {
     }
   }
   if (!ok) return kExitBadInput;
+  std::vector<io::RolePath> inputs;
+  for (const std::string& path : o.reports) inputs.push_back({"the report", path});
+  if (!OutputsApart("merge", {{"--report", o.report_path}}, inputs, io.err)) return kExitBadInput;
   const nlohmann::json merged = Report(std::move(plans));
   if (!o.report_path.empty()) {
     if (const std::string e = io::WriteTextFileAtomically(o.report_path, merged.dump(1) + "\n");
@@ -451,7 +459,8 @@ int RunMerge(const MergeOptions& o, Streams io) {
              << (p["feasible"].get<bool>() ? "FEASIBLE" : "INFEASIBLE") << "\n";
     io.out << "summary: " << merged["summary"]["plans"] << " plans, "
            << merged["summary"]["feasible"] << " feasible, " << merged["summary"]["infeasible"]
-           << " infeasible (merged from " << o.reports.size() << " reports)\n";
+           << " infeasible (merged from " << o.reports.size()
+           << (o.reports.size() == 1 ? " report)\n" : " reports)\n");
   }
   return all_feasible ? kExitOk : kExitNegative;
 }

@@ -183,6 +183,10 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
 }
 
 int RunGraph(const GraphOptions& o, Streams io) {
+  if (!OutputsApart("graph",
+                    {{"--dot", o.dot_path}, {"--svg", o.svg_path}, {"--json", o.json_path}},
+                    {{"the scene", o.scene_path}, {"--verdicts", o.verdicts_path}}, io.err))
+    return kExitBadInput;
   // Graphviz is checked before the exploration: a missing `dot` should not cost one.
   if (!o.svg_path.empty()) {
     if (const SvgFromDot probe = RenderDot("digraph{}"); !probe.error.empty()) {
@@ -321,6 +325,20 @@ int RunPlans(const PlansOptions& o, Streams io) {
               "--speed above 0 and at most 1 m/s\n";
     return kExitBadInput;
   }
+  // The files it may write, named before the exploration: none may be the scene it reads.
+  namespace fs = std::filesystem;
+  if (const io::SceneLoadResult scene = io::LoadSceneFile(o.graph.scene_path); scene.scene) {
+    const fs::path dir =
+        o.out_dir.empty() ? fs::path(scene.scene->name + "-plans") : fs::path(o.out_dir);
+    std::vector<io::RolePath> outputs;
+    for (int i = 1; i <= o.k; ++i) {
+      const std::string name = scene.scene->name + "-candidate-" + std::to_string(i);
+      outputs.push_back({"the plan file", dir / (name + ".yaml")});
+      outputs.push_back({"the plan's trajectory", dir / (name + ".csv")});
+    }
+    if (!OutputsApart("plans", outputs, {{"the scene", o.graph.scene_path}}, io.err))
+      return kExitBadInput;
+  }
   std::variant<Built, int> built = BuildGraph(o.graph, io);
   if (const int* code = std::get_if<int>(&built)) return *code;
   const Built& b = std::get<Built>(built);
@@ -334,7 +352,6 @@ int RunPlans(const PlansOptions& o, Streams io) {
   const std::vector<graph::Path> paths =
       graph::KShortestPaths(g, graph::ArcCosts(g, b.weights), o.k);
 
-  namespace fs = std::filesystem;
   const fs::path out_dir =
       o.out_dir.empty() ? fs::path(b.scene.name + "-plans") : fs::path(o.out_dir);
   std::error_code ec;

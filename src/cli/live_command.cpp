@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iomanip>
 #include <memory>
 #include <sstream>
@@ -255,6 +256,14 @@ int RunLive(const LiveOptions& o, Streams io) {
   const EmulatorArgs& args = choice.emulator;
   const bool emulated = choice.kind == DeviceChoice::Kind::kEmulator;
   const bool stepped = emulated && args.stepped;
+  const std::filesystem::path plan_directory = std::filesystem::path(o.plan).parent_path();
+  if (!OutputsApart("live", {{"--record", o.record}},
+                    {{"the plan", o.plan},
+                     {"the plan's scene", plan_directory / loaded.plan->scene},
+                     {"the plan's trajectory", plan_directory / loaded.plan->trajectory},
+                     {"the emulator's trajectory", emulated ? args.trajectory : std::string()}},
+                    io.err))
+    return kExitBadInput;
   plan::Trajectory target = *loaded.trajectory;
   if (emulated && !args.trajectory.empty()) {
     io::TrajectoryLoadResult t = io::LoadTrajectoryFile(args.trajectory);

@@ -4,8 +4,11 @@
 #include <vector>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/io/interrupt.hpp>
 
 int main(int argc, char** argv) {
+  // SIGINT and SIGTERM remove the temporaries of unfinished outputs and exit 130.
+  tubeplan::io::HandleInterrupts();
   std::vector<std::string> args(argv + 1, argv + argc);
   return tubeplan::cli::Run(args, std::cout, std::cerr);
 }

@@ -40,6 +40,9 @@ struct Visit {
 };
 
 int RunSimulate(const SimulateOptions& o, Streams io) {
+  if (!OutputsApart("simulate", {{"--out", o.out_path}},
+                    {{"the scene", o.scene_path}, {"the trajectory", o.trajectory_path}}, io.err))
+    return kExitBadInput;
   io::SceneLoadResult scene = io::LoadSceneFile(o.scene_path);
   // The trajectory is checked in a streamed pass and replayed in a second one, row by row: an
   // hour's recording is never held (docs/hardening.md).
@@ -54,7 +57,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
       format = SeriesFormat::kJsonLines;
     } else {
       io.err << o.out_path << ": error: unknown output format \"" << ext
-             << "\", and expected a file name ending in .csv or .jsonl\n";
+             << "\", expected a file name ending in .csv or .jsonl\n";
       return kExitBadInput;
     }
   }

@@ -27,6 +27,10 @@ void Diagnostics::Warning(std::string file, int line, int column, std::string me
   all_.push_back({std::move(file), line, column, Severity::kWarning, std::move(message)});
 }
 
+void Diagnostics::ErrorAfterAll(std::string file, std::string message) {
+  all_.push_back({std::move(file), 0, 0, Severity::kError, std::move(message), true});
+}
+
 bool Diagnostics::HasErrors() const {
   return std::any_of(all_.begin(), all_.end(),
                      [](const Diagnostic& d) { return d.severity == Severity::kError; });
@@ -38,7 +42,8 @@ std::string Diagnostics::FormatAll() const {
   sorted.reserve(all_.size());
   for (const Diagnostic& d : all_) sorted.push_back(&d);
   std::stable_sort(sorted.begin(), sorted.end(), [](const Diagnostic* a, const Diagnostic* b) {
-    return std::tie(a->file, a->line, a->column) < std::tie(b->file, b->line, b->column);
+    return std::tie(a->file, a->after_all, a->line, a->column) <
+           std::tie(b->file, b->after_all, b->line, b->column);
   });
   std::string text;
   for (const Diagnostic* d : sorted) {

@@ -16,17 +16,24 @@ void ReadLimits(Reader& r, const YAML::Node& node, plan::Limits& l) {
   const std::string w = "limits";
   if (!r.ExpectMap(node, w, {"max_force", "max_strain", "max_penetration", "dwell", "stall"}))
     return;
-  auto check = [&](const char* key, Dimension dimension, double& target, double lo, double hi,
-                   const char* expected) {
-    if (r.Field(node, key, w, dimension, false, target) && !(target >= lo && target <= hi))
-      r.Error(r.Get(node, key, w, false), w + "." + key + " is out of range, expected " + expected);
+  // Each range with both its bounds, the value as the file wrote it.
+  auto check = [&](const char* key, Dimension dimension, const char* si_unit, double& target,
+                   double lo, double hi, const char* expected) {
+    if (r.Field(node, key, w, dimension, false, target) && !(target >= lo && target <= hi)) {
+      const YAML::Node n = r.Get(node, key, w, false);
+      r.Error(n, w + "." + key + " " + AsWritten(n, si_unit) + " is out of range, expected " +
+                     expected);
+    }
   };
-  check("max_force", dim_::kForce, l.max_force_N, 1e-6, 1e4, "a force above 0, e.g. \"8.5 N\"");
-  check("max_strain", dim_::kNone, l.max_strain, 1e-9, 1.0, "a strain in (0, 1], e.g. 0.2");
-  check("max_penetration", dim_::kLength, l.max_penetration_m, 0.0, 0.1,
+  check("max_force", dim_::kForce, "N", l.max_force_N, 1e-6, 1e4,
+        "a force from 1 uN to 10 kN, e.g. \"8.5 N\"");
+  check("max_strain", dim_::kNone, "", l.max_strain, 1e-9, 1.0,
+        "a strain from 1e-9 to 1, e.g. 0.2");
+  check("max_penetration", dim_::kLength, "m", l.max_penetration_m, 0.0, 0.1,
         "a length from 0 to 100 mm, e.g. \"0.2 mm\"");
-  check("dwell", dim_::kTime, l.dwell_s, 0.0, 10.0, "a time from 0 to 10 s, e.g. \"20 ms\"");
-  check("stall", dim_::kTime, l.stall_s, 1e-3, 3600.0, "a time above 0, e.g. \"1 s\"");
+  check("dwell", dim_::kTime, "s", l.dwell_s, 0.0, 10.0, "a time from 0 to 10 s, e.g. \"20 ms\"");
+  check("stall", dim_::kTime, "s", l.stall_s, 1e-3, 3600.0,
+        "a time from 1 ms to 3600 s, e.g. \"1 s\"");
 }
 
 }  // namespace
@@ -48,7 +55,7 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     return result;
   YAML::Node root;
   try {
-    root = YAML::Load(std::string(yaml_text));
+    root = LoadOneDocument(r, std::string(yaml_text), "a plan file");
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
     r.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +

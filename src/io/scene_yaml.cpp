@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <iomanip>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -21,6 +23,7 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
+#include <tubeplan/scene/geometry.hpp>
 
 #include "yaml_reader.hpp"
 
@@ -39,6 +42,25 @@ Eigen::Isometry3d Pose(const Eigen::Vector3d& position_m, const Eigen::Vector3d&
   X.linear() = scene::RotationFromRpy(rpy_rad);
   X.translation() = position_m;
   return X;
+}
+
+// Roll, pitch and yaw: finite and within a turn either way. A larger angle is a slip of the
+// unit or the sign (-1e20 deg turns a part nowhere a person meant), not an orientation.
+constexpr double kMaxAngle_rad = 2.0 * std::numbers::pi;
+
+std::optional<Eigen::Vector3d> ReadRpy(Reader& r, const YAML::Node& node, const std::string& what) {
+  std::optional<Eigen::Vector3d> rpy = r.Vector(node, what, dim::kAngle);
+  if (!rpy) return rpy;
+  bool ok = true;
+  for (int i = 0; i < 3; ++i) {
+    // A turn and a hair: 360 deg written in radians rounds either way.
+    if (std::abs((*rpy)[i]) <= kMaxAngle_rad * (1.0 + 1e-12)) continue;
+    const YAML::Node item = node[std::size_t(i)];
+    r.Error(item, what + "[" + std::to_string(i) + "] " + AsWritten(item, "rad") +
+                      " is out of range, expected an angle from -360 deg to 360 deg");
+    ok = false;
+  }
+  return ok ? rpy : std::nullopt;
 }
 
 // The exponent of the friction law is physics.md's [2/3, 1]; files write 2/3 as 0.6667 or 0.667,
@@ -64,7 +86,7 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   if (f.static_coefficient < 0.0) fail("static", "must be zero or more");
   if (f.kinetic_coefficient < 0.0) {
     fail("kinetic", "must be zero or more");
-  } else if (f.kinetic_coefficient > f.static_coefficient) {
+  } else if (f.static_coefficient >= 0.0 && f.kinetic_coefficient > f.static_coefficient) {
     std::ostringstream m;
     m << "(" << f.kinetic_coefficient << ") must not exceed static (" << f.static_coefficient
       << "): sliding friction is at most the friction that holds";
@@ -80,37 +102,16 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   return ok ? std::optional(f) : std::nullopt;
 }
 
-// Separating-axis test of two oriented boxes: true when they share a volume thicker than
-// `tolerance_m` along every axis (boxes that only touch do not overlap).
-bool BoxesOverlap(const scene::BoxPart& a, const scene::BoxPart& b, double tolerance_m) {
-  const Eigen::Matrix3d& Ra = a.X_WP.linear();
-  const Eigen::Matrix3d& Rb = b.X_WP.linear();
-  const Eigen::Vector3d ha = a.size_m / 2.0;
-  const Eigen::Vector3d hb = b.size_m / 2.0;
-  const Eigen::Vector3d d_W = b.X_WP.translation() - a.X_WP.translation();
-  std::vector<Eigen::Vector3d> axes;
-  for (int i = 0; i < 3; ++i) {
-    axes.push_back(Ra.col(i));
-    axes.push_back(Rb.col(i));
-    for (int j = 0; j < 3; ++j) {
-      const Eigen::Vector3d c = Ra.col(i).cross(Rb.col(j));
-      if (c.norm() > 1e-9) axes.push_back(c.normalized());  // parallel edges give no new axis
-    }
-  }
-  for (const Eigen::Vector3d& n : axes) {
-    const double ra = (Ra.transpose() * n).cwiseAbs().dot(ha);
-    const double rb = (Rb.transpose() * n).cwiseAbs().dot(hb);
-    if (std::abs(d_W.dot(n)) >= ra + rb - tolerance_m) return false;  // a separating axis
-  }
-  return true;
-}
-
 bool PointInside(const scene::BoxPart& box, const Eigen::Vector3d& p_W, double tolerance_m) {
   const Eigen::Vector3d p_P = box.X_WP.inverse() * p_W;
   return ((box.size_m / 2.0).array() - p_P.cwiseAbs().array() > tolerance_m).all();
 }
 
 constexpr double kGeometryTolerance_m = 1e-9;
+
+// The most parts a scene may hold (docs/scene-format.md): the core compares the tube with every
+// part within its reach each tick, and a scene of a thousand parts is far beyond a task's fixture.
+constexpr std::size_t kMaxParts = 1000;
 
 void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok) {
   if (!node.IsSequence() || node.size() == 0) {
@@ -119,7 +120,17 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
     parts_ok = false;
     return;
   }
-  std::vector<YAML::Node> position_nodes;
+  if (node.size() > kMaxParts) {
+    r.Error(node[kMaxParts], "parts[" + std::to_string(kMaxParts) + "] is one part too many: " +
+                                 std::to_string(node.size()) + " parts, expected at most " +
+                                 std::to_string(kMaxParts) + " (docs/scene-format.md says why)");
+    parts_ok = false;
+    return;
+  }
+  // Where each part is, for a message about it; kept as marks: a YAML::Node assigned to another
+  // merges the whole document's node set into its own, once a part (quadratic in the parts).
+  std::vector<YAML::Mark> position_marks;
+  std::set<std::string> names;
   for (std::size_t i = 0; i < node.size(); ++i) {
     const YAML::Node part_node = node[i];
     const std::string where = "parts[" + std::to_string(i) + "]";
@@ -136,13 +147,11 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           r.Error(n, where + ".name '" + part.name +
                          "' must start with a letter and hold only letters, digits and '_'");
         }
-        for (const scene::BoxPart& other : s.parts) {
-          if (other.name == part.name)
-            r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
-        }
+        if (!names.insert(part.name).second)
+          r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
       }
     }
-    YAML::Node position_node(YAML::NodeType::Undefined);
+    YAML::Mark position_mark = YAML::Mark::null_mark();
     if (const YAML::Node box = r.Get(part_node, "box", where, true); box.IsDefined()) {
       const std::string bw = where + ".box";
       if (r.ExpectMap(box, bw, {"size", "position", "rpy"})) {
@@ -154,14 +163,14 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           }
         }
         Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
-        position_node = r.Get(box, "position", bw, false);
-        if (position_node.IsDefined()) {
-          if (const auto p = r.Vector(position_node, bw + ".position", dim::kLength)) position = *p;
+        if (const YAML::Node n = r.Get(box, "position", bw, false); n.IsDefined()) {
+          position_mark = n.Mark();
+          if (const auto p = r.Vector(n, bw + ".position", dim::kLength)) position = *p;
         } else {
-          position_node = box;
+          position_mark = box.Mark();
         }
         if (const YAML::Node n = r.Get(box, "rpy", bw, false); n.IsDefined())
-          if (const auto a = r.Vector(n, bw + ".rpy", dim::kAngle)) rpy = *a;
+          if (const auto a = ReadRpy(r, n, bw + ".rpy")) rpy = *a;
         part.X_WP = Pose(position, rpy);
       }
     }
@@ -194,17 +203,13 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
       part.friction = ReadFriction(r, f, where + ".friction");
     if (r.error_count() != errors) parts_ok = false;
     s.parts.push_back(part);
-    position_nodes.push_back(position_node);
+    position_marks.push_back(position_mark);
   }
   if (!parts_ok) return;
-  for (std::size_t i = 0; i < s.parts.size(); ++i) {
-    for (std::size_t j = 0; j < i; ++j) {
-      if (BoxesOverlap(s.parts[j], s.parts[i], kGeometryTolerance_m)) {
-        r.Error(position_nodes[i], "part '" + s.parts[i].name + "' overlaps part '" +
-                                       s.parts[j].name + "', expected parts that at most touch");
-        parts_ok = false;
-      }
-    }
+  for (const auto& [i, j] : scene::OverlappingParts(s.parts, kGeometryTolerance_m)) {
+    r.Error(position_marks[i], "part '" + s.parts[i].name + "' overlaps part '" + s.parts[j].name +
+                                   "', expected parts that at most touch");
+    parts_ok = false;
   }
 }
 
@@ -316,6 +321,69 @@ void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {
   }
 }
 
+// The model's message on a tube key, "outer_radius (-0.008) must be ...", with each key's value
+// in it as the file wrote it: "outer_radius (-8 mm) must be ...".
+std::string TubeValuesAsWritten(Reader& r, const YAML::Node& tube, std::string problem) {
+  constexpr std::array<std::pair<const char*, const char*>, 5> kUnits = {{{"outer_radius", "m"},
+                                                                          {"inner_radius", "m"},
+                                                                          {"length", "m"},
+                                                                          {"youngs_modulus", "Pa"},
+                                                                          {"poisson_ratio", ""}}};
+  for (const auto& [key, unit] : kUnits) {
+    const std::string opening = std::string(key) + " (";
+    const std::size_t at = problem.find(opening);
+    if (at == std::string::npos || (at > 0 && problem[at - 1] != ' ')) continue;
+    const std::size_t from = at + opening.size();
+    const std::size_t to = problem.find(')', from);
+    const YAML::Node value = r.Get(tube, key, "tube", false);
+    if (to == std::string::npos || !value.IsScalar()) continue;
+    problem.replace(from, to - from, AsWritten(value, unit));
+  }
+  return problem;
+}
+
+// "[1, -90, 40] mm" for a position in metres.
+std::string Millimetres(const Eigen::Vector3d& p_m) {
+  std::ostringstream text;
+  text << std::setprecision(6) << "[" << p_m.x() * 1e3 << ", " << p_m.y() * 1e3 << ", "
+       << p_m.z() * 1e3 << "] mm";
+  return text.str();
+}
+
+// The start the scene gives the tube: the held end inside the workspace, and the tube's body
+// (straight from the held end along its +z) clear of every part, as the core takes it at t = 0.
+// A part the held end is inside of is reported already.
+void CheckStart(Reader& r, const scene::Scene& s, const YAML::Mark& at, bool body_known,
+                const std::vector<bool>& held_end_inside) {
+  const Eigen::Vector3d p_m = s.X_WH_start.translation();
+  if (s.workspace && ((p_m.array() < s.workspace->min_W_m.array()).any() ||
+                      (p_m.array() > s.workspace->max_W_m.array()).any())) {
+    r.Error(at, "start.position " + Millimetres(p_m) + " is outside the workspace (min " +
+                    Millimetres(s.workspace->min_W_m) + ", max " +
+                    Millimetres(s.workspace->max_W_m) +
+                    "), expected the held end's start inside it");
+  }
+  if (!body_known) return;
+  const model::TubeSpec& tube = s.tube;
+  for (std::size_t i = 0; i < s.parts.size(); ++i) {
+    if (held_end_inside[i]) continue;
+    const std::optional<double> depth_m = scene::StraightTubeOverlap(
+        s.X_WH_start, tube.outer_radius_m, tube.length_m, s.parts[i], kGeometryTolerance_m);
+    if (!depth_m) continue;
+    std::ostringstream m;
+    m << std::setprecision(3) << "the tube at its start goes into part '" << s.parts[i].name
+      << "' ";
+    if (*depth_m >= tube.outer_radius_m)
+      m << "across its axis";
+    else
+      m << "by " << *depth_m * 1e3 << " mm";
+    m << " (the straight tube from start.position along its own +z, " << tube.length_m * 1e3
+      << " mm long, outer radius " << tube.outer_radius_m * 1e3
+      << " mm), expected the tube's body clear of every part at the start";
+    r.Error(at, m.str());
+  }
+}
+
 void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
                                         "friction", "parts", "start",     "goal",
@@ -339,6 +407,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       if (s.name.empty()) r.Error(n, "name must not be empty");
     }
   }
+  bool tube_ok = false;  // every tube key read and valid: its body can be placed
   if (const YAML::Node t = r.Get(root, "tube", "scene", true); t.IsDefined()) {
     const std::string w = "tube";
     if (r.ExpectMap(
@@ -357,14 +426,16 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       field("youngs_modulus", dim::kPressure, spec.youngs_modulus_Pa);
       field("poisson_ratio", dim::kNone, spec.poisson_ratio);
       // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
-      for (const std::string& problem : model::ValidateTubeSpec(spec)) {
+      const std::vector<std::string> problems = model::ValidateTubeSpec(spec);
+      tube_ok = read.size() == 5 && problems.empty();
+      for (const std::string& problem : problems) {
         const std::string key = problem.substr(0, problem.find(' '));
         const YAML::Node at = r.Get(t, key, w, false);
         if (at.IsDefined()) {
           if (read.count(key) == 0) continue;
           // r2 >= r1 is only meaningful when r1 itself was read.
           if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
-          r.Error(at, "tube." + problem);
+          r.Error(at, "tube." + TubeValuesAsWritten(r, t, problem));
         } else if (read.size() == 5) {
           r.Error(t, "tube " + problem);  // about the section as a whole
         }
@@ -392,20 +463,30 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   } else {
     parts_ok = false;
   }
+  // Where the start's position is written, once it and the start's turn were read cleanly.
+  std::optional<YAML::Mark> start_mark;
+  std::vector<bool> held_end_inside(s.parts.size(), false);
   if (const YAML::Node st = r.Get(root, "start", "scene", true); st.IsDefined()) {
     const std::string w = "start";
     if (r.ExpectMap(st, w, {"position", "rpy"})) {
       Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
-      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined())
-        if (const auto a = r.Vector(n, "start.rpy", dim::kAngle)) rpy = *a;
+      bool rpy_ok = true;
+      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined()) {
+        const auto a = ReadRpy(r, n, "start.rpy");
+        if (a) rpy = *a;
+        rpy_ok = a.has_value();
+      }
       if (const YAML::Node n = r.Get(st, "position", w, true); n.IsDefined()) {
         if (const auto p = r.Vector(n, "start.position", dim::kLength)) {
           s.X_WH_start = Pose(*p, rpy);
+          if (rpy_ok) start_mark = n.Mark();
           if (parts_ok) {
-            for (const scene::BoxPart& part : s.parts)
-              if (PointInside(part, *p, kGeometryTolerance_m))
-                r.Error(n, "start.position is inside part '" + part.name +
-                               "', expected the held end outside every part");
+            for (std::size_t i = 0; i < s.parts.size(); ++i) {
+              if (!PointInside(s.parts[i], *p, kGeometryTolerance_m)) continue;
+              held_end_inside[i] = true;
+              r.Error(n, "start.position is inside part '" + s.parts[i].name +
+                             "', expected the held end outside every part");
+            }
           }
         }
       }
@@ -452,6 +533,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       }
     }
   }
+  if (start_mark) CheckStart(r, s, *start_mark, tube_ok && parts_ok, held_end_inside);
 }
 
 }  // namespace
@@ -470,7 +552,7 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
   if (!CheckInputText(yaml_text, display_name, "a YAML scene file", result.diagnostics))
     return result;
   try {
-    const YAML::Node root = YAML::Load(std::string(yaml_text));
+    const YAML::Node root = LoadOneDocument(reader, std::string(yaml_text), "a scene file");
     if (CheckYamlShape(reader, root, "a scene file")) ReadScene(reader, root, s);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".

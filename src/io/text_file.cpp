@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/text_file.hpp>
 
 namespace tubeplan::io {
@@ -157,6 +158,69 @@ std::string Abbreviate(std::string_view text, std::size_t max_bytes) {
   return std::string(text.substr(0, cut)) + "...";
 }
 
+namespace {
+
+// What makes two paths one file: its device and inode when it exists, else its canonical path
+// (an output not written yet, or an input that is missing).
+struct FileIdentity {
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  std::string canonical;
+};
+
+FileIdentity IdentityOf(const std::filesystem::path& path) {
+  FileIdentity id;
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0) {
+    id.exists = true;
+    id.device = info.st_dev;
+    id.inode = info.st_ino;
+  }
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  id.canonical = (ec ? absolute.lexically_normal() : canonical).string();
+  return id;
+}
+
+bool SameFile(const FileIdentity& a, const FileIdentity& b) {
+  if (a.exists && b.exists) return a.device == b.device && a.inode == b.inode;
+  return a.canonical == b.canonical;
+}
+
+// "--out T.csv" or "the trajectory T.csv".
+std::string Named(const RolePath& p) { return p.role + " " + p.path.string(); }
+
+// When the two spellings differ, how they can be one file.
+std::string Through(const RolePath& a, const RolePath& b) {
+  return a.path == b.path ? "" : " (through a link or another spelling of its path)";
+}
+
+}  // namespace
+
+std::string CheckOutputsApart(const std::vector<RolePath>& outputs,
+                              const std::vector<RolePath>& inputs) {
+  std::vector<FileIdentity> input_ids;
+  for (const RolePath& in : inputs) input_ids.push_back(IdentityOf(in.path));
+  std::vector<FileIdentity> output_ids;
+  for (const RolePath& out : outputs) {
+    output_ids.push_back(out.path.empty() ? FileIdentity{} : IdentityOf(out.path));
+    if (out.path.empty()) continue;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      if (inputs[i].path.empty() || !SameFile(output_ids.back(), input_ids[i])) continue;
+      return Named(out) + " is the same file as " + Named(inputs[i]) + Through(out, inputs[i]) +
+             ": writing it would replace the input, expected another file for the output";
+    }
+    for (std::size_t j = 0; j + 1 < output_ids.size(); ++j) {
+      if (outputs[j].path.empty() || !SameFile(output_ids.back(), output_ids[j])) continue;
+      return Named(out) + " is the same file as " + Named(outputs[j]) + Through(out, outputs[j]) +
+             ": one would replace the other, expected a file of its own for each output";
+    }
+  }
+  return {};
+}
+
 void InputTextCheck::Feed(std::string_view piece) {
   size_ += piece.size();
   if (blank_ && piece.find_first_not_of(" \t\r\n") != std::string_view::npos) blank_ = false;
@@ -202,6 +266,21 @@ void InputTextCheck::Scan(std::string_view data, bool last) {
   };
   for (std::size_t i = 0; i < n;) {
     const auto c = static_cast<unsigned char>(data[i]);
+    // A CR ends a line only with a LF after it: one alone means the file's lines end in CR.
+    if (cr_pending_) {
+      cr_pending_ = false;
+      if (c != '\n' && !lone_cr_) {
+        findings_.push_back({Kind::kLoneCr, cr_line_, cr_column_});
+        lone_cr_ = true;
+      }
+    }
+    if (c == '\r') {
+      cr_pending_ = true;
+      cr_line_ = line_;
+      cr_column_ = column(i);
+      ++i;
+      continue;
+    }
     if (c == '\n') {
       if (open_long_ != SIZE_MAX) EndLongLine(base_ + i);
       ++line_;
@@ -294,7 +373,16 @@ bool InputTextCheck::Finish(const std::string& display_name, std::string_view ex
             std::string("invalid UTF-8 (byte ") + hex + "), expected UTF-8 text: " + expect);
         break;
       }
+      case Kind::kLoneCr:
+        diagnostics.Error(display_name, f.line, f.column,
+                          "a carriage return (CR) with no line feed after it: the lines end in "
+                          "CR alone (as classic Mac OS saved text), expected LF or CRLF line "
+                          "endings in " +
+                              expect);
+        break;
       case Kind::kLong:
+        // The lines of a file that ends them in CR alone are one line here: said above.
+        if (lone_cr_) break;
         diagnostics.Error(display_name, f.line, 1,
                           "line " + std::to_string(f.line) + " is " + std::to_string(f.length) +
                               " bytes long, expected at most " + std::to_string(kMaxLineBytes) +
@@ -313,22 +401,50 @@ bool CheckInputText(std::string_view text, const std::string& display_name,
   return check.Finish(display_name, expected, diagnostics);
 }
 
-AtomicFile::AtomicFile(std::filesystem::path path) : path_(std::move(path)) {
-  // Same directory, so the rename is atomic (same file system); the pid and a counter keep two
-  // writers of one path (processes or threads) from sharing a temporary file.
+namespace {
+
+// `path` + ".tmp.PID.N": in the same directory, so the rename is atomic (same file system); the
+// pid and a counter keep two writers of one path (processes or threads) from sharing one.
+std::filesystem::path TemporaryFor(const std::filesystem::path& path) {
   static std::atomic<unsigned> counter{0};
-  temporary_ = path_;
-  temporary_ += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  std::filesystem::path temporary = path;
+  temporary += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter++);
+  return temporary;
+}
+
+// Creates the temporary file for `path`, and the directories above it when they are missing (a
+// fresh checkout has no build/); -1 and `error` set when it cannot.
+int CreateTemporary(const std::filesystem::path& path, const std::filesystem::path& temporary,
+                    int& slot, std::string& error) {
+  constexpr int kFlags = O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC;
+  int fd = CreateRegistered(temporary.c_str(), kFlags, 0666, slot);
+  if (fd < 0 && errno == ENOENT && path.has_parent_path()) {
+    std::error_code ec;
+    std::filesystem::create_directories(path.parent_path(), ec);
+    if (ec) {
+      error = "cannot create the directory " + path.parent_path().string() + ": " + ec.message();
+      return -1;
+    }
+    fd = CreateRegistered(temporary.c_str(), kFlags, 0666, slot);
+  }
+  if (fd < 0) error = "cannot create " + temporary.string() + ": " + std::strerror(errno);
+  return fd;
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path path)
+    : path_(std::move(path)), temporary_(TemporaryFor(path_)) {
   // A write past RLIMIT_FSIZE raises SIGXFSZ, whose default action kills the process and leaves
   // the temporary behind; ignored, the write fails with EFBIG and is reported like a full disk.
   std::signal(SIGXFSZ, SIG_IGN);
-  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd_ < 0) error_ = "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+  fd_ = CreateTemporary(path_, temporary_, slot_, error_);
 }
 
 AtomicFile::~AtomicFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!committed_ && (fd_ >= 0 || !error_.empty())) ::unlink(temporary_.c_str());
+  if (!committed_ && fd_ >= 0) ::unlink(temporary_.c_str());
+  ForgetTemporary(slot_);
 }
 
 void AtomicFile::Fail(const char* what, int error) {
@@ -337,6 +453,8 @@ void AtomicFile::Fail(const char* what, int error) {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
   ::unlink(temporary_.c_str());
+  ForgetTemporary(slot_);
+  slot_ = -1;
 }
 
 bool AtomicFile::Write(std::string_view text) {
@@ -377,9 +495,10 @@ std::string AtomicFile::Commit() {
       }
     }
   }
+  // Nothing asked to be written yet (the temporary could not be created): no room to name.
   return error_ + "; nothing was written (" + path_.string() +
-         " is as it was), expected a writable directory with room for " + std::to_string(bytes_) +
-         " bytes";
+         " is as it was), expected a writable directory" +
+         (bytes_ > 0 ? " with room for " + std::to_string(bytes_) + " bytes" : std::string());
 }
 
 std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text) {
@@ -389,19 +508,27 @@ std::string WriteTextFileAtomically(const std::filesystem::path& path, std::stri
 }
 
 StreamingTextFile::~StreamingTextFile() {
-  if (file_ == nullptr) return;
-  std::fclose(file_);
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    std::error_code ignored;
+    std::filesystem::remove(temporary_, ignored);
+  }
+  ForgetTemporary(slot_);
 }
 
 std::string StreamingTextFile::Open(const std::filesystem::path& path) {
   path_ = path;
-  temporary_ = path;
-  temporary_ += ".tmp." + std::to_string(::getpid());
-  file_ = std::fopen(temporary_.c_str(), "wb");
-  if (file_ == nullptr) return "cannot create " + temporary_.string() + ": " + std::strerror(errno);
-  return {};
+  temporary_ = TemporaryFor(path);
+  std::string error;
+  const int fd = CreateTemporary(path_, temporary_, slot_, error);
+  if (fd < 0) return error;
+  file_ = ::fdopen(fd, "wb");
+  if (file_ == nullptr) {
+    error = "cannot create " + temporary_.string() + ": " + std::strerror(errno);
+    ::close(fd);
+    ::unlink(temporary_.c_str());
+  }
+  return error;
 }
 
 void StreamingTextFile::Append(std::string_view text) {
@@ -431,6 +558,8 @@ std::string StreamingTextFile::Commit() {
           "cannot rename " + temporary_.string() + " to " + path_.string() + ": " + ec.message();
   }
   if (!error.empty()) std::filesystem::remove(temporary_, ec);
+  ForgetTemporary(slot_);
+  slot_ = -1;
   return error;
 }
 

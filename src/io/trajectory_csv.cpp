@@ -3,6 +3,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -16,6 +17,11 @@ namespace {
 // Enough to show what is wrong with a file; a file with thousands of bad rows is one mistake
 // repeated, and ten thousand lines of it would hide the first.
 constexpr int kMaxErrors = 50;
+
+// Times differ from what the file wrote by their decimal rounding (0.35 - 0.30 is 0.04999...96,
+// 0.40 - 0.35 is 0.05000...03): a gap is compared with a nanosecond to spare, so a 20 Hz file
+// sits at the 50 ms limit on every row, not over it on some.
+constexpr double kTimeRounding_s = 1e-9;
 
 constexpr std::array<std::string_view, 8> kPoseColumns = {"t",  "px", "py", "pz",
                                                           "qw", "qx", "qy", "qz"};
@@ -58,7 +64,8 @@ class Collector {
   }
   void Finish() {
     if (count_ > kMaxErrors)
-      d_.Error(file_, 0, 0, "... and " + std::to_string(count_ - kMaxErrors) + " more errors");
+      d_.ErrorAfterAll(file_, "... and " + std::to_string(count_ - kMaxErrors) +
+                                  (count_ - kMaxErrors == 1 ? " more error" : " more errors"));
   }
 
  private:
@@ -118,6 +125,7 @@ class RowParser {
   bool have_header_ = false;
   std::array<std::size_t, 8> pose_index_{};
   std::vector<std::size_t> extra_index_;
+  std::vector<bool> is_pose_;  // per column of the header
   std::size_t column_count_ = 0;
   bool have_previous_ = false;
   double previous_t_ = 0.0;
@@ -163,12 +171,14 @@ void RowParser::Metadata(std::string_view content, std::size_t leading, int line
 void RowParser::Header(std::string_view content, int line_number) {
   have_header_ = true;
   column_count_ = fields_.size();
+  is_pose_.assign(fields_.size(), false);
   std::array<bool, 8> found{};
   for (std::size_t i = 0; i < fields_.size(); ++i) {
     bool pose = false;
     for (std::size_t c = 0; c < kPoseColumns.size(); ++c) {
       if (fields_[i].text != kPoseColumns[c]) continue;
       pose = true;
+      is_pose_[i] = true;
       if (found[c]) {
         errors_.Error(line_number, fields_[i].column,
                       "column '" + Abbreviate(fields_[i].text) +
@@ -228,6 +238,18 @@ bool RowParser::Line(std::string_view line, int line_number, plan::HandSample& s
   bool row_ok = true;
   for (std::size_t i = 0; i < fields_.size(); ++i) {
     const Field& f = fields_[i];
+    // A column beyond the pose holds any text (a button's state, a label): its value is the
+    // number it spells, else NaN; nothing here reads it.
+    if (!is_pose_[i]) {
+      double v = std::numeric_limits<double>::quiet_NaN();
+      const char* first = f.text.data();
+      const char* last = first + f.text.size();
+      if (!f.text.empty() && *first == '+') ++first;
+      if (const auto [ptr, ec] = std::from_chars(first, last, v); ec != std::errc() || ptr != last)
+        v = std::numeric_limits<double>::quiet_NaN();
+      values_[i] = v;
+      continue;
+    }
     double v = 0.0;
     const char* first = f.text.data();
     const char* last = first + f.text.size();
@@ -277,7 +299,7 @@ bool RowParser::Line(std::string_view line, int line_number, plan::HandSample& s
                   "time " + Number(s.t_s) + " s is not after the previous sample's " +
                       Number(previous_t_) + " s, expected strictly increasing times");
     rows_ok_ = false;
-  } else if (have_previous_ && s.t_s - previous_t_ > options_.max_gap_s) {
+  } else if (have_previous_ && s.t_s - previous_t_ > options_.max_gap_s + kTimeRounding_s) {
     errors_.Error(line_number, t_column,
                   "gap of " + Number(s.t_s - previous_t_) + " s before this sample, more than " +
                       Number(options_.max_gap_s) + " s (a dropped recording?)");

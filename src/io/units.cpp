@@ -299,8 +299,10 @@ QuantityResult ParseQuantityAs(std::string_view text, Dimension expected) {
   if (q.dimension == expected) return result;
   std::string_view unit = text.substr(unit_offset);
   while (!unit.empty() && IsSpace(unit.back())) unit.remove_suffix(1);
+  const std::string wanted = Describe(expected);
+  const bool vowel = std::string_view("aeiou").find(wanted.front()) != std::string_view::npos;
   return Fail(unit_offset, "has a unit of " + Describe(q.dimension) + " (" + Abbreviate(unit) +
-                               "), expected a " + Describe(expected) + " such as " +
+                               "), expected " + (vowel ? "an " : "a ") + wanted + " such as " +
                                ExampleUnit(expected));
 }
 

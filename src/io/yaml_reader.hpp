@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
 #include <yaml-cpp/depthguard.h>
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <tubeplan/io/diagnostics.hpp>
@@ -55,6 +57,16 @@ inline std::string Suggestion(std::string_view word, const std::vector<std::stri
 inline std::string Join(const std::vector<std::string>& words) {
   std::string text;
   for (const std::string& w : words) text += (text.empty() ? "" : ", ") + w;
+  return text;
+}
+
+/// A scalar's value for a message as the file wrote it, a plain number with its SI unit
+/// (`-0.008 m`, `5 mm`), never a bare SI number the user did not write.
+inline std::string AsWritten(const YAML::Node& node, std::string_view si_unit) {
+  if (!node.IsScalar()) return "?";
+  const QuantityResult q = ParseQuantity(node.Scalar());
+  std::string text = Abbreviate(node.Scalar());
+  if (q.quantity && !q.quantity->has_unit && !si_unit.empty()) text += " " + std::string(si_unit);
   return text;
 }
 
@@ -255,8 +267,17 @@ inline constexpr int kMaxYamlDepth = 64;
 inline constexpr std::size_t kMaxYamlNodes = 100000;
 
 namespace detail {
+// yaml-cpp's tags for nodes written without one: "?" (plain) and "!" (quoted).
+inline bool Untagged(const YAML::Node& node) {
+  return node.Tag().empty() || node.Tag() == "?" || node.Tag() == "!";
+}
+
 inline bool WalkYaml(Reader& r, const YAML::Node& node, int depth, std::size_t& visited,
                      const std::string& expected) {
+  // A tag (`!custom`, `!!binary`) asks for a type the format does not have: said, not ignored.
+  if (!Untagged(node))
+    r.Error(node, "unknown tag '" + Abbreviate(node.Tag()) + "', expected " + expected +
+                      " without tags (plain values such as 5 mm or \"5 mm\")");
   if (++visited > kMaxYamlNodes) {
     r.Error(node, "the document expands to more than " + std::to_string(kMaxYamlNodes) +
                       " nodes (aliases repeat what they name: a 'billion laughs'?), expected " +
@@ -280,6 +301,40 @@ inline bool WalkYaml(Reader& r, const YAML::Node& node, int depth, std::size_t& 
   return true;
 }
 }  // namespace detail
+
+namespace detail {
+// Where each document of a YAML stream starts; nothing else of it is kept.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> marks;
+  void OnDocumentStart(const YAML::Mark& mark) override { marks.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+}  // namespace detail
+
+/// The one document of `text` (YAML::Load reads the first and ignores the rest, invalid or not).
+/// A second document is an error at its start; a YAML error in it throws as in YAML::Load.
+inline YAML::Node LoadOneDocument(Reader& r, const std::string& text, const std::string& expected) {
+  YAML::Node root = YAML::Load(text);
+  std::istringstream in(text);
+  YAML::Parser parser(in);
+  detail::DocumentStarts starts;
+  if (parser.HandleNextDocument(starts) && parser.HandleNextDocument(starts) &&
+      starts.marks.size() >= 2)
+    r.Error(starts.marks[1], "a second YAML document starts here, expected " + expected +
+                                 " as one document (no '---' after its start)");
+  return root;
+}
 
 /// Checks the loaded document against kMaxYamlDepth and kMaxYamlNodes (counting a node once
 /// for every alias that reaches it); reports the first bound exceeded and returns false.

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string_view>
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/judge.hpp>
@@ -11,10 +12,22 @@ namespace tubeplan::plan {
 
 namespace {
 
-std::string Format(const char* what, double value, const char* unit, double limit, double t_s) {
-  char buffer[160];
-  std::snprintf(buffer, sizeof buffer, "limit exceeded: %s %.4g %s > %.4g %s at t = %.3f s", what,
-                value, unit, limit, unit, t_s);
+// "strain 0.9263 > 0.2 at t = 1.000 s": the value with as many digits as it takes to differ
+// from the limit as written (8.500001 N > 8.5 N, never 8.5 N > 8.5 N), a unit only when there
+// is one.
+std::string Format(const char* what, double value, const char* unit, double limit, double t_s,
+                   const char* note = "") {
+  const std::string space_unit = *unit != '\0' ? std::string(" ") + unit : std::string();
+  char limit_text[32];
+  std::snprintf(limit_text, sizeof limit_text, "%.4g", limit);
+  char value_text[32];
+  for (int digits = 4; digits <= 17; ++digits) {
+    std::snprintf(value_text, sizeof value_text, "%.*g", digits, value);
+    if (std::string_view(value_text) != limit_text) break;
+  }
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "limit exceeded: %s %s%s%s > %s%s at t = %.3f s", what,
+                value_text, space_unit.c_str(), note, limit_text, space_unit.c_str(), t_s);
   return buffer;
 }
 
@@ -73,8 +86,13 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
     v.peak_force_N = std::max(v.peak_force_N, force_N);
     if (out.flags & core::kBeyondLinearRange) v.beyond_linear_s += step_s_;
     if (out.flags & core::kNotConverged) v.unconverged_s += step_s_;
+    // At the device's clamp the force is the most the device renders, which a plan's limit is
+    // often set to: said so, rather than "8.5 N > 8.5 N".
     if (force_N > limits_.max_force_N && v.reason.empty())
-      Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+      Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s,
+                       (out.flags & core::kForceClamped)
+                           ? " (the device's clamp was reached: it renders no more)"
+                           : ""));
     if (out.max_strain > limits_.max_strain && v.reason.empty())
       Fail(at_, Format("strain", out.max_strain, "", limits_.max_strain, t_s));
     for (const core::ContactState& c : out.Contacts()) {

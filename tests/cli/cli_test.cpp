@@ -274,7 +274,16 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
 }
 
 TEST_CASE("usage: no subcommand and --version", "[cli]") {
-  CHECK(RunTool({}).exit_code == 2);
+  const std::string commands =
+      "; the commands are check, beam, bench, simulate, graph, plans, evaluate, merge, live, "
+      "accuracy, stability (tubeplan --help says what each does)\n";
+  const Outcome none = RunTool({});
+  CHECK(none.exit_code == 2);
+  CHECK(none.err == "tubeplan: error: no command given" + commands);
+  // A word where the command belongs is named, not "A subcommand is required".
+  const Outcome unknown = RunTool({"frobnicate", "x.yaml"});
+  CHECK(unknown.exit_code == 2);
+  CHECK(unknown.err == "tubeplan: error: unknown command 'frobnicate'" + commands);
   const Outcome v = RunTool({"--version"});
   CHECK(v.exit_code == 0);
   CHECK_THAT(v.out, Catch::Contains("tubeplan"));

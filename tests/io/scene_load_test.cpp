@@ -235,7 +235,7 @@ TEST_CASE("Every problem in a file is reported at once", "[scene]") {
         "t.yaml:3:42: error: tube.inner_radius (6 mm) must be smaller than outer_radius (5 mm)\n"
         "t.yaml:3:58: error: tube.length: has a unit of force (N), expected a length such as "
         "\"5 mm\"\n"
-        "t.yaml:3:77: error: tube.youngs_modulus (-3e+06) must be a finite number greater than "
+        "t.yaml:3:77: error: tube.youngs_modulus (-3 MPa) must be a finite number greater than "
         "zero\n"
         "t.yaml:12:1: error: unknown key 'colour' in 'scene' (expected one of: tubeplan, name, "
         "tube, contact, friction, parts, start, goal, device, model, workspace, heuristics)\n");
@@ -266,4 +266,107 @@ TEST_CASE("Damaged scenes never throw and never load half-checked", "[scene]") {
   }
   // Most damage must be caught (comments and spaces are harmless, most other bytes are not).
   CHECK(rejected > loaded_count);
+}
+
+TEST_CASE("The tube's body at the start must be clear of every part", "[scene]") {
+  const auto load = [](const std::string& start) {
+    return LoadSceneText(WithLine(10, start), "t.yaml").diagnostics.FormatAll();
+  };
+  const std::string body =
+      " (the straight tube from start.position along its own +z, 150 mm long, outer radius 5 mm), "
+      "expected the tube's body clear of every part at the start\n";
+  // Along +y, 3 mm above the floor: its lower side 2 mm into it (only the held end was checked).
+  CHECK(load("start: {position: [0, -90 mm, 3 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: the tube at its start goes into part 'floor' by 2 mm" + body);
+  // Resting on the floor (touching) is fine.
+  CHECK(load("start: {position: [0, -90 mm, 5 mm], rpy: [-90 deg, 0, 0]}") == "");
+  // Pushed end first into the wall's near face: across the axis; its flat tip exactly on the
+  // face is fine (a capsule's round end would be 5 mm into the wall).
+  CHECK(load("start: {position: [15 mm, -249 mm, 10 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: the tube at its start goes into part 'wall' across its axis" + body);
+  CHECK(load("start: {position: [15 mm, -250 mm, 10 mm], rpy: [-90 deg, 0, 0]}") == "");
+  // The held end inside a part is said once, as before, not again for the body.
+  CHECK(load("start: {position: [15 mm, 0, 10 mm], rpy: [-90 deg, 0, 0]}") ==
+        "t.yaml:10:19: error: start.position is inside part 'wall', expected the held end outside "
+        "every part\n");
+}
+
+TEST_CASE("A start outside the workspace is an error", "[scene]") {
+  const std::string text =
+      kMinimal + "workspace: {min: [-100 mm, -100 mm, -10 mm], max: [100 mm, 100 mm, 30 mm]}\n";
+  CHECK(LoadSceneText(text, "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:10:19: error: start.position [0, -90, 40] mm is outside the workspace (min [-100, "
+        "-100, -10] mm, max [100, 100, 30] mm), expected the held end's start inside it\n");
+  const std::string inside =
+      kMinimal + "workspace: {min: [-100 mm, -100 mm, -10 mm], max: [100 mm, 100 mm, 50 mm]}\n";
+  CHECK(LoadSceneText(inside, "t.yaml").diagnostics.FormatAll() == "");
+}
+
+TEST_CASE("A second YAML document and YAML tags are errors, not ignored", "[scene]") {
+  CHECK(LoadSceneText(kMinimal + "---\nname: other\n", "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:12:1: error: a second YAML document starts here, expected a scene file as one "
+        "document (no '---' after its start)\n");
+  // An invalid later document is reported, not skipped.
+  const auto broken = LoadSceneText(kMinimal + "---\nname: [\n", "t.yaml");
+  CHECK_FALSE(broken.scene);
+  CHECK_THAT(broken.diagnostics.FormatAll(), Catch::Contains("expected valid YAML"));
+  CHECK(LoadSceneText(WithLine(2, "name: !custom t"), "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:2:7: error: unknown tag '!custom', expected a scene file without tags (plain "
+        "values such as 5 mm or \"5 mm\")\n");
+  CHECK_FALSE(LoadSceneText(WithLine(2, "name: !!str t"), "t.yaml").scene);
+}
+
+TEST_CASE("Angles are finite and within a turn either way", "[scene]") {
+  CHECK(LoadSceneText(WithLine(10, "start: {position: [0, -90 mm, 40 mm], rpy: [-1e20 deg, 0, 7]}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:10:45: error: start.rpy[0] -1e20 deg is out of range, expected an angle from "
+        "-360 deg to 360 deg\n"
+        "t.yaml:10:59: error: start.rpy[2] 7 rad is out of range, expected an angle from -360 deg "
+        "to 360 deg\n");
+  CHECK(LoadSceneText(WithLine(10, "start: {position: [0, -90 mm, 40 mm], rpy: [360 deg, 0, 0]}"),
+                      "t.yaml")
+            .scene);
+  CHECK(LoadSceneText(WithLine(9,
+                               "    box: {size: [10 mm, 200 mm, 20 mm], position: [15 mm, 0, "
+                               "10 mm], rpy: [0, 0, 361 deg]}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:9:82: error: parts[1].box.rpy[2] 361 deg is out of range, expected an angle from "
+        "-360 deg to 360 deg\n");
+}
+
+TEST_CASE("Friction and tube messages say one thing each, with the values as written", "[scene]") {
+  // A negative static friction is one error, with no follow-on about the kinetic one.
+  CHECK(LoadSceneText(WithLine(4, "friction: {static: -0.1, kinetic: 0.08}"), "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:4:20: error: friction.static must be zero or more\n");
+  // Values as the file wrote them, a plain number with its SI unit.
+  CHECK(LoadSceneText(WithLine(3,
+                               "tube: {outer_radius: -0.008, inner_radius: 4 mm, length: "
+                               "-150 mm, youngs_modulus: 3 MPa, poisson_ratio: 0.5}"),
+                      "t.yaml")
+            .diagnostics.FormatAll() ==
+        "t.yaml:3:22: error: tube.outer_radius (-0.008 m) must be a finite number greater than "
+        "zero\n"
+        "t.yaml:3:58: error: tube.length (-150 mm) must be a finite number greater than zero\n");
+}
+
+TEST_CASE("A scene of more than 1000 parts is refused at the part too many", "[scene]") {
+  std::string parts;
+  for (int i = 0; i < 1001; ++i)
+    parts += "  - {name: p" + std::to_string(i) + ", box: {size: [1 mm, 1 mm, 1 mm], position: [" +
+             std::to_string(2 * (i % 40)) + " mm, " + std::to_string(2 * (i / 40)) +
+             " mm, 100 mm]}}\n";
+  const std::string head = kMinimal.substr(0, kMinimal.find("start:"));
+  const std::string tail = kMinimal.substr(kMinimal.find("start:"));
+  CHECK(LoadSceneText(head + parts + tail, "t.yaml").diagnostics.FormatAll() ==
+        "t.yaml:1008:5: error: parts[1000] is one part too many: 1003 parts, expected at most "
+        "1000 (docs/scene-format.md says why)\n");
+  // A thousand load, and one overlapping pair among them is found and named.
+  std::string overlapping = parts.substr(0, parts.find("  - {name: p997,"));
+  overlapping += "  - {name: q, box: {size: [1 mm, 1 mm, 1 mm], position: [0.5 mm, 0, 100 mm]}}\n";
+  const auto loaded = LoadSceneText(head + overlapping + tail, "t.yaml");
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:1007:57: error: part 'q' overlaps part 'p0', expected parts that at most touch\n");
 }

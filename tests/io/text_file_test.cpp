@@ -3,6 +3,7 @@
 #include <fstream>
 #include <string>
 #include <unistd.h>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -27,10 +28,87 @@ TEST_CASE("Atomic writes replace the file whole and leave no temporary behind", 
   int files = 0;
   for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir)) ++files;
   CHECK(files == 1);
-  // A write into a directory that does not exist fails with a message and changes nothing.
-  const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "no" / "x.txt", "z");
-  CHECK_THAT(error, Catch::StartsWith("cannot create"));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("An output's missing directories are made; one that cannot be made is said", "[files]") {
+  const auto dir = ScratchDir();
+  // A fresh checkout has no build/: the directory and its parents are made as mkdir -p does.
+  REQUIRE(tubeplan::io::WriteTextFileAtomically(dir / "no" / "deeper" / "x.txt", "z").empty());
+  CHECK(tubeplan::io::ReadTextFile(dir / "no" / "deeper" / "x.txt") ==
+        std::optional<std::string>("z"));
+  // A parent that is a file: the message names the temporary it could not create and, since
+  // nothing was asked to be written yet, speaks of no room ("room for 0 bytes").
+  std::ofstream(dir / "plain") << "a file\n";
+  const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "plain" / "x.txt", "");
+  CHECK_THAT(error, Catch::StartsWith("cannot create " + (dir / "plain" / "x.txt").string() +
+                                      ".tmp."));
+  CHECK_THAT(error, Catch::EndsWith(": Not a directory; nothing was written (" +
+                                    (dir / "plain" / "x.txt").string() +
+                                    " is as it was), expected a writable directory"));
+  tubeplan::io::AtomicFile never(dir / "plain" / "y.txt");
+  CHECK_THAT(never.Commit(), Catch::EndsWith("expected a writable directory"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("An output that is an input's file is refused, through links too", "[files]") {
+  using tubeplan::io::CheckOutputsApart;
+  namespace fs = std::filesystem;
+  const auto dir = ScratchDir();
+  const fs::path input = dir / "t.csv";
+  std::ofstream(input) << "t,px,py,pz,qw,qx,qy,qz\n";
+  const std::vector<tubeplan::io::RolePath> inputs = {{"the scene", dir / "s.yaml"},
+                                                      {"the trajectory", input}};
+  // The same spelling.
+  CHECK(CheckOutputsApart({{"--out", input}}, inputs) ==
+        "--out " + input.string() + " is the same file as the trajectory " + input.string() +
+            ": writing it would replace the input, expected another file for the output");
+  // A symbolic link, a hard link and another spelling of the path: the same file.
+  fs::create_symlink(input, dir / "link.csv");
+  fs::create_hard_link(input, dir / "hard.csv");
+  for (const fs::path& other :
+       {dir / "link.csv", dir / "hard.csv", dir / "sub" / ".." / "t.csv", dir / "." / "t.csv"}) {
+    fs::create_directories(dir / "sub");
+    CAPTURE(other.string());
+    CHECK(CheckOutputsApart({{"--out", other}}, inputs) ==
+          "--out " + other.string() + " is the same file as the trajectory " + input.string() +
+              " (through a link or another spelling of its path): writing it would replace the "
+              "input, expected another file for the output");
+  }
+  // An input that does not exist yet, named twice: the canonical paths decide.
+  CHECK_THAT(CheckOutputsApart({{"--report", dir / "sub" / ".." / "s.yaml"}}, inputs),
+             Catch::StartsWith("--report " + (dir / "sub" / ".." / "s.yaml").string() +
+                               " is the same file as the scene "));
+  // Two outputs to one file: one would replace the other.
+  CHECK(CheckOutputsApart({{"--dot", dir / "g"}, {"--json", dir / "g"}}, inputs) ==
+        "--json " + (dir / "g").string() + " is the same file as --dot " + (dir / "g").string() +
+            ": one would replace the other, expected a file of its own for each output");
+  // Files apart, and options not given (empty paths), pass.
+  CHECK(CheckOutputsApart({{"--out", dir / "series.csv"}, {"--json", ""}}, inputs).empty());
+  // A copy is another file, whatever it holds.
+  fs::copy_file(input, dir / "copy.csv");
+  CHECK(CheckOutputsApart({{"--out", dir / "copy.csv"}}, inputs).empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("A file whose lines end in a carriage return alone is one clear error", "[files]") {
+  tubeplan::io::Diagnostics d;
+  // Classic Mac OS line ends: the whole file would be one line (and a YAML comment).
+  CHECK_FALSE(tubeplan::io::CheckInputText("# comment\rtubeplan: 1\rname: x\r", "s.yaml",
+                                           "a YAML scene file", d));
+  CHECK(d.FormatAll() ==
+        "s.yaml:1:10: error: a carriage return (CR) with no line feed after it: the lines end in "
+        "CR alone (as classic Mac OS saved text), expected LF or CRLF line endings in a YAML "
+        "scene file\n");
+  // CRLF, and a CR as the last byte, are fine; a CR cut from its LF by a chunk's end too.
+  tubeplan::io::Diagnostics fine;
+  CHECK(tubeplan::io::CheckInputText("a: 1\r\nb: 2\r\n", "s.yaml", "a YAML scene file", fine));
+  CHECK(tubeplan::io::CheckInputText("a: 1\r\nb: 2\r", "s.yaml", "a YAML scene file", fine));
+  tubeplan::io::InputTextCheck pieces;
+  pieces.Feed("a: 1\r");
+  pieces.Feed("\nb: 2\n");
+  CHECK(pieces.Finish("s.yaml", "a YAML scene file", fine));
+  CHECK(fine.FormatAll() == "");
 }
 
 TEST_CASE("Reading: empty files are empty text, directories and missing files are nothing",

@@ -152,6 +152,9 @@ TEST_CASE("A unit of the wrong dimension names both dimensions", "[units]") {
         "has a unit of force*time/length (N s/m), expected a force/length such as \"10 N/mm\"");
   // Angles are a dimension of their own: degrees cannot set a length.
   CHECK(ParseQuantityAs("90 deg", dim::kLength).error);
+  // "an angle", not "a angle".
+  CHECK(ParseQuantityAs("5 mm", dim::kAngle).error->message ==
+        "has a unit of length (mm), expected an angle such as \"90 deg\"");
 }
 
 TEST_CASE("Numbers round-trip through their shortest decimal form", "[units]") {

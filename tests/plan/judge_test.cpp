@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 
 #include <catch2/catch.hpp>
@@ -344,4 +345,52 @@ TEST_CASE("Ticks beyond the linear range, held back or out of the segmented rule
   CHECK(j.transitions[0].segmentation_off_s == Approx(0.007).margin(1e-12));
   CHECK(j.transitions[0].shape_off_s == 0.0);
   CHECK(j.transitions[0].verdict == plan::Verdict::kInfeasible);
+}
+
+TEST_CASE("A limit's message reads right: one space a word, the device's clamp said", "[plan]") {
+  const auto reason = [](const std::function<void(core::StepOutput&)>& set) {
+    plan::Limits limits;
+    limits.max_force_N = 8.5;
+    limits.max_strain = 0.2;
+    plan::Judging judging({"{}", "{Fe - wall.xneg}"}, limits, 1e-3);
+    core::StepOutput out;
+    judging.Tick(1e-3, out, [] { return std::string("{}"); });
+    set(out);
+    judging.Tick(2e-3, out, [] { return std::string("{}"); });
+    return judging.Finish().transitions[0].reason;
+  };
+  // A strain has no unit: no doubled spaces around the missing one.
+  CHECK(reason([](core::StepOutput& o) { o.max_strain = 0.9263; }) ==
+        "limit exceeded: strain 0.9263 > 0.2 at t = 0.002 s");
+  // The force held at the device's clamp, a rounding over a limit set to it: said, and the
+  // value with the digits that tell it from the limit.
+  CHECK(reason([](core::StepOutput& o) {
+          o.force_W_N = Eigen::Vector3d(0.0, 0.0, std::nextafter(8.5, 9.0));
+          o.flags = core::kForceClamped;
+        }) ==
+        "limit exceeded: operator force 8.500000000000002 N (the device's clamp was reached: "
+        "it renders no more) > 8.5 N at t = 0.002 s");
+  CHECK(reason([](core::StepOutput& o) { o.force_W_N = Eigen::Vector3d(9.0, 0.0, 0.0); }) ==
+        "limit exceeded: operator force 9 N > 8.5 N at t = 0.002 s");
+}
+
+TEST_CASE("A plan's limit out of range is said with its value as written and both bounds",
+          "[plan]") {
+  const std::filesystem::path dir = "judge_test_ranges";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "p.yaml") << "tubeplan: 1\nplan: p\nscene: "
+                                << SourcePath("scenes/groove.yaml")
+                                << "\ntrajectory: " << SourcePath("plans/groove-insert.csv")
+                                << "\nstates: [\"{}\", goal]\n"
+                                   "limits: {max_force: 1e300 N, stall: 0}\n";
+  const io::PlanLoadResult loaded = io::LoadPlanFile(dir / "p.yaml");
+  const std::string file = (dir / "p.yaml").string();
+  CHECK(loaded.diagnostics.FormatAll() ==
+        file +
+            ":6:21: error: limits.max_force 1e300 N is out of range, expected a force from 1 uN "
+            "to 10 kN, e.g. \"8.5 N\"\n" +
+            file +
+            ":6:37: error: limits.stall 0 s is out of range, expected a time from 1 ms to 3600 "
+            "s, e.g. \"1 s\"\n");
+  std::filesystem::remove_all(dir);
 }

@@ -1,5 +1,6 @@
 // Hand trajectories: resampling onto the core's step, and the CSV loader's values and messages.
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -250,6 +251,48 @@ TEST_CASE("Trajectory errors are all reported, then capped", "[trajectory]") {
   CHECK(loaded.diagnostics.all()[0].line == 3);
   CHECK(loaded.diagnostics.all()[0].column == 10);
   CHECK(loaded.diagnostics.all()[50].message == "... and 10 more errors");
+  // Printed after the errors it counts, not first (its line 0 would sort it there).
+  const std::string all = loaded.diagnostics.FormatAll();
+  CHECK_THAT(all, Catch::StartsWith("t.csv:3:10: error: 'x' is not a number"));
+  CHECK_THAT(all, Catch::EndsWith("t.csv: error: ... and 10 more errors\n"));
+}
+
+TEST_CASE("A 20 Hz file sits at the gap limit on every row, not over it on some", "[trajectory]") {
+  // Times as decimals: 0.35 - 0.30 and 0.40 - 0.35 round to either side of 0.05.
+  std::string text = "t,px,py,pz,qw,qx,qy,qz\n";
+  char row[64];
+  for (int k = 0; k <= 200; ++k) {
+    std::snprintf(row, sizeof row, "%.2f,0,0,0,1,0,0,0\n", k * 0.05);
+    text += row;
+  }
+  const auto loaded = LoadTrajectoryText(text, "t.csv");
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  CHECK(loaded.trajectory);
+  // A gap beyond 50 ms is still one (51 ms).
+  const auto gap =
+      LoadTrajectoryText("t,px,py,pz,qw,qx,qy,qz\n0,0,0,0,1,0,0,0\n0.051,0,0,0,1,0,0,0\n", "t.csv");
+  CHECK(gap.diagnostics.FormatAll() ==
+        "t.csv:3:1: error: gap of 0.051 s before this sample, more than 0.05 s (a dropped "
+        "recording?)\n");
+}
+
+TEST_CASE("Extra columns hold any text and are kept by name", "[trajectory]") {
+  const auto loaded = LoadTrajectoryText(
+      "t,px,py,pz,qw,qx,qy,qz,button,note\n0,0,0,0,1,0,0,0,1,start\n"
+      "0.001,0,0,0,1,0,0,0,pressed,2026-11-24T10:00:00\n",
+      "t.csv");
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.trajectory);
+  CHECK(loaded.trajectory->extra_columns == std::vector<std::string>{"button", "note"});
+  CHECK(loaded.trajectory->extra_values[0][0] == 1.0);
+  CHECK(std::isnan(loaded.trajectory->extra_values[0][1]));
+  CHECK(std::isnan(loaded.trajectory->extra_values[1][0]));
+  // The pose columns are still numbers.
+  CHECK(LoadTrajectoryText("t,px,py,pz,qw,qx,qy,qz,note\n0,0,0,0,1,0,0,0,a\n"
+                           "0.001,zero,0,0,1,0,0,0,b\n",
+                           "t.csv")
+            .diagnostics.FormatAll() ==
+        "t.csv:3:7: error: 'zero' is not a number, expected a decimal number\n");
 }
 
 TEST_CASE("Damaged trajectory files never throw", "[trajectory]") {

@@ -15,6 +15,7 @@ struct Diagnostic {
   int column = 0;  ///< 1-based; 0 with line 0
   Severity severity = Severity::kError;
   std::string message;
+  bool after_all = false;  ///< shown after the file's other diagnostics ("... and 12 more errors")
 };
 
 /// "file:line:col: error: message" ("file: error: message" when line is 0).
@@ -24,6 +25,8 @@ class Diagnostics {
  public:
   void Error(std::string file, int line, int column, std::string message);
   void Warning(std::string file, int line, int column, std::string message);
+  /// An error about the file's other diagnostics, shown after them (a count of those left out).
+  void ErrorAfterAll(std::string file, std::string message);
   bool HasErrors() const;
   const std::vector<Diagnostic>& all() const { return all_; }
   /// Every diagnostic, one per line, in file order then position order.

@@ -40,7 +40,8 @@ ReadResult ReadInputFile(const std::filesystem::path& path,
 std::optional<std::string> ReadTextFile(const std::filesystem::path& path);
 
 /// Checks that `text` is text a person or a recorder wrote: not empty, not binary (a NUL byte),
-/// not UTF-16 or UTF-32 (a byte-order mark), valid UTF-8, no line longer than kMaxLineBytes. Each
+/// not UTF-16 or UTF-32 (a byte-order mark), valid UTF-8, no line longer than kMaxLineBytes, no
+/// line ending in a carriage return alone (classic Mac OS; LF and CRLF are the line ends). Each
 /// kind of problem is reported once, at its first place, as "what, and `expected`" (e.g. "a YAML
 /// scene file"). Returns false when the text must not be parsed. A UTF-8 byte-order mark is fine.
 bool CheckInputText(std::string_view text, const std::string& display_name,
@@ -58,7 +59,7 @@ class InputTextCheck {
   bool failing() const { return wide_ != nullptr || !findings_.empty(); }
 
  private:
-  enum class Kind { kNul, kUtf8, kLong };
+  enum class Kind { kNul, kUtf8, kLong, kLoneCr };
   struct Finding {
     Kind kind;
     int line = 0;
@@ -75,7 +76,9 @@ class InputTextCheck {
   bool blank_ = true;           // only " \t\r\n" so far
   bool bom_checked_ = false;
   const char* wide_ = nullptr;  // "UTF-16" or "UTF-32" when a byte-order mark says so
-  bool nul_ = false, utf8_ = false, long_ = false;
+  bool nul_ = false, utf8_ = false, long_ = false, lone_cr_ = false;
+  bool cr_pending_ = false;  // the last byte seen was a CR: a line feed may follow
+  int cr_line_ = 0, cr_column_ = 0;
   std::size_t open_long_ = SIZE_MAX;  // index of the kLong finding whose line has not ended
   int line_ = 1;
   std::uint64_t line_start_ = 0;
@@ -143,10 +146,25 @@ class InputLineReader {
 /// UTF-8 sequence) and "...", so a 1 MB field does not become a 1 MB message.
 std::string Abbreviate(std::string_view text, std::size_t max_bytes = 40);
 
+/// A file a command reads or writes, with what it is to the user: "the scene", "--out".
+struct RolePath {
+  std::string role;
+  std::filesystem::path path;
+};
+
+/// Refuses an output that is the very file of an input, or of another output: the same device
+/// and inode when the output exists (a symlink or a hard link to the input included), else the
+/// same canonical path. An empty string when every output is a file apart; else the message,
+/// naming both paths ("--out T.csv is the same file as the trajectory T.csv, ..."), which the
+/// command prints with exit code 2 before it writes anything. Empty roles and paths are skipped.
+std::string CheckOutputsApart(const std::vector<RolePath>& outputs,
+                              const std::vector<RolePath>& inputs);
+
 /// A file written whole or not at all, for outputs too large to hold in memory: the text goes
-/// to a temporary file next to `path` as it comes (Write), and Commit flushes it to the disk and
-/// renames it over `path`. Destroyed without a successful Commit (an error, an exception, an
-/// interruption), it removes the temporary file and `path` stays as it was.
+/// to a temporary file next to `path` (`NAME.tmp.PID.N`) as it comes (Write), and Commit flushes
+/// it to the disk and renames it over `path`. Destroyed without a successful Commit (an error,
+/// an exception), it removes the temporary file and `path` stays as it was; so does SIGINT or
+/// SIGTERM (io/interrupt.hpp). Missing parent directories of `path` are created.
 class AtomicFile {
  public:
   explicit AtomicFile(std::filesystem::path path);
@@ -165,6 +183,7 @@ class AtomicFile {
   void Fail(const char* what, int error);
   std::filesystem::path path_, temporary_;
   int fd_ = -1;
+  int slot_ = -1;  // the temporary's registration for the signal handler
   std::uintmax_t bytes_ = 0;
   bool committed_ = false;
   std::string error_;
@@ -177,10 +196,11 @@ class AtomicFile {
 /// or a missing directory all come back here as a message, never as a partial file.
 std::string WriteTextFileAtomically(const std::filesystem::path& path, std::string_view text);
 
-/// A file written as it goes (a live recording): into a temporary file next to `path`, flushed
-/// to the operating system on every Flush(), and renamed over `path` by Commit(). A crash leaves
-/// `path` as it was (and the partial data in the temporary file); destroying it uncommitted
-/// removes the temporary file.
+/// A file written as it goes (a live recording): into a temporary file next to `path`
+/// (`NAME.tmp.PID.N`), flushed to the operating system on every Flush(), and renamed over `path`
+/// by Commit(). A crash or SIGKILL leaves `path` as it was (and the partial data in the
+/// temporary file); destroying it uncommitted, SIGINT or SIGTERM remove the temporary file.
+/// Missing parent directories of `path` are created.
 class StreamingTextFile {
  public:
   StreamingTextFile() = default;
@@ -199,6 +219,7 @@ class StreamingTextFile {
  private:
   std::filesystem::path path_, temporary_;
   std::FILE* file_ = nullptr;
+  int slot_ = -1;
   bool failed_ = false;
 };
 

@@ -24,8 +24,9 @@ struct Trajectory {
   std::string device;                      ///< from the "# device:" line, may be empty
   double nominal_rate_Hz = 0.0;            ///< from the "# rate:" line, 0 when not given
   std::vector<std::string> extra_columns;  ///< names of columns beyond the pose
-  /// Per sample, in extra_columns order; empty when there are no extra columns (an empty vector
-  /// per row would cost 24 bytes a sample: 86 MB for an hour at 1 kHz).
+  /// Per sample, in extra_columns order: the number a field spells, NaN for other text (extra
+  /// columns may hold any text). Empty when there are no extra columns (an empty vector per
+  /// row would cost 24 bytes a sample: 86 MB for an hour at 1 kHz).
   std::vector<std::vector<double>> extra_values;
 };
 
