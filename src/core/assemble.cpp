@@ -9,8 +9,8 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
-// The block of unknowns node k moves with: nodes 0 and 1 with the held end, node k >= 2 its own.
-int BlockOf(int node) { return node <= 1 ? 0 : node - 1; }
+// The block of unknowns of node k: node 0 is the held end.
+int BlockOf(int node) { return node; }
 
 class Assembler {
  public:
@@ -39,12 +39,13 @@ class Assembler {
   void AddAtPoint(const Eigen::Matrix<double, 3, 9>& J, int first, int nodes, const Vec3& g_p,
                   const Mat3& H_p) {
     if (!derivatives_) return;
+    // Fixed-size products: the columns of a two-node stencil's third node are zero.
     StencilTerm t;
     t.first = first;
     t.nodes = nodes;
-    const int n = 3 * nodes;
-    t.gradient.head(n) = J.leftCols(n).transpose() * g_p;
-    t.hessian.topLeftCorner(n, n) = J.leftCols(n).transpose() * H_p * J.leftCols(n);
+    t.gradient.noalias() = J.transpose() * g_p;
+    const Eigen::Matrix<double, 3, 9> HJ = H_p * J;
+    t.hessian.noalias() = J.transpose() * HJ;
     AddStencil(t);
   }
 
@@ -62,19 +63,14 @@ class Assembler {
 
 }  // namespace
 
-int UnknownCount(const Model& model) { return 3 * model.rod.elements; }
+int UnknownCount(const Model& model) { return 3 * (model.rod.elements + 1); }
 
-void NodesOf(const Model& model, const Data& data, const Eigen::VectorXd& q,
-             std::span<Vec3> x_W) {
-  const Vec3 p = q.segment<3>(0);
-  x_W[0] = p;
-  x_W[1] = p + model.rod.segment_m * data.input.tangent_held_W;
-  for (int k = 2; k <= model.rod.elements; ++k) x_W[std::size_t(k)] = q.segment<3>(3 * (k - 1));
+void NodesOf(const Model& model, const Eigen::VectorXd& q, std::span<Vec3> x_W) {
+  for (int k = 0; k <= model.rod.elements; ++k) x_W[std::size_t(k)] = q.segment<3>(3 * k);
 }
 
 void UnknownsOf(const Model& model, std::span<const Vec3> x_W, Eigen::VectorXd& q) {
-  q.segment<3>(0) = x_W[0];
-  for (int k = 2; k <= model.rod.elements; ++k) q.segment<3>(3 * (k - 1)) = x_W[std::size_t(k)];
+  for (int k = 0; k <= model.rod.elements; ++k) q.segment<3>(3 * k) = x_W[std::size_t(k)];
 }
 
 MaterialPoint FrictionMaterial(const Model& model, const FrictionPoint& f,
@@ -112,12 +108,65 @@ CouplingTerm Coupling(const Model& model, const Data& data, const Vec3& p_held_W
 
 double BendingEnergyOf(const Model& model, const Data& data, std::span<const Vec3> x_W) {
   double energy = 0.0;
-  for (int i = 1; i < model.rod.elements; ++i)
+  for (int i = 0; i < model.rod.elements; ++i)
     energy += model.rod.linear
                   ? LinearBendingEnergy(model.rod, data.state.R_WH, x_W, i, nullptr)
-                  : BendingEnergy(model.rod, x_W, i, nullptr);
+                  : BendingEnergy(model.rod, data.input.tangent_held_W, x_W, i, nullptr);
   return energy;
 }
+
+namespace {
+
+// The rim's points on one part, samples [first, end): one contact whose distance is the smooth
+// minimum d = -tau log sum exp(-d_j / tau) of theirs, with the paper's K (eps - d)+ shared by
+// the softmin's weights. Tilted, the nearest point takes it all (a point contact, K); flat, the
+// points share it evenly (the whole end face, K), and the end resists tilting as a rigid flat
+// end does, up to the moment that puts the whole force on its rim (docs/core.md).
+double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int first, int end,
+              Assembler& a, bool derivatives) {
+  const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
+  const double tau = kRimSoftness * eps;
+  Sample* s = &data.scratch.samples[std::size_t(first)];
+  const int count = end - first;
+  double d_min = s[0].distance_m;
+  for (int j = 1; j < count; ++j) d_min = std::min(d_min, s[j].distance_m);
+  double sum = 0.0;
+  std::array<double, kRimSamples> w{};
+  for (int j = 0; j < count; ++j) sum += (w[std::size_t(j)] = std::exp(-(s[j].distance_m - d_min) / tau));
+  for (int j = 0; j < count; ++j) w[std::size_t(j)] /= sum;
+  const double d = d_min - tau * std::log(sum);
+  for (int j = 0; j < count; ++j) s[j].contact_distance_m = d;
+  const double depth = eps - d;
+  if (!(depth > 0.0)) {
+    for (int j = 0; j < count; ++j) s[j].normal_force_N = 0.0;
+    return 0.0;
+  }
+  const double force = K * depth;
+  for (int j = 0; j < count; ++j) s[j].normal_force_N = force * w[std::size_t(j)];
+  if (derivatives) {
+    // d distance / d (x_{N-1}, x_N) of each point, their weighted mean, and the softmin's
+    // curvature: H = K m m^T + (F / tau) (sum w g g^T - m m^T).
+    Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
+    Eigen::Matrix<double, 6, 6> spread = Eigen::Matrix<double, 6, 6>::Zero();
+    for (int j = 0; j < count; ++j) {
+      const MaterialPoint mp =
+          Material(Carrier::kEndNode, x_W, s[j].node, 0.0, s[j].moving_offset_W);
+      const Eigen::Matrix<double, 6, 1> g = mp.jacobian.leftCols<6>().transpose() * s[j].normal_W;
+      mean += w[std::size_t(j)] * g;
+      spread += w[std::size_t(j)] * g * g.transpose();
+    }
+    StencilTerm t;
+    t.first = model.rod.elements - 1;
+    t.nodes = 2;
+    t.gradient.head<6>() = -force * mean;
+    t.hessian.topLeftCorner<6, 6>() =
+        K * mean * mean.transpose() + (force / tau) * (spread - mean * mean.transpose());
+    a.AddStencil(t);
+  }
+  return 0.5 * K * depth * depth;
+}
+
+}  // namespace
 
 double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool derivatives) {
   Assembler a(model, data, derivatives);
@@ -126,10 +175,11 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
   StencilTerm term;
   StencilTerm* want = derivatives ? &term : nullptr;
 
-  // The rod: bending at the inner nodes, the stiff axial spring of every free element.
-  for (int i = 1; i < rod.elements; ++i) {
+  // The rod: bending at the grip (against the held end's axis) and at the inner nodes, the
+  // stiff axial spring of every element.
+  for (int i = 0; i < rod.elements; ++i) {
     energy += rod.linear ? LinearBendingEnergy(rod, data.state.R_WH, x_W, i, want)
-                         : BendingEnergy(rod, x_W, i, want);
+                         : BendingEnergy(rod, data.input.tangent_held_W, x_W, i, want);
     a.AddStencil(term);
     energy += rod.linear ? AxialHoldEnergy(rod, data.state.R_WH, x_W, i, want)
                          : StretchEnergy(rod, x_W, i, want);
@@ -141,11 +191,23 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
   energy += c.energy_J;
   a.AddHeldEnd(c.force_N, c.stiffness_N_per_m);
 
-  // The penalty K (eps - d)+ of every contact point, along its normal (Gauss-Newton: the
-  // curvature of the distance is left out of the Hessian).
+  // The penalty K (eps - d)+ of every contact point, along its normal, with the curvature of
+  // the distance near an edge or vertex (a point rolling round it); the rim's points on one
+  // part press as one contact.
   const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     Sample& smp = data.scratch.samples[std::size_t(k)];
+    if (smp.kind == SampleKind::kRim) {
+      int end = k + 1;
+      while (end < data.scratch.sample_count &&
+             data.scratch.samples[std::size_t(end)].kind == SampleKind::kRim &&
+             data.scratch.samples[std::size_t(end)].part == smp.part)
+        ++end;
+      energy += AddRim(model, data, x_W, k, end, a, derivatives);
+      k = end - 1;
+      continue;
+    }
+    smp.contact_distance_m = smp.distance_m;
     const double depth = eps - smp.distance_m;
     if (!(depth > 0.0)) continue;
     const double kw = K * smp.weight;
@@ -155,7 +217,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
     const MaterialPoint mp =
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
-                 kw * smp.normal_W * smp.normal_W.transpose());
+                 kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
   }
 
   // Friction: a spring from each friction point to its anchor in the tangent plane, stiffness

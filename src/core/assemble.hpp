@@ -13,11 +13,9 @@
 
 namespace tubeplan::core {
 
-/// The unknowns: the held end's position, then nodes 2 .. N (nodes 0 and 1 follow the held end).
+/// The unknowns: the nodes 0 .. N, node 0 being the held end.
 int UnknownCount(const Model& model);
-/// The nodes of the unknowns q, the held end's axis fixed for the tick.
-void NodesOf(const Model& model, const Data& data, const Eigen::VectorXd& q,
-             std::span<Eigen::Vector3d> x_W);
+void NodesOf(const Model& model, const Eigen::VectorXd& q, std::span<Eigen::Vector3d> x_W);
 void UnknownsOf(const Model& model, std::span<const Eigen::Vector3d> x_W, Eigen::VectorXd& q);
 
 /// The potential at the nodes x_W with the contact points in data.scratch.samples (found at

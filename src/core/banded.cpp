@@ -4,16 +4,6 @@
 
 namespace tubeplan::core {
 
-void BandMatrix::AddBlock(int bi, int bj, const Eigen::Matrix3d& block) {
-  // Row i of the band holds columns i - kBandWidth .. i; a diagonal block adds its lower half.
-  for (int r = 0; r < 3; ++r) {
-    const int i = 3 * bi + r;
-    double* row = &a_[Index(i, 3 * bj)];
-    const int columns = bi == bj ? r + 1 : 3;
-    for (int c = 0; c < columns; ++c) row[c] += block(r, c);
-  }
-}
-
 void BandMatrix::AddDiagonal(double lambda) {
   for (int i = 0; i < n_; ++i) (*this)(i, i) += lambda;
 }
@@ -34,24 +24,30 @@ void BandMatrix::Multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
 bool BandLdlt::Factor(const BandMatrix& a, double min_pivot) {
   f_.a_ = a.a_;
   const int n = f_.n_;
+  constexpr int w = kBandWidth;
+  double* f = f_.a_.data();
+  // Row i of the band starts at f + i (w + 1); entry (i, j) is at its offset w - (i - j).
+  const auto at = [f](int i, int j) -> double& { return f[i * (w + 1) + w - (i - j)]; };
   // Column by column (Golub & Van Loan, algorithm 4.1.2 restricted to the band): with
   // v_k = L(j, k) D(k), D(j) = A(j, j) - sum_k L(j, k) v_k, then L(i, j) for the rows below.
-  std::array<double, kBandWidth> v{};
+  std::array<double, w> v{};
   for (int j = 0; j < n; ++j) {
-    const int k0 = std::max(0, j - kBandWidth);
-    double d = f_(j, j);
+    const int k0 = std::max(0, j - w);
+    const double* row_j = &at(j, k0);
+    double d = at(j, j);
     for (int k = k0; k < j; ++k) {
-      v[std::size_t(k - k0)] = f_(j, k) * f_(k, k);
-      d -= f_(j, k) * v[std::size_t(k - k0)];
+      v[std::size_t(k - k0)] = row_j[k - k0] * at(k, k);
+      d -= row_j[k - k0] * v[std::size_t(k - k0)];
     }
     if (!(d > min_pivot)) return false;
-    f_(j, j) = d;
-    const int i1 = std::min(n - 1, j + kBandWidth);
+    at(j, j) = d;
+    const int i1 = std::min(n - 1, j + w);
     for (int i = j + 1; i <= i1; ++i) {
-      double s = f_(i, j);
-      const int kk0 = std::max(k0, i - kBandWidth);
-      for (int k = kk0; k < j; ++k) s -= f_(i, k) * v[std::size_t(k - k0)];
-      f_(i, j) = s / d;
+      const int kk0 = std::max(k0, i - w);
+      const double* row_i = &at(i, kk0);
+      double s = at(i, j);
+      for (int k = kk0; k < j; ++k) s -= row_i[k - kk0] * v[std::size_t(k - k0)];
+      at(i, j) = s / d;
     }
   }
   return true;

@@ -27,8 +27,16 @@ class BandMatrix {
   /// Entry (i, j) of the lower band, i - kBandWidth <= j <= i.
   double& operator()(int i, int j) { return a_[Index(i, j)]; }
   double operator()(int i, int j) const { return a_[Index(i, j)]; }
-  /// Adds a symmetric 3 x 3 block at block rows (bi, bj), scalar rows 3 bi and 3 bj; bi >= bj.
-  void AddBlock(int bi, int bj, const Eigen::Matrix3d& block);
+  /// Adds a 3 x 3 block at block rows (bi, bj), scalar rows 3 bi and 3 bj, bi >= bj; of a block
+  /// on the diagonal only the lower half is read.
+  template <typename Block>
+  void AddBlock(int bi, int bj, const Eigen::MatrixBase<Block>& block) {
+    for (int r = 0; r < 3; ++r) {
+      double* row = &a_[Index(3 * bi + r, 3 * bj)];
+      const int columns = bi == bj ? r + 1 : 3;
+      for (int c = 0; c < columns; ++c) row[c] += block(r, c);
+    }
+  }
   /// Adds lambda to every diagonal entry.
   void AddDiagonal(double lambda);
   /// y = A x for the symmetric matrix.

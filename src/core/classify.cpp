@@ -62,9 +62,10 @@ Vec3 CurvatureAt(const Model& model, const Data& data, double s_m) {
   const int n = model.rod.elements;
   const double h = model.rod.segment_m;
   auto at_node = [&](int i) -> Vec3 {
-    if (i <= 0 || i >= n) return Vec3::Zero();
-    const Vec3 a = (x[std::size_t(i)] - x[std::size_t(i - 1)]).normalized();
+    if (i >= n) return Vec3::Zero();
     const Vec3 b = (x[std::size_t(i + 1)] - x[std::size_t(i)]).normalized();
+    if (i == 0) return 2.0 * (b - data.input.tangent_held_W) / h;  // over half an element
+    const Vec3 a = (x[std::size_t(i)] - x[std::size_t(i - 1)]).normalized();
     return (b - a) / h;
   };
   const double u = std::clamp(s_m / h, 0.0, double(n));
@@ -114,7 +115,7 @@ void Classify(const Model& model, Data& data) {
       n.mask = smp.face_mask;
       n.pc.tube = te;
       n.pc.part_element = model.parts[std::size_t(smp.part)].element_of[smp.face_mask];
-      n.pc.distance_m = smp.distance_m;
+      n.pc.distance_m = smp.contact_distance_m;
       n.pc.s_m = ArcOf(model, smp);
       n.pc.normal_W = smp.normal_W;
       n.pc.p_WC_m = smp.point_W;
@@ -130,8 +131,8 @@ void Classify(const Model& model, Data& data) {
     pc.friction_work_J += smp.friction_work_J;
     pc.sliding = pc.sliding || smp.sliding;
     g[std::size_t(at)].s_far_m = std::max(g[std::size_t(at)].s_far_m, ArcOf(model, smp));
-    if (smp.distance_m < pc.distance_m) {
-      pc.distance_m = smp.distance_m;
+    if (smp.contact_distance_m < pc.distance_m) {
+      pc.distance_m = smp.contact_distance_m;
       pc.s_m = ArcOf(model, smp);
       pc.normal_W = smp.normal_W;
       pc.p_WC_m = smp.point_W;

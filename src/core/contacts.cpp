@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #include "core/rod.hpp"
 
@@ -47,9 +48,16 @@ class Finder {
     Scratch& s = d_.scratch;
     s.sample_count = 0;
     s.samples_truncated = false;
+    std::fill(s.clearance_m.begin(), s.clearance_m.end(), s.far_clearance_m);
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
+      // How far each node's surface is from the part, for the solve's step.
+      for (int i = 0; i <= n_; ++i)
+        s.clearance_m[std::size_t(i)] =
+            std::min(s.clearance_m[std::size_t(i)],
+                     part.geometry.Distance(x_[std::size_t(i)], Entry(p, i)).distance_m -
+                         m_.rod.outer_radius_m);
       // The side's sections at the inner nodes, the free end's rim, the side between nodes
       // against the part's edges, the end face against its vertices.
       for (int i = 1; i < n_; ++i) Section(p, part, i);
@@ -85,6 +93,7 @@ class Finder {
     smp->weight = weight;
     smp->distance_m = dist.distance_m;
     smp->normal_W = dist.normal_W;
+    smp->curvature_per_m = dist.curvature_per_m;
     smp->face_mask = dist.face_mask;
     smp->point_W = mp.point_W;
     smp->offset_W = mp.offset_W;
@@ -120,6 +129,7 @@ class Finder {
   void SectionFrame(const PartModel& part, int p, int node, const Vec3& c, const Vec3& t,
                     std::uint8_t entry, Vec3& rho, Vec3& side) {
     Scratch& s = d_.scratch;
+    const double r1 = m_.rod.outer_radius_m;
     const std::size_t k = std::size_t(p * (n_ + 1) + node);
     Vec3& kept = d_.state.section_direction_W[k];
     if (s.section_chosen[k]) {
@@ -127,7 +137,7 @@ class Finder {
       side = s.section_side_W[k];
       return;
     }
-    rho = NearestOnCircle(part, c, t, m_.rod.outer_radius_m, kept, entry);
+    rho = NearestOnCircle(part, c, t, r1, kept, entry);
     side = t.cross(rho);
     if (keep_) {
       kept = rho;
@@ -160,7 +170,8 @@ class Finder {
     const Vec3 t = CarrierTangent(Carrier::kEndNode, x_, n_);
     Vec3 rho, side;
     SectionFrame(part, p, n_, c, t, entry, rho, side);
-    // The nearest point and the others equally spaced around the rim.
+    // The nearest point and the others equally spaced around the rim: together they press as
+    // one contact (Assemble), so that a flat end bears on its whole rim.
     for (int j = 0; j < kRimSamples; ++j) {
       const double phi = 2.0 * M_PI * j / kRimSamples;
       const Vec3 offset = r1 * (std::cos(phi) * rho + std::sin(phi) * side);
@@ -231,6 +242,9 @@ class Finder {
       at.normal_W = w / lw;
       at.point_W = q;
       at.face_mask = mask;
+      at.curvature_per_m = Eigen::Matrix3d::Identity() - at.normal_W * at.normal_W.transpose();
+      if (u > 0.0 && u < 1.0) at.curvature_per_m -= ab * ab.transpose() / ab.squaredNorm();
+      at.curvature_per_m /= lw;
       // The distance moves with the axis point alone; the surface point is r1 from it towards
       // the edge.
       MaterialPoint mp = Material(Carrier::kElement, x_, i, theta, Vec3::Zero(), false);
@@ -284,14 +298,19 @@ void FindPartsNear(const Model& model, std::span<const Vec3> x_W, double reach_m
     lo = lo.cwiseMin(x);
     hi = hi.cwiseMax(x);
   }
-  const double grow = model.rod.outer_radius_m + model.contact.threshold_m + reach_m;
-  lo.array() -= grow;
-  hi.array() += grow;
+  const double r1 = model.rod.outer_radius_m;
+  const double grow = r1 + model.contact.threshold_m + reach_m;
+  // The parts whose boxes come within `grow` of the nodes' box; of the others, the gap to the
+  // nearest box bounds how far the tube's surface is from them.
+  double far = std::numeric_limits<double>::infinity();
   for (std::size_t p = 0; p < model.parts.size(); ++p) {
     const BoxGeometry& g = model.parts[p].geometry;
-    data.scratch.parts_near[p] =
-        !((g.min_W().array() > hi.array()).any() || (g.max_W().array() < lo.array()).any());
+    const Vec3 gap = (g.min_W() - hi).cwiseMax(lo - g.max_W()).cwiseMax(0.0);
+    const bool near = !(gap.array() > grow).any();
+    data.scratch.parts_near[p] = near;
+    if (!near) far = std::min(far, gap.maxCoeff() - r1);
   }
+  data.scratch.far_clearance_m = far;
 }
 
 void FindContacts(const Model& model, std::span<const Vec3> x_W, Data& data, Choices choices) {

@@ -61,13 +61,14 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.state.entry_mask.assign(parts * nodes, 0);
   d.scratch.x_trial_W.assign(nodes, Eigen::Vector3d::Zero());
   d.scratch.x_start_W.assign(nodes, Eigen::Vector3d::Zero());
-  const int unknowns = 3 * n;
+  const int unknowns = 3 * (n + 1);
   for (Eigen::VectorXd* v : {&d.scratch.unknowns, &d.scratch.unknowns_trial, &d.scratch.gradient,
                              &d.scratch.step, &d.scratch.direction, &d.scratch.work})
     v->setZero(unknowns);
   d.scratch.hessian = BandMatrix(unknowns);
   d.scratch.factor = BandLdlt(unknowns);
   d.scratch.parts_near.assign(parts, 0);
+  d.scratch.clearance_m.assign(nodes, 0.0);
   d.scratch.entry_seen.assign(parts * nodes, 0);
   d.scratch.section_chosen.assign(parts * nodes, 0);
   d.scratch.section_side_W.assign(parts * nodes, Eigen::Vector3d::Zero());

@@ -38,7 +38,11 @@ struct Sample {
   double theta = 0.0;          ///< position along the segment (kSide), 0..1
   double weight = 1.0;         ///< share of K it carries
   double distance_m = 0.0;     ///< signed distance d of the point to the part
+  /// The distance its contact presses by: its own, or for the rim's points on one part their
+  /// smooth minimum (Assemble), so that every contact's force is K (eps - this).
+  double contact_distance_m = 0.0;
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
+  Eigen::Matrix3d curvature_per_m = Eigen::Matrix3d::Zero();  ///< d2 distance / d point2
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();    ///< on the tube's surface
   Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();   ///< from the centreline to the point
   Eigen::Vector3d moving_offset_W = Eigen::Vector3d::Zero();
@@ -111,7 +115,11 @@ struct Scratch {
   Eigen::VectorXd gradient, step, direction, work;
   BandMatrix hessian;
   BandLdlt factor;
-  std::vector<std::uint8_t> parts_near;  ///< per part: within reach this tick
+  std::vector<std::uint8_t> parts_near;  ///< per part: within reach this iteration
+  /// Per node: the distance from its section's surface to the nearest part (a lower bound) [m],
+  /// and that bound for the parts not near.
+  std::vector<double> clearance_m;
+  double far_clearance_m = 0.0;
   std::vector<std::uint8_t> entry_seen;  ///< per (part, node): a contact point there this tick
   /// Where on the tube each contact point sits is chosen once a tick, when it is first found, and
   /// kept for the tick's iterations (so that the potential they minimise does not change under

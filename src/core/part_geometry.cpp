@@ -69,6 +69,15 @@ PartDistance BoxGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entr
     r.distance_m = out_m;
     r.normal_W = R_WP_ * g_P;
     r.point_W = p_W - out_m * r.normal_W;
+    // Beyond an edge or a vertex the distance is to a line or a point: it curves.
+    const int beyond = (q[0] > 0.0) + (q[1] > 0.0) + (q[2] > 0.0);
+    if (beyond >= 2) {
+      Eigen::Matrix3d c = Eigen::Matrix3d::Identity() - r.normal_W * r.normal_W.transpose();
+      if (beyond == 2)
+        for (int a = 0; a < 3; ++a)
+          if (q[a] <= 0.0) c -= R_WP_.col(a) * R_WP_.col(a).transpose();
+      r.curvature_per_m = c / out_m;
+    }
     return r;
   }
   // Inside: out through the face the point came in by, if it is known, else the nearest face.

@@ -21,6 +21,9 @@ struct PartDistance {
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();  ///< nearest point on the part's surface
   std::uint8_t face_mask = 0;  ///< faces the nearest point lies on (BoxFace bits)
+  /// The distance's second derivative: (I - n n^T - a a^T) / distance near an edge (a its unit
+  /// direction), (I - n n^T) / distance near a vertex, zero near a face or inside.
+  Eigen::Matrix3d curvature_per_m = Eigen::Matrix3d::Zero();
 };
 
 struct PartEdge {

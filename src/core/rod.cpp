@@ -36,7 +36,30 @@ void EdgesToNodes(const Mat3& hee, const Mat3& hef, const Mat3& hff, const Vec3&
 
 }  // namespace
 
-double BendingEnergy(const RodModel& rod, std::span<const Vec3> x_W, int i, StencilTerm* term) {
+double BendingEnergy(const RodModel& rod, const Vec3& t_H, std::span<const Vec3> x_W, int i,
+                     StencilTerm* term) {
+  if (i == 0) {
+    // Between the grip's axis and the first element.
+    const double c = 2.0 * rod.bending_stiffness_Nm2 / rod.segment_m;
+    const Vec3 f = x_W[1] - x_W[0];
+    const double lf = f.norm();
+    const Vec3 b = f / lf;
+    const double cos_phi = t_H.dot(b);
+    if (term != nullptr) {
+      const Vec3 gf = (t_H - cos_phi * b) / lf;
+      const Mat3 H = -c * (-(b * gf.transpose() + gf * b.transpose()) / lf -
+                           cos_phi * (Mat3::Identity() - b * b.transpose()) / (lf * lf));
+      term->first = 0;
+      term->nodes = 2;
+      term->gradient.segment<3>(0) = c * gf;
+      term->gradient.segment<3>(3) = -c * gf;
+      term->hessian.block<3, 3>(0, 0) = H;
+      term->hessian.block<3, 3>(3, 3) = H;
+      term->hessian.block<3, 3>(0, 3) = -H;
+      term->hessian.block<3, 3>(3, 0) = -H;
+    }
+    return c * (1.0 - cos_phi);
+  }
   const double c = rod.bending_stiffness_Nm2 / rod.segment_m;
   const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
   const Vec3 f = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
@@ -87,6 +110,21 @@ double LinearBendingEnergy(const RodModel& rod, const Mat3& R_WH, std::span<cons
   // Lateral projector of the held frame: the beam bends in its x and y only.
   const Vec3 z = R_WH.col(2);
   const Mat3 P = Mat3::Identity() - z * z.transpose();
+  if (i == 0) {
+    // At the grip: the ghost node x_0 - h z mirrors the clamp.
+    const Vec3 b = P * (x_W[1] - x_W[0]);
+    if (term != nullptr) {
+      term->first = 0;
+      term->nodes = 2;
+      term->gradient.segment<3>(0) = -2.0 * c * b;
+      term->gradient.segment<3>(3) = 2.0 * c * b;
+      term->hessian.block<3, 3>(0, 0) = 2.0 * c * P;
+      term->hessian.block<3, 3>(3, 3) = 2.0 * c * P;
+      term->hessian.block<3, 3>(0, 3) = -2.0 * c * P;
+      term->hessian.block<3, 3>(3, 0) = -2.0 * c * P;
+    }
+    return c * b.squaredNorm();
+  }
   const Vec3 b = P * (x_W[std::size_t(i + 1)] - 2.0 * x_W[std::size_t(i)] + x_W[std::size_t(i - 1)]);
   if (term != nullptr) {
     term->first = i - 1;

@@ -19,20 +19,23 @@ struct StencilTerm {
   Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
 };
 
-/// Bending at inner node i (1 <= i <= N-1): (EI / h) (1 - cos phi_i), phi_i the angle between
-/// the elements on either side; its energy is returned and, when `term` is given, filled.
-double BendingEnergy(const RodModel& rod, std::span<const Eigen::Vector3d> x_W, int i,
-                     StencilTerm* term);
+/// Bending at node i: (EI / h) (1 - cos phi_i), phi_i the angle between the elements on either
+/// side; at the grip (i = 0) between the held end's axis t_H and the first element, with twice
+/// the weight (the grip's half element carries half the length and twice the curvature). Its
+/// energy is returned and, when `term` is given, filled.
+double BendingEnergy(const RodModel& rod, const Eigen::Vector3d& t_H,
+                     std::span<const Eigen::Vector3d> x_W, int i, StencilTerm* term);
 
 /// Stretching of element i (from node i to i + 1): (EA / 2h) (|e_i| - h)^2. Its Hessian keeps the
 /// geometric term, negative for a shortened element: the softening that lets a column buckle.
 double StretchEnergy(const RodModel& rod, std::span<const Eigen::Vector3d> x_W, int i,
                      StencilTerm* term);
 
-/// The paper's small-deflection beam (model.beam: linear) at inner node i: EI / (2 h^3) |b|^2
-/// with b the lateral part, in the held frame, of x_{i+1} - 2 x_i + x_{i-1}. Its elements keep
-/// their length along the held axis (`AxialHoldEnergy` of element i), not their length: the
-/// paper's beam has no axial response and stretches as it deflects.
+/// The paper's small-deflection beam (model.beam: linear) at node i: EI / (2 h^3) |b|^2 with b
+/// the lateral part, in the held frame, of x_{i+1} - 2 x_i + x_{i-1} (at the grip, i = 0, of
+/// x_1 - x_0, with twice the weight). Its elements keep their length along the held axis
+/// (`AxialHoldEnergy` of element i), not their length: the paper's beam has no axial response
+/// and stretches as it deflects.
 double LinearBendingEnergy(const RodModel& rod, const Eigen::Matrix3d& R_WH,
                            std::span<const Eigen::Vector3d> x_W, int i, StencilTerm* term);
 double AxialHoldEnergy(const RodModel& rod, const Eigen::Matrix3d& R_WH,

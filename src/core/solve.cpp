@@ -23,6 +23,19 @@ double LargestMove(const Eigen::VectorXd& step) {
   return m;
 }
 
+// The largest fraction of a step that moves no node farther than it may go: half its clearance
+// from the parts, and at least the step cap (within which a point meets a part's penalty before
+// it could pass its middle).
+double StepFraction(const Model& model, const Scratch& s, const Eigen::VectorXd& step) {
+  double fraction = 1.0;
+  for (int k = 0; k < step.size() / 3; ++k) {
+    const double move = step.segment<3>(3 * k).norm();
+    const double may = std::max(model.solver.step_cap_m, 0.5 * s.clearance_m[std::size_t(k)]);
+    if (move > may) fraction = std::min(fraction, may / move);
+  }
+  return fraction;
+}
+
 // Factors H + (shift + lambda) I with the smallest lambda >= 0 (0, then growing from a small
 // fraction of the diagonal) that is positive definite. Returns lambda, or -1 if none was found.
 double FactorShifted(Scratch& s, double shift) {
@@ -73,7 +86,8 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
   if (lambda > 0.0) {
     const double curvature = NegativeCurvature(s, s.direction);
     if (curvature < 0.0) {
-      data.solve.indefinite = true;
+      // Balanced where the energy falls away: a saddle, the straight column past its load.
+      if (balanced) data.solve.indefinite = true;
       const double sign = s.direction.dot(s.gradient) > 0.0 ? -1.0 : 1.0;
       s.step += sign * (model.solver.step_cap_m / std::max(LargestMove(s.direction), 1e-300)) *
                 s.direction;
@@ -91,12 +105,11 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
 bool LineSearch(const Model& model, Data& data, double& energy) {
   Scratch& s = data.scratch;
   std::span<Vec3> trial(s.x_trial_W);
-  const double move = LargestMove(s.step);
-  double alpha = move > model.solver.step_cap_m ? model.solver.step_cap_m / move : 1.0;
+  double alpha = StepFraction(model, s, s.step);
   const double slope = s.gradient.dot(s.step);
   for (int halving = 0; halving < 8; ++halving, alpha *= 0.5) {
     s.unknowns_trial = s.unknowns + alpha * s.step;
-    NodesOf(model, data, s.unknowns_trial, trial);
+    NodesOf(model, s.unknowns_trial, trial);
     FindContacts(model, trial, data, Choices::kPending);
     // The first trial is taken most often: its derivatives are assembled with its energy.
     const double e = Assemble(model, data, trial, halving == 0);
@@ -136,7 +149,7 @@ void SolveEquilibrium(const Model& model, Data& data) {
     // stiff axial terms (their lengths cancel to ~1e-18 m): what is left is below any figure.
     if (!report.indefinite && -s.gradient.dot(s.step) < kDecrementFloor_J) {
       s.unknowns += s.step;
-      NodesOf(model, data, s.unknowns, x);
+      NodesOf(model, s.unknowns, x);
       FindContacts(model, x, data);
       energy = Assemble(model, data, x, true);
       report.converged = true;

@@ -34,7 +34,6 @@ bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand
   data.input.p_hand_W = p_hand;
   // A tube touching nothing moves with the hand as a rigid body, as far as one solve
   // iteration may move it: the solve then starts from where it will end.
-  const double h = model.rod.segment_m;
   const bool free = data.out.contact_count == 0 && s.sample_count == 0;
   if (free && hand_move.norm() <= model.solver.step_cap_m) {
     const Vec3 p_H = st.x_W[0];
@@ -43,7 +42,6 @@ bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand
   }
   st.R_WH = R_new;
   data.input.tangent_held_W = R_new.col(2);
-  st.x_W[1] = st.x_W[0] + h * data.input.tangent_held_W;
   data.solve = SolveReport{};
   std::fill(s.section_chosen.begin(), s.section_chosen.end(), 0);
   s.side_chosen_count = 0;
@@ -103,11 +101,13 @@ void WriteOutput(const Model& model, Data& data) {
 
   // The tube's elastic energy, strain and tip deflection.
   out.energy_J = BendingEnergyOf(model, data, st.x_W);
+  // Curvature: each node's turn over an element's length; the grip's over half of one.
   double turn = 0.0;
-  for (int i = 1; i < model.rod.elements; ++i) {
-    const Vec3 a = (st.x_W[std::size_t(i)] - st.x_W[std::size_t(i - 1)]).normalized();
+  for (int i = 0; i < model.rod.elements; ++i) {
+    const Vec3 a = i == 0 ? data.input.tangent_held_W
+                          : Vec3((st.x_W[std::size_t(i)] - st.x_W[std::size_t(i - 1)]).normalized());
     const Vec3 b = (st.x_W[std::size_t(i + 1)] - st.x_W[std::size_t(i)]).normalized();
-    turn = std::max(turn, std::atan2(a.cross(b).norm(), a.dot(b)));
+    turn = std::max(turn, (i == 0 ? 2.0 : 1.0) * std::atan2(a.cross(b).norm(), a.dot(b)));
   }
   out.max_strain = model.rod.outer_radius_m * turn / model.rod.segment_m;
   out.tip_deflection_m = TipDeflection(model, data);

@@ -463,9 +463,10 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
     std::string counted, current;
     int held = 0;
     for (int k = 1; !runner.Done(); ++k) {
-      // Held back from going through a part, the tube no longer follows the motion: it ends
+      // Stretched beyond the device's force, the tube no longer follows the motion: it ends
       // here, as the exploration's do (docs/graph.md).
-      if (core.Step(k * s.model.time_step_s, runner.Next(core.last())).flags & core::kHeldBack)
+      if (core.Step(k * s.model.time_step_s, runner.Next(core.last())).flags &
+          core::kProxySeparated)
         break;
       const std::string cf = core.FormationText();
       ++cf_ticks[cf];

@@ -74,7 +74,8 @@ TEST_CASE("The minimal scene of these tests is valid", "[scene]") {
   // No device or model section: the documented defaults.
   CHECK(loaded.scene->device.max_force_N == 8.5);
   CHECK_FALSE(loaded.scene->device.coupling_stiffness_N_per_m.has_value());
-  CHECK(loaded.scene->model.beam == tubeplan::model::BeamModel::kLinear);
+  CHECK(loaded.scene->model.tube == tubeplan::scene::TubeModel::kRod);
+  CHECK(loaded.scene->model.elements == 0);
   CHECK(loaded.scene->friction.exponent == 1.0);
 }
 
@@ -115,7 +116,7 @@ TEST_CASE("A good scene gives exactly its SI values", "[scene]") {
   CHECK(tubeplan::states::ToString(s.goal) == "{Fs - floor.top, Fs u wall.top_inner}");
   CHECK(s.device.coupling_stiffness_N_per_m == 400.0);
   CHECK(s.device.coupling_damping_Ns_per_m == 2.0);
-  CHECK(s.model.beam == tubeplan::model::BeamModel::kElastica);
+  CHECK(s.model.tube == tubeplan::scene::TubeModel::kRod);
   CHECK(s.model.time_step_s == 1e-3);
 }
 

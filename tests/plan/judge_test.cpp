@@ -321,8 +321,7 @@ TEST_CASE("Monte-Carlo robustness is the same for any --jobs", "[plan]") {
 
 }  // namespace
 
-TEST_CASE("Ticks beyond the linear range, held back or out of the segmented rule's range are timed",
-          "[plan]") {
+TEST_CASE("Ticks beyond the linear range or whose solve stopped short are timed", "[plan]") {
   // Synthetic ticks with no contact (the CF stays {}, the first planned state): 50 plain, 30
   // flagged beyond_linear, 20 plain. The transition {} -> {Fe - wall.xneg} is under way all along
   // and gets the 30 flagged ticks' time, 30 steps of 1 ms (summed: rounding only, 1e-12).
@@ -331,19 +330,15 @@ TEST_CASE("Ticks beyond the linear range, held back or out of the segmented rule
   const auto text = [] { return std::string("{}"); };
   for (int k = 0; k < 100; ++k) {
     out.flags = (k >= 50 && k < 80) ? core::kBeyondLinearRange : 0u;
-    // And 12 held back (core::kHeldBack), 5 of them among those 30: each flag is timed alone.
-    if (k >= 75 && k < 87) out.flags |= core::kHeldBack;
-    // And 7 with the segmented rule out of its range (core::kSegmentationOff), all among the
-    // held ones.
-    if (k >= 78 && k < 85) out.flags |= core::kSegmentationOff;
+    // And 12 whose solve stopped short (core::kNotConverged), 5 of them among those 30: each
+    // flag is timed alone.
+    if (k >= 75 && k < 87) out.flags |= core::kNotConverged;
     judging.Tick(1e-3 * (k + 1), out, text);
   }
   const plan::Judgement j = judging.Finish();
   REQUIRE(j.transitions.size() == 1);
   CHECK(j.transitions[0].beyond_linear_s == Approx(0.030).margin(1e-12));
-  CHECK(j.transitions[0].held_s == Approx(0.012).margin(1e-12));
-  CHECK(j.transitions[0].segmentation_off_s == Approx(0.007).margin(1e-12));
-  CHECK(j.transitions[0].shape_off_s == 0.0);
+  CHECK(j.transitions[0].unconverged_s == Approx(0.012).margin(1e-12));
   CHECK(j.transitions[0].verdict == plan::Verdict::kInfeasible);
 }
 
