@@ -218,6 +218,14 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
+    // A share that fades: its change moves the energy too.
+    if (smp.weight_nodes > 0) {
+      StencilTerm t;
+      t.first = smp.weight_first;
+      t.nodes = smp.weight_nodes;
+      t.gradient = 0.5 * K * depth * depth * smp.weight_gradient;
+      a.AddStencil(t);
+    }
   }
 
   // Friction: a spring from each friction point to its anchor in the tangent plane, stiffness

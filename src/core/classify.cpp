@@ -29,7 +29,7 @@ struct Gathered {
 // the face).
 TubeElement TubeElementOf(const Model& model, const Data& data, const Sample& s) {
   switch (s.kind) {
-    case SampleKind::kSection:
+    case SampleKind::kNode:
     case SampleKind::kSide:
       return TubeElement::kSide;
     case SampleKind::kEndFace:

@@ -33,6 +33,9 @@ void ClosestSegmentPoints(const Vec3& p0, const Vec3& p1, const Vec3& q0, const 
   }
 }
 
+// Where a node's sphere stops standing for the side: |n.t| from kCapStart, over kCapFade.
+constexpr double kCapStart = 0.3, kCapFade = 0.2;
+
 // Smooth step from 0 at a = 0 to 1 at a = 1.
 double SmoothStep(double a) {
   a = std::clamp(a, 0.0, 1.0);
@@ -58,11 +61,10 @@ class Finder {
             std::min(s.clearance_m[std::size_t(i)],
                      part.geometry.Distance(x_[std::size_t(i)], Entry(p, i)).distance_m -
                          m_.rod.outer_radius_m);
-      // The side's sections at the inner nodes, the free end's rim, the side between nodes
-      // against the part's edges, the end face against its vertices.
-      for (int i = 1; i < n_; ++i) Section(p, part, i);
-      Rim(p, part);
+      // The side at the inner nodes and between them, the free end's rim and end face.
+      for (int i = 1; i < n_; ++i) Node(p, part, i);
       for (int i = 0; i < n_; ++i) Side(p, part, i);
+      Rim(p, part);
       EndFace(p, part);
     }
   }
@@ -81,10 +83,10 @@ class Finder {
     return &s.samples[std::size_t(s.sample_count++)];
   }
 
-  void Record(SampleKind kind, int part, int node, int feature, double theta, double weight,
-              const PartDistance& dist, const MaterialPoint& mp, const Vec3& moving_offset_W) {
+  Sample* Record(SampleKind kind, int part, int node, int feature, double theta, double weight,
+                 const PartDistance& dist, const MaterialPoint& mp, const Vec3& moving_offset_W) {
     Sample* smp = Add();
-    if (smp == nullptr) return;
+    if (smp == nullptr) return nullptr;
     smp->kind = kind;
     smp->part = part;
     smp->node = node;
@@ -98,7 +100,10 @@ class Finder {
     smp->point_W = mp.point_W;
     smp->offset_W = mp.offset_W;
     smp->moving_offset_W = moving_offset_W;
+    smp->weight_gradient.setZero();
+    smp->weight_nodes = 0;
     smp->normal_force_N = 0.0;
+    return smp;
   }
 
   // The point of a section circle (centre c, unit axis t, radius r) nearest the part: where the
@@ -110,12 +115,12 @@ class Finder {
     if (rho.norm() < 1e-12) rho = t.unitOrthogonal();
     rho.normalize();
     PartDistance at = part.geometry.Distance(c, entry);
-    for (int k = 0; k < 8; ++k) {
+    for (int k = 0; k < 16; ++k) {
       Vec3 g = -(at.normal_W - at.normal_W.dot(t) * t);
       const double lg = g.norm();
       if (lg < 1e-9) break;  // the section faces the part squarely: every point is as near
       g /= lg;
-      const bool settled = (g - rho).norm() < 1e-10;
+      const bool settled = (g - rho).norm() < 1e-12;
       rho = g;
       if (settled) break;
       at = part.geometry.Distance(c + r * rho, entry);
@@ -148,18 +153,34 @@ class Finder {
     }
   }
 
-  void Section(int p, const PartModel& part, int i) {
+  // The side surface at inner node i: the sphere of radius r1 about the node, the capsule
+  // chain's surface there. It stands for the side where the part lies across the tube (the
+  // distance's gradient n about square to the tangent t); where n turns towards the tangent, the
+  // sphere's cap is within the neighbouring elements or past the tube's end, and its share of K
+  // fades out between |n.t| = 0.3 and 0.5 (past a bend of 35 deg at one node). A side along a
+  // face or an edge bears on every node near it.
+  void Node(int p, const PartModel& part, int i) {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& c = x_[std::size_t(i)];
-    const std::uint8_t entry = Entry(p, i);
-    if (part.geometry.Distance(c, entry).distance_m - r1 >= eps) return;
-    const Vec3 t = CarrierTangent(Carrier::kInnerNode, x_, i);
-    Vec3 rho, side;
-    SectionFrame(part, p, i, c, t, entry, rho, side);
-    const MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, r1 * rho, false);
-    const PartDistance at = part.geometry.Distance(mp.point_W, entry);
-    if (at.distance_m >= eps) return;
-    Record(SampleKind::kSection, p, i, 0, 0.0, 1.0, at, mp, r1 * rho);
+    PartDistance at = part.geometry.Distance(c, Entry(p, i));
+    if (at.distance_m - r1 >= eps) return;
+    MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), true);
+    const double along = at.normal_W.dot(mp.tangent_W);
+    const double x = (std::abs(along) - kCapStart) / kCapFade;
+    const double weight = 1.0 - SmoothStep(x);
+    if (weight <= 0.0) return;
+    at.distance_m -= r1;
+    mp.offset_W = -r1 * at.normal_W;
+    mp.point_W += mp.offset_W;
+    Sample* smp = Record(SampleKind::kNode, p, i, 0, 0.0, weight, at, mp, Vec3::Zero());
+    if (smp != nullptr && x > 0.0 && x < 1.0) {
+      // d |n.t| = sign (t^T C dx_i + n^T dt), C the distance's curvature at the node.
+      const double slope = -6.0 * x * (1.0 - x) / kCapFade * (along < 0.0 ? -1.0 : 1.0);
+      smp->weight_gradient = slope * (mp.tangent_jacobian.transpose() * at.normal_W);
+      smp->weight_gradient.segment<3>(3) += slope * (at.curvature_per_m * mp.tangent_W);
+      smp->weight_first = i - 1;
+      smp->weight_nodes = 3;
+    }
   }
 
   void Rim(int p, const PartModel& part) {
@@ -182,75 +203,86 @@ class Finder {
     }
   }
 
-  // Where along element i its point nearest edge e lies: found when first met in the tick, then
-  // kept for the tick. False when the element does not pass the edge (or there is no room).
-  bool SidePosition(int p, int i, int e, const Vec3& a, const Vec3& b, const PartEdge& edge,
-                    double& theta) {
-    Scratch& s = d_.scratch;
-    for (int k = 0; k < s.side_chosen_count; ++k) {
-      const Scratch::SideChoice& c = s.side_chosen[std::size_t(k)];
-      if (c.part == p && c.element == i && c.edge == e) {
-        theta = c.theta;
-        return true;
-      }
-    }
-    double u = 0.0;
-    ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
-    if (!(theta > 0.0 && theta < 1.0)) return false;
-    auto& list = keep_ ? s.side_chosen : s.side_pending;
-    int& count = keep_ ? s.side_chosen_count : s.side_pending_count;
-    if (count == int(list.size())) {
-      s.samples_truncated = true;
-      return false;
-    }
-    list[std::size_t(count++)] = {p, i, e, theta};
-    return true;
-  }
-
+  // The side surface between nodes i and i + 1, a cylinder, against the part's edges: where the
+  // element's axis comes nearest an edge (or a vertex it ends in) inside the element, and that
+  // edge is the part's nearest feature there. Its share of K fades out towards the nodes, whose
+  // spheres carry it there, and as the element turns parallel to the edge (the spheres then are
+  // as near): the share's derivatives go into the gradient with it.
   void Side(int p, const PartModel& part, int i) {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
-    const double h = m_.rod.segment_m;
     const Vec3& a = x_[std::size_t(i)];
     const Vec3& b = x_[std::size_t(i + 1)];
-    const Vec3 mid = 0.5 * (a + b);
-    const std::uint8_t entry = Entry(p, i);
-    if (part.geometry.Distance(mid, entry).distance_m - 0.5 * (b - a).norm() - r1 >= eps) return;
-    // Between nodes an edge of the part can come nearer than both sections. The point's share of
-    // K fades out towards the nodes, whose sections carry it there.
-    const double ramp_m = std::min(0.25 * r1, 0.5 * h);
-    const auto& edges = part.geometry.edges();
     const Vec3 lo = a.cwiseMin(b).array() - (r1 + eps), hi = a.cwiseMax(b).array() + (r1 + eps);
+    const Vec3 v = b - a;
+    const double ramp = std::min(0.25 * r1, 0.5 * m_.rod.segment_m) / v.norm();  // in theta
+    const auto& edges = part.geometry.edges();
     for (int e = 0; e < int(edges.size()); ++e) {
       const PartEdge& edge = edges[std::size_t(e)];
       if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
         continue;
-      double theta = 0.0;
-      if (!SidePosition(p, i, e, a, b, edge, theta)) continue;
-      const Vec3 c = a + theta * (b - a);
+      double theta = 0.0, u = 0.0;
+      ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
+      if (!(theta > 0.0 && theta < 1.0)) continue;
+      const Vec3 c = a + theta * v;
       const Vec3 ab = edge.b_W - edge.a_W;
-      const double u = std::clamp((c - edge.a_W).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
       const Vec3 q = edge.a_W + u * ab;
       const Vec3 w = c - q;
       const double lw = w.norm();
       if (!(lw - r1 < eps) || lw == 0.0) continue;
-      const double weight = SmoothStep(std::min(theta, 1.0 - theta) * (b - a).norm() / ramp_m);
+      const PartDistance axis = part.geometry.Distance(c, Entry(p, i));
+      if (axis.distance_m > 0.0 && ((axis.face_mask & edge.face_mask) != edge.face_mask ||
+                                    std::popcount(unsigned(axis.face_mask)) < 2))
+        continue;
+      // The share: s(theta) towards the nodes, times s(sin^2 phi / sin^2 20 deg) for the angle
+      // phi between the element and the edge (1 against a vertex, a point).
+      const bool on_line = u > 0.0 && u < 1.0;
+      const double near_node = std::min(theta, 1.0 - theta) / ramp;
+      const double along = SmoothStep(near_node);
+      double across = 1.0;
+      Vec3 d_across_dv = Vec3::Zero();
+      if (on_line) {
+        constexpr double kSin2Fade = 0.116977778440511;  // sin^2 20 deg
+        const Vec3 unit = ab.normalized();
+        const Vec3 cross = v.cross(unit);
+        const double sin2 = cross.squaredNorm() / v.squaredNorm();
+        across = SmoothStep(sin2 / kSin2Fade);
+        const double x = std::clamp(sin2 / kSin2Fade, 0.0, 1.0);
+        const Vec3 d_sin2_dv = 2.0 * unit.cross(cross) / v.squaredNorm() -
+                               2.0 * cross.squaredNorm() * v / (v.squaredNorm() * v.squaredNorm());
+        d_across_dv = 6.0 * x * (1.0 - x) / kSin2Fade * d_sin2_dv;
+      }
+      const double weight = along * across;
       if (weight <= 0.0) continue;
-      // The edge, or the vertex it ends in.
-      const std::uint8_t mask = u == 0.0 ? edge.a_mask : u == 1.0 ? edge.b_mask : edge.face_mask;
+      // d theta / d (a, b): theta = -(v^T P w0) / (v^T P v), w0 = a - q, P the projector across
+      // the edge's line (the identity for a vertex).
+      Eigen::Matrix3d P = Eigen::Matrix3d::Identity();
+      if (on_line) P -= ab * ab.transpose() / ab.squaredNorm();
+      const Vec3 w0 = a - q, Pv = P * v, Pw0 = P * w0;
+      const double num = -v.dot(Pw0), den = v.dot(Pv);
+      const Vec3 d_theta_a = ((Pw0 - Pv) * den + 2.0 * num * Pv) / (den * den);
+      const Vec3 d_theta_b = (-Pw0 * den - 2.0 * num * Pv) / (den * den);
+      const double d_along =
+          near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) / ramp * (theta < 0.5 ? 1.0 : -1.0)
+                          : 0.0;
       PartDistance at;
       at.distance_m = lw - r1;
       at.normal_W = w / lw;
       at.point_W = q;
-      at.face_mask = mask;
-      at.curvature_per_m = Eigen::Matrix3d::Identity() - at.normal_W * at.normal_W.transpose();
-      if (u > 0.0 && u < 1.0) at.curvature_per_m -= ab * ab.transpose() / ab.squaredNorm();
-      at.curvature_per_m /= lw;
-      // The distance moves with the axis point alone; the surface point is r1 from it towards
-      // the edge.
+      // The edge, or the vertex it ends in.
+      at.face_mask = u == 0.0 ? edge.a_mask : u == 1.0 ? edge.b_mask : edge.face_mask;
+      at.curvature_per_m = (P - at.normal_W * at.normal_W.transpose()) / lw;
+      // The distance moves with the axis point alone (the nearest point's own motion along the
+      // axis and the edge changes it only to second order); the surface point is r1 from it.
       MaterialPoint mp = Material(Carrier::kElement, x_, i, theta, Vec3::Zero(), false);
       mp.offset_W = -r1 * at.normal_W;
       mp.point_W += mp.offset_W;
-      Record(SampleKind::kSide, p, i, e, theta, weight, at, mp, Vec3::Zero());
+      Sample* smp = Record(SampleKind::kSide, p, i, e, theta, weight, at, mp, Vec3::Zero());
+      if (smp != nullptr) {
+        smp->weight_gradient.segment<3>(0) = across * d_along * d_theta_a - along * d_across_dv;
+        smp->weight_gradient.segment<3>(3) = across * d_along * d_theta_b + along * d_across_dv;
+        smp->weight_first = i;
+        smp->weight_nodes = 2;
+      }
     }
   }
 
@@ -315,7 +347,6 @@ void FindPartsNear(const Model& model, std::span<const Vec3> x_W, double reach_m
 
 void FindContacts(const Model& model, std::span<const Vec3> x_W, Data& data, Choices choices) {
   data.scratch.section_pending_count = 0;
-  data.scratch.side_pending_count = 0;
   // The parts within reach of the nodes and of the next iteration's move.
   FindPartsNear(model, x_W, model.solver.step_cap_m, data);
   Finder(model, x_W, data, choices).Run();
@@ -329,9 +360,7 @@ void CommitContactChoices(Data& data) {
     s.section_side_W[c.index] = c.side_W;
     s.section_chosen[c.index] = 1;
   }
-  for (int k = 0; k < s.side_pending_count && s.side_chosen_count < int(s.side_chosen.size()); ++k)
-    s.side_chosen[std::size_t(s.side_chosen_count++)] = s.side_pending[std::size_t(k)];
-  s.section_pending_count = s.side_pending_count = 0;
+  s.section_pending_count = 0;
 }
 
 }  // namespace tubeplan::core

@@ -50,7 +50,10 @@ bool StateFinite(const Data& d) {
 int ElementCount(const scene::Scene& scene) {
   constexpr int kDefault = 24;
   const int n = scene.model.elements > 0 ? scene.model.elements : kDefault;
-  return std::clamp(n, kMinElementCount, kMaxElementCount);
+  // Elements at least r1 long: the side's sphere at the last inner node then stays within the
+  // end face (docs/core.md, "Contact points").
+  const int longest = int(scene.tube.length_m / scene.tube.outer_radius_m);
+  return std::clamp(std::min(n, longest), kMinElementCount, kMaxElementCount);
 }
 
 void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
@@ -72,7 +75,6 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.scratch.entry_seen.assign(parts * nodes, 0);
   d.scratch.section_chosen.assign(parts * nodes, 0);
   d.scratch.section_side_W.assign(parts * nodes, Eigen::Vector3d::Zero());
-  d.scratch.side_chosen_count = 0;
   // The tube straight along the held end's z, the hand at the held end.
   for (int k = 0; k <= n; ++k)
     d.state.x_W[std::size_t(k)] =

@@ -19,24 +19,28 @@ namespace tubeplan::core {
 
 /// Where on the tube a contact point is.
 enum class SampleKind : std::uint8_t {
-  kSection,  ///< the side surface's section circle at an inner node
+  kNode,     ///< the side surface at an inner node (the capsule chain's sphere there)
   kRim,      ///< the free end's rim
   kSide,     ///< the side surface between two nodes, against a part's edge
   kEndFace,  ///< the free end's face, against a part's vertex
 };
 
 /// One contact point between the tube's surface and a part. The point is a material point of the
-/// section at `node` (kSection, kRim, kEndFace) or of the element from `node` (kSide), offset
+/// section at `node` (kNode, kRim, kEndFace) or of the element from `node` (kSide), offset
 /// from the centreline by `offset_W`; its distance moves with the material point whose offset
 /// was `moving_offset_W` (Material), whose derivatives the assembly takes.
 struct Sample {
-  SampleKind kind = SampleKind::kSection;
+  SampleKind kind = SampleKind::kNode;
   std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
   int part = 0;                ///< index into Model::parts
   int node = 0;                ///< the section's node, or the segment's first node
   int feature = 0;             ///< ring position (kRim), edge (kSide) or vertex (kEndFace)
   double theta = 0.0;          ///< position along the segment (kSide), 0..1
   double weight = 1.0;         ///< share of K it carries
+  /// d weight / d nodes from weight_first on (two or three): a share that fades moves with them.
+  Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  int weight_first = 0;
+  int weight_nodes = 0;
   double distance_m = 0.0;     ///< signed distance d of the point to the part
   /// The distance its contact presses by: its own, or for the rim's points on one part their
   /// smooth minimum (Assemble), so that every contact's force is K (eps - this).
@@ -58,7 +62,7 @@ struct Sample {
 /// The rod carrier of a contact point of this kind.
 inline Carrier CarrierOf(SampleKind kind) {
   switch (kind) {
-    case SampleKind::kSection:
+    case SampleKind::kNode:
       return Carrier::kInnerNode;
     case SampleKind::kSide:
       return Carrier::kElement;
@@ -71,7 +75,7 @@ inline Carrier CarrierOf(SampleKind kind) {
 
 /// Friction carried by one contact point: its anchor on the part and whether it sticks.
 struct FrictionPoint {
-  SampleKind kind = SampleKind::kSection;
+  SampleKind kind = SampleKind::kNode;
   int part = 0;
   int node = 0;
   int feature = 0;
@@ -121,18 +125,11 @@ struct Scratch {
   std::vector<double> clearance_m;
   double far_clearance_m = 0.0;
   std::vector<std::uint8_t> entry_seen;  ///< per (part, node): a contact point there this tick
-  /// Where on the tube each contact point sits is chosen once a tick, when it is first found, and
-  /// kept for the tick's iterations (so that the potential they minimise does not change under
-  /// them): per (part, node), whether its section's direction is this tick's; and the side's
-  /// points found so far (part, element, edge, position along the element).
+  /// Where the rim's points sit is chosen once a tick, when the rim first meets a part, and kept
+  /// for the tick's iterations (so that the potential they minimise does not change under them):
+  /// per (part, node), whether its direction is this tick's, and tangent x direction then.
   std::vector<std::uint8_t> section_chosen;
-  std::vector<Eigen::Vector3d> section_side_W;  ///< tangent x direction, when it was chosen
-  struct SideChoice {
-    int part = 0, element = 0, edge = 0;
-    double theta = 0.0;
-  };
-  std::array<SideChoice, 128> side_chosen{};
-  int side_chosen_count = 0;
+  std::vector<Eigen::Vector3d> section_side_W;
   /// Choices a trial point of the line search made, kept if the point is taken.
   struct SectionChoice {
     std::size_t index = 0;
@@ -140,8 +137,6 @@ struct Scratch {
   };
   std::array<SectionChoice, 128> section_pending{};
   int section_pending_count = 0;
-  std::array<SideChoice, 128> side_pending{};
-  int side_pending_count = 0;
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
 };

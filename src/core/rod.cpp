@@ -58,7 +58,8 @@ double BendingEnergy(const RodModel& rod, const Vec3& t_H, std::span<const Vec3>
       term->hessian.block<3, 3>(0, 3) = -H;
       term->hessian.block<3, 3>(3, 0) = -H;
     }
-    return c * (1.0 - cos_phi);
+    // 1 - cos phi as |t - b|^2 / 2: no cancellation when the angle is small.
+    return 0.5 * c * (t_H - b).squaredNorm();
   }
   const double c = rod.bending_stiffness_Nm2 / rod.segment_m;
   const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
@@ -78,7 +79,8 @@ double BendingEnergy(const RodModel& rod, const Vec3& t_H, std::span<const Vec3>
     term->first = i - 1;
     EdgesToNodes(-c * dge_de, -c * dge_df, -c * dgf_df, -c * ge, -c * gf, *term);
   }
-  return c * (1.0 - cos_phi);
+  // 1 - cos phi as |a - b|^2 / 2: no cancellation when the angle is small.
+  return 0.5 * c * (a - b).squaredNorm();
 }
 
 double StretchEnergy(const RodModel& rod, std::span<const Vec3> x_W, int i, StencilTerm* term) {
@@ -253,6 +255,7 @@ MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double
   const double along = t.dot(offset0_W);
   for (int k = 0; k < mp.nodes; ++k) {
     const Mat3& T = dt[std::size_t(k)];
+    mp.tangent_jacobian.block<3, 3>(0, 3 * k) = T;
     mp.jacobian.block<3, 3>(0, 3 * k) =
         dc[std::size_t(k)] * Mat3::Identity() -
         scale * (along * across * T + t * (T.transpose() * offset0_W).transpose());

@@ -58,6 +58,8 @@ struct MaterialPoint {
   int first = 0;                                       ///< first node of the stencil
   int nodes = 0;
   Eigen::Matrix<double, 3, 9> jacobian = Eigen::Matrix<double, 3, 9>::Zero();
+  /// d tangent / d nodes of the stencil.
+  Eigen::Matrix<double, 3, 9> tangent_jacobian = Eigen::Matrix<double, 3, 9>::Zero();
 };
 
 /// The tangent at a carrier (unit).

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "core/assemble.hpp"
 #include "core/contacts.hpp"
@@ -159,7 +157,6 @@ void SolveEquilibrium(const Model& model, Data& data) {
     // steps, shorter and nearer the gradient (Levenberg-Marquardt), from the contact stiffness
     // up.
     bool moved = LineSearch(model, data, energy);
-    if (std::getenv("TP_DEBUG")) std::fprintf(stderr, "  it %d E=%.17g res=%.3e moved=%d samples=%d fp=%d\n", report.iterations, energy, report.residual_N, moved, s.sample_count, data.state.friction_count);
     for (double damping = model.contact.stiffness_N_per_m; !moved && damping < 1e5 * model.contact.stiffness_N_per_m; damping *= 10.0) {
       if (NewtonStep(model, data, damping) != Outcome::kStep) break;
       moved = LineSearch(model, data, energy);

@@ -44,7 +44,6 @@ bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand
   data.input.tangent_held_W = R_new.col(2);
   data.solve = SolveReport{};
   std::fill(s.section_chosen.begin(), s.section_chosen.end(), 0);
-  s.side_chosen_count = 0;
   data.out.flags = 0;
   return true;
 }

@@ -172,3 +172,42 @@ TEST_CASE("A frictionless side wall at the tip: 3EI/l^3 in series, a small-defle
     x_prev = x_m;
   }
 }
+
+TEST_CASE("The side on a frictionless edge at distance a: 3EI/a^3 in series, convex", "[core]") {
+  // The steel tube along +z; a box below it whose top edge (along y) crosses under the tube at
+  // a = 2l/3 from the grip, eps / 2 below its surface: a lateral point load at a, the rest of the
+  // tube free beyond it.
+  scene::Scene s = SteelScene();
+  const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  const double a = 2.0 * l / 3.0;
+  s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
+  scene::BoxPart edge = Box("edge", {0.02, 0.1, 0.02}, {0.0, 0.0, 0.0});
+  // Turned 45 deg about y: its edge along y, pointing at the tube (-x).
+  edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  edge.X_WP.translation() = Eigen::Vector3d(-(r1 + 0.5 * eps) - 0.01 * std::sqrt(2.0), 0.0, a);
+  s.parts.push_back(edge);
+  core::Core c(s);
+  const double k_side = 3.0 * EI(s) / (a * a * a);
+  const double k_series = 1.0 / (1.0 / 400.0 + 1.0 / s.contact.stiffness_N_per_m + 1.0 / k_side);
+  double t = 0.0, F_prev = 0.0, x_prev = 0.0;
+  for (const double x_m : {-1e-3, -2e-3, -3e-3}) {
+    Eigen::Isometry3d X = s.X_WH_start;
+    X.translation().x() = x_m;
+    const core::StepOutput& out = MoveTo(c, X, 200, 300, t);
+    INFO(c.FormationText());
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    CHECK(pc.tube == states::TubeElement::kSide);
+    CHECK(c.elements()[std::size_t(pc.part_element)].name == "edge.top_xneg");
+    // The tube bends round the edge: its convex side meets it.
+    CHECK(pc.marker == states::Marker::kConvex);
+    CHECK(pc.s_m == Approx(a).margin(1e-3));
+    if (F_prev > 0.0) {
+      const double k = (out.force_W_N.x() - F_prev) / (x_prev - x_m);
+      // 1 %: as the tip's test; the load point is found along an element, not at a node.
+      CHECK(k == Approx(k_series).epsilon(0.01));
+    }
+    F_prev = out.force_W_N.x();
+    x_prev = x_m;
+  }
+}
