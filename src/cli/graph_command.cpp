@@ -55,9 +55,10 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   const nlohmann::json report =
       text ? nlohmann::json::parse(*text, nullptr, false) : nlohmann::json();
   std::vector<graph::ReplayedPlan> plans;
-  bool ok = text && !report.is_discarded() && report.is_object() &&
-            report.value("tubeplan_evaluate", 0) == 1 && report.contains("plans") &&
-            report["plans"].is_array();
+  bool ok =
+      text && !report.is_discarded() && report.is_object() &&
+      (report.value("tubeplan_evaluate", 0) == 1 || report.value("tubeplan_evaluate", 0) == 2) &&
+      report.contains("plans") && report["plans"].is_array();
   for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
     const nlohmann::json& p = report["plans"][i];
     graph::ReplayedPlan r;
@@ -85,7 +86,7 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   if (!ok) {
     err << path
         << ": error: not a readable tubeplan evaluate report, expected the JSON that "
-           "`tubeplan evaluate --report` writes (version 1)\n";
+           "`tubeplan evaluate --report` writes (version 1 or 2)\n";
     return std::nullopt;
   }
   return plans;

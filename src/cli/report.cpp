@@ -1,14 +1,36 @@
 #include "report.hpp"
 
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
 #include <iomanip>
 
 #include <tubeplan/plan/perturb.hpp>
 
 namespace tubeplan::cli {
 
-// A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
-// merge of shard reports is the report of the unsharded run.
-nlohmann::json Report(nlohmann::json plans) {
+std::string CanonicalPlanPath(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  return (ec ? absolute.lexically_normal() : canonical).string();
+}
+
+std::string PlanSetId(std::vector<std::string> canonical_paths) {
+  std::sort(canonical_paths.begin(), canonical_paths.end());
+  std::uint64_t h = 1469598103934665603ull;
+  for (const std::string& path : canonical_paths) {
+    for (const unsigned char c : path) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ static_cast<unsigned char>('\n')) * 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+// A report's plans in file order, what it covers and its summary: what both `evaluate` and
+// `merge` write, so a merge of shard reports is the report of the unsharded run.
+nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
   std::stable_sort(plans.begin(), plans.end(),
                    [](const nlohmann::json& a, const nlohmann::json& b) {
                      return a["file"].get<std::string>() < b["file"].get<std::string>();
@@ -18,11 +40,13 @@ nlohmann::json Report(nlohmann::json plans) {
   const long count = static_cast<long>(plans.size());
   return {
       {"tubeplan_evaluate", kEvaluateJsonVersion},
+      {"plan_set", {{"id", scope.plan_set_id}, {"plans", scope.plan_set_plans}}},
+      {"shard", {{"index", scope.shard_index}, {"count", scope.shard_count}}},
       {"plans", plans},
       {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
 }
 
-nlohmann::json ToJson(const std::vector<Evaluated>& results) {
+nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope) {
   nlohmann::json plans = nlohmann::json::array();
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
@@ -62,7 +86,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
   }
-  return Report(std::move(plans));
+  return Report(std::move(plans), scope);
 }
 
 void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
