@@ -3,6 +3,7 @@
 // the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
 // JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <map>
@@ -12,6 +13,7 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <unistd.h>
 #include <variant>
 
 #include <nlohmann/json.hpp>
@@ -42,7 +44,8 @@ struct GraphOptions {
   std::uint64_t seed = 1;
   int random = 120;
   int budget = 3000;
-  int jobs = 0;  // 0: the machine's cores
+  double time_limit_s = 0.0;  // 0: none
+  int jobs = 0;               // 0: the machine's cores
   std::string weights;
   std::optional<double> tolerance;
   std::string verdicts_path;  // graph only: an evaluate report
@@ -152,13 +155,28 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
   explore.seed = o.seed;
   explore.random_motions = o.random;
   explore.max_motions = o.budget;
+  explore.time_limit_s = o.time_limit_s;
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  // Progress on a terminal only, about once a second, on one line (a log stays clean).
+  if (isatty(STDERR_FILENO) != 0) {
+    explore.status = [&io, path = o.scene_path](const graph::ExploreStatus& st) {
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "\rexploring %s: %s, %d motions done, %d started; the graph so far %d CFs, "
+                    "%d transitions; %.0f s\033[K",
+                    path.c_str(), st.phase.c_str(), st.motions_done, st.motions_started, st.nodes,
+                    st.arcs, st.seconds);
+      io.err << line << std::flush;
+    };
+  }
   std::optional<std::vector<graph::ReplayedPlan>> verdicts;
   if (!o.verdicts_path.empty()) {
     verdicts = ReadVerdicts(o.verdicts_path, io.err);
     if (!verdicts) return kExitBadInput;
   }
   graph::ContactGraph g = graph::Explore(s, explore);
+  if (explore.status) io.err << "\r\033[K" << std::flush;
+  explore.status = nullptr;
   graph::Prune(g, weights);
   if (verdicts) graph::ApplyVerdicts(g, *verdicts);
   return Built{s, std::move(g), explore, weights};
@@ -172,9 +190,15 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,
-                  "stop after this many motions in all, saturated or not (said in the output)")
+                  "run at most this many motions in all (a motion: one list of guarded moves of "
+                  "the hand from the start pose; docs/graph.md), saturated or not (said in the "
+                  "output)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  sub->add_option("--time-limit", o.time_limit_s,
+                  "stop exploring after this many seconds of wall time, saturated or not (said in "
+                  "the output; default: no limit)")
+      ->check(CLI::Range(0.001, 1e7));
   sub->add_option("--jobs", o.jobs, "threads (default: the machine's cores)")
       ->check(CLI::Range(1, 256));
   sub->add_option("--weights", o.weights,
@@ -261,11 +285,17 @@ int RunGraph(const GraphOptions& o, Streams io) {
       << kProbes << " small motions (" << explore.probe_step_m * 1e3
       << " mm along and against 3 directions, " << explore.probe_turn_rad * 180.0 / std::numbers::pi
       << " deg about 2 axes), the last round found no new state)\n";
+  } else if (g.end == graph::ExploreEnd::kTimeLimit) {
+    t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
+      << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
+      << " states probed)\n";
   } else {
-    t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out with "
+    t << "  (NOT saturated: stopped by the budget of " << explore.max_motions << " motions, with "
       << g.probed << " of " << g.nodes.size() << " states probed)\n";
   }
-  t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
+  t << "start "
+    << (g.start >= 0 ? g.nodes[std::size_t(g.start)].cf : "not reached (no motion ended)")
+    << "; goal " << states::ToString(s.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
   t << "part elements touched: " << g.reached_elements.size()
     << "; never touched: " << g.unreached_elements.size();

@@ -13,6 +13,7 @@
 
 #include <tubeplan/cli/app.hpp>
 
+#include "../scratch.hpp"
 #include "run_tool.hpp"
 
 namespace {
@@ -77,6 +78,27 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
 }
 
 }  // namespace
+
+TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli]") {
+  Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "1", "--jobs", "2"});
+  CHECK(r.exit_code == 1);  // one sweep does not reach the goal
+  CHECK(r.out.find(" from 1 motions (1 sweep)") != std::string::npos);
+  CHECK(r.out.find("(NOT saturated: stopped by the budget of 1 motions, with 0 of ") !=
+        std::string::npos);
+  CHECK(r.out.find("(saturated") == std::string::npos);
+  // A limit shorter than any motion: nothing explored, said so, and no crash on the empty graph.
+  r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--time-limit", "0.001", "--json",
+               tubeplan::testing::ScratchDir("graph-limit").string() + "/g.json"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("(NOT saturated: stopped by the time limit of 0.001 s after 0 motions") !=
+        std::string::npos);
+  CHECK(r.out.find("start not reached (no motion ended)") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(
+      tubeplan::testing::Slurp(tubeplan::testing::ScratchDir("graph-limit") / "g.json"));
+  CHECK(j["stats"]["ended_by"] == "time_limit");
+  CHECK(j["parameters"]["time_limit_s"] == 0.001);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("graph-limit"));
+}
 
 TEST_CASE("beam --json reports the cantilever's analytic tip figures", "[cli]") {
   const Outcome r = RunTool(Beam({"--tip-force", "0.5 N", "--json", "--at", "0,0,300 mm"}));
