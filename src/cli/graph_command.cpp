@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <memory>
@@ -19,8 +20,10 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/motion.hpp>
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
@@ -131,7 +134,11 @@ struct Built {
 };
 
 // Loads the scene, explores and prunes; on bad input reports and returns the exit code.
-std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
+// `before` (may be empty) sees the scene before the exploration and may end the command there
+// with an exit code.
+std::variant<Built, int> BuildGraph(
+    const GraphOptions& o, Streams io,
+    const std::function<std::optional<int>(const scene::Scene&)>& before = {}) {
   io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
   io.err << loaded.diagnostics.FormatAll();
   if (!loaded.scene) return kExitBadInput;
@@ -174,6 +181,8 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
     verdicts = ReadVerdicts(o.verdicts_path, io.err);
     if (!verdicts) return kExitBadInput;
   }
+  if (before)
+    if (const std::optional<int> code = before(s)) return *code;
   graph::ContactGraph g = graph::Explore(s, explore);
   if (explore.status) io.err << "\r\033[K" << std::flush;
   explore.status = nullptr;
@@ -352,10 +361,29 @@ int RunPlans(const PlansOptions& o, Streams io) {
               "--speed above 0 and at most 1 m/s\n";
     return kExitBadInput;
   }
-  std::variant<Built, int> built = BuildGraph(o.graph, io);
+  // A goal the tube starts in leaves nothing to plan: said before any exploration.
+  const auto nothing_to_plan = [&](const scene::Scene& s, const std::string& start) {
+    io.err << o.graph.scene_path << ": nothing to plan: the goal " << states::ToString(s.goal)
+           << " is the state the tube starts in (" << start
+           << " at the scene's start pose), so a plan would be that one state and no move; no "
+              "plan written. Give the scene a goal the tube has to be moved to\n";
+    return kExitNegative;
+  };
+  std::variant<Built, int> built =
+      BuildGraph(o.graph, io, [&](const scene::Scene& s) -> std::optional<int> {
+        core::Core core(s);
+        core.Reset(graph::MotionStart(s));
+        core.Step(s.model.time_step_s, graph::MotionStart(s));
+        const std::string start = core.FormationText();
+        if (start != states::ToString(s.goal)) return std::nullopt;
+        return nothing_to_plan(s, start);
+      });
   if (const int* code = std::get_if<int>(&built)) return *code;
   const Built& b = std::get<Built>(built);
   const graph::ContactGraph& g = b.graph;
+  // The explorer's start state can differ from a tick at rest (its first tick moves the hand).
+  if (g.goal >= 0 && g.goal == g.start)
+    return nothing_to_plan(b.scene, g.nodes[std::size_t(g.start)].cf);
   if (g.goal < 0) {
     io.err << o.graph.scene_path << ": error: exploration never reached the goal "
            << states::ToString(b.scene.goal) << ", so there is no plan to extract; expected a "

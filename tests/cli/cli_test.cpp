@@ -79,6 +79,30 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
 
 }  // namespace
 
+// The groove scene with one line changed (`from` replaced by `to`), written to the scratch
+// directory `tag`.
+std::string GrooveWith(const std::string& tag, const std::string& from, const std::string& to) {
+  std::string text = tubeplan::testing::Slurp(SourcePath("scenes/groove.yaml"));
+  const std::size_t at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, from.size(), to);
+  return tubeplan::testing::WriteScratch(tag, "scene.yaml", text);
+}
+
+TEST_CASE("plans: a goal the tube starts in is said, and no plan is written", "[cli]") {
+  const std::string scene = GrooveWith("plans-start", "goal: \"{Fs - floor.top}\"", "goal: \"{}\"");
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-start") / "out";
+  const Outcome r = RunTool({"plans", scene, "--out-dir", dir.string(), "--budget", "20"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.empty());
+  CHECK(r.err == scene +
+                     ": nothing to plan: the goal {} is the state the tube starts in ({} at the "
+                     "scene's start pose), so a plan would be that one state and no move; no plan "
+                     "written. Give the scene a goal the tube has to be moved to\n");
+  CHECK_FALSE(std::filesystem::exists(dir));
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-start"));
+}
+
 TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli]") {
   Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "1", "--jobs", "2"});
   CHECK(r.exit_code == 1);  // one sweep does not reach the goal
