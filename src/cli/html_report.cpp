@@ -110,10 +110,15 @@ std::string VerdictTable(const Evaluated& e) {
       why += why.empty() ? "via" : "; via";
       for (const std::string& d : v.detour) why += " " + d;
     }
+    why = EscapeXml(why);
+    for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+      if (v.flagged_s[i] > 0.0)
+        why += "<div class=\"warning\">warning: " +
+               EscapeXml(plan::FlagWarning(i, v.flagged_s[i])) + "</div>";
     o << "<tr><td>" << k + 1 << "</td><td class=\"cf\">" << EscapeXml(v.from) << " &rarr; "
       << EscapeXml(v.to)
       << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
-      << plan::ToString(v.verdict) << "</span></td><td>" << EscapeXml(why)
+      << plan::ToString(v.verdict) << "</span></td><td>" << why
       << "</td><td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
       << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
       << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
@@ -308,13 +313,20 @@ void ReplayRecorder::operator()(double t_s, const core::Core& core) {
   Take(b.energy_J, t_s, out.energy_J, new_bin);
   Take(b.strain, t_s, out.max_strain, new_bin);
 
-  // The CF's text only when it changes (it allocates); its index for every frame.
-  const core::FormationKey key = core::KeyOf(out);
-  if (rec_.cfs.empty() || key != key_) {
+  // The CF's text only when it changes (it allocates); its index for every frame. A fault tick
+  // shows no state of the tube: it is named so.
+  const auto index_of = [&](const std::string& text) {
+    const int i = int(std::find(rec_.cfs.begin(), rec_.cfs.end(), text) - rec_.cfs.begin());
+    if (i == int(rec_.cfs.size())) rec_.cfs.push_back(text);
+    return i;
+  };
+  if (out.flags & core::kSolverFault) {
+    cf_ = index_of(kFaultCf);
+    key_valid_ = false;
+  } else if (const core::FormationKey key = core::KeyOf(out); !key_valid_ || key != key_) {
     key_ = key;
-    const std::string text = core.FormationText();
-    cf_ = int(std::find(rec_.cfs.begin(), rec_.cfs.end(), text) - rec_.cfs.begin());
-    if (cf_ == int(rec_.cfs.size())) rec_.cfs.push_back(text);
+    key_valid_ = true;
+    cf_ = index_of(core.FormationText());
   }
   if (!new_bin) return;
   ReplayRecording::Frame f;

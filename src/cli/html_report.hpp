@@ -51,8 +51,11 @@ struct ReplayRecording {
   double t_first_s = 0.0, t_last_s = 0.0;
   std::vector<Bin> bins;
   std::vector<Frame> frames;
-  std::vector<std::string> cfs;  ///< the CFs the frames name, in order of first appearance
+  /// The CFs the frames name, in order of first appearance; a tick the core flagged as a fault
+  /// is named kFaultCf (its formation there reads {}, which is not the tube's state).
+  std::vector<std::string> cfs;
 };
+inline constexpr const char* kFaultCf = "{} (solver fault: the core held the tube still)";
 
 /// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default).
 class ReplayRecorder {
@@ -65,6 +68,7 @@ class ReplayRecorder {
   ReplayRecording rec_;
   long ticks_ = 0;
   core::FormationKey key_{};
+  bool key_valid_ = false;
   int cf_ = 0;
 };
 

@@ -63,11 +63,9 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
                              {"peak_force_N", v.peak_force_N},
                              {"friction_work_J", v.friction_work_J},
                              {"energy_entry_J", v.energy_entry_J},
-                             {"energy_exit_J", v.energy_exit_J},
-                             {"beyond_linear_s", v.beyond_linear_s},
-                             {"shape_off_s", v.shape_off_s},
-                             {"held_s", v.held_s},
-                             {"segmentation_off_s", v.segmentation_off_s}});
+                             {"energy_exit_J", v.energy_exit_J}});
+      for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+        transitions.back()[plan::kWarnedFlags[i].key] = v.flagged_s[i];
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -121,23 +119,9 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
       << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
       << " -> " << v.energy_exit_J << " J\n";
-    if (v.beyond_linear_s > 0.0)
-      t << "      warning: for " << v.beyond_linear_s
-        << " s the linear model drew the tube beyond its range (tip deflection above l/3): "
-           "the verdict rests on a shape the tube cannot take\n";
-    if (v.shape_off_s > 0.0)
-      t << "      warning: for " << v.shape_off_s
-        << " s the tube's shape was off the points its contacts were solved at (flag shape_off): "
-           "the verdict rests on ticks the core did not resolve\n";
-    if (v.held_s > 0.0)
-      t << "      warning: for " << v.held_s
-        << " s the core held the tube back from going through a part (flag held): the tube did "
-           "not follow the plan's hand there\n";
-    if (v.segmentation_off_s > 0.0)
-      t << "      warning: for " << v.segmentation_off_s
-        << " s the segmented rule was outside its range (flag segmentation_off: it left out more "
-           "than eps/10 at a load point): the verdict rests on forces the coupled rule would "
-           "correct (multi_contact: coupled)\n";
+    for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+      if (v.flagged_s[i] > 0.0)
+        t << "      warning: " << plan::FlagWarning(i, v.flagged_s[i]) << "\n";
   }
   t.precision(precision);
 }

@@ -37,6 +37,7 @@ struct SimulateOptions {
 struct Visit {
   double t_s = 0.0;
   std::string cf;
+  bool fault = false;  // entered on a tick the core flagged fault: {} there is not the tube's state
 };
 
 int RunSimulate(const SimulateOptions& o, Streams io) {
@@ -113,7 +114,9 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     core_s += tick_s;
     worst_tick_s = std::max(worst_tick_s, tick_s);
     cf_text = core.FormationText();
-    if (visits.empty() || visits.back().cf != cf_text) visits.push_back({sample.t_s, cf_text});
+    const bool fault = (out.flags & core::kSolverFault) != 0;
+    if (visits.empty() || visits.back().cf != cf_text || visits.back().fault != fault)
+      visits.push_back({sample.t_s, cf_text, fault});
     const double force_N = out.force_W_N.norm();
     if (force_N > peak_force_N) peak_force_N = force_N, peak_force_t = sample.t_s;
     if (out.max_strain > peak_strain) peak_strain = out.max_strain, peak_strain_t = sample.t_s;
@@ -146,7 +149,10 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["duration_s"] = duration_s;
     j["capsules"] = core.capsule_count();
     nlohmann::json v = nlohmann::json::array();
-    for (const Visit& visit : visits) v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
+    for (const Visit& visit : visits) {
+      v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
+      if (visit.fault) v.back()["fault"] = true;
+    }
     j["visits"] = v;
     j["final_cf"] = cf_text;
     j["goal"] = states::ToString(s.goal);
@@ -176,7 +182,9 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   text << "contact formations, in order (t = entry time):\n";
   const std::size_t shown = std::min<std::size_t>(visits.size(), 40);
   for (std::size_t i = 0; i < shown; ++i)
-    text << "  t = " << std::setw(7) << visits[i].t_s << " s  " << visits[i].cf << "\n";
+    text << "  t = " << std::setw(7) << visits[i].t_s << " s  " << visits[i].cf
+         << (visits[i].fault ? "  (solver fault: the core held the tube still; not its state)" : "")
+         << "\n";
   if (visits.size() > shown)
     text << "  ... " << visits.size() - shown << " more changes (the series in --out has all)\n";
   text << "final: " << cf_text << (cf_text == states::ToString(s.goal) ? " (the goal)" : "")

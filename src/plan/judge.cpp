@@ -39,6 +39,18 @@ const char* ToString(Verdict verdict) {
   return "infeasible";
 }
 
+std::string FlagWarning(std::size_t i, double seconds) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "for %.3g s ", seconds);
+  return buffer + std::string(kWarnedFlags[i].meaning);
+}
+
+double TransitionVerdict::FlaggedSeconds(std::uint32_t flag) const {
+  for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
+    if (kWarnedFlags[i].flag == flag) return flagged_s[i];
+  return 0.0;
+}
+
 Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s)
     : states_(std::move(states)),
       limits_(limits),
@@ -71,10 +83,8 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
     TransitionVerdict& v = j_.transitions[at_];
     const double force_N = out.force_W_N.norm();
     v.peak_force_N = std::max(v.peak_force_N, force_N);
-    if (out.flags & core::kBeyondLinearRange) v.beyond_linear_s += step_s_;
-    if (out.flags & core::kShapeOffContacts) v.shape_off_s += step_s_;
-    if (out.flags & core::kHeldBack) v.held_s += step_s_;
-    if (out.flags & core::kSegmentationOff) v.segmentation_off_s += step_s_;
+    for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
+      if (out.flags & kWarnedFlags[i].flag) v.flagged_s[i] += step_s_;
     if (force_N > limits_.max_force_N && v.reason.empty())
       Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s));
     if (out.max_strain > limits_.max_strain && v.reason.empty())
@@ -88,7 +98,11 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
   }
   stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
 
-  // Debounce: a state counts once held `dwell` ticks.
+  // Debounce: a state counts once held `dwell` ticks. A tick the core flags as a fault shows no
+  // state of the tube (it reads {}): after the first tick it neither changes the state nor counts
+  // towards its dwell.
+  const bool first = j_.observed.empty();
+  if (!first && (out.flags & core::kSolverFault)) return;
   const core::FormationKey key = core::KeyOf(out);
   if (j_.ticks == 1 || key != raw_key_) {
     raw_key_ = key;
@@ -98,7 +112,6 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
     raw_energy_ = out.energy_J;
   }
   ++raw_held_;
-  const bool first = j_.observed.empty();
   if (!(first || (raw_held_ == dwell_ && raw_ != stable_))) return;
   stable_ = raw_;
   j_.observed.push_back({raw_since_, raw_});

@@ -339,9 +339,9 @@ TEST_CASE("Ticks beyond the linear range, held back or out of the segmented rule
   }
   const plan::Judgement j = judging.Finish();
   REQUIRE(j.transitions.size() == 1);
-  CHECK(j.transitions[0].beyond_linear_s == Approx(0.030).margin(1e-12));
-  CHECK(j.transitions[0].held_s == Approx(0.012).margin(1e-12));
-  CHECK(j.transitions[0].segmentation_off_s == Approx(0.007).margin(1e-12));
-  CHECK(j.transitions[0].shape_off_s == 0.0);
+  CHECK(j.transitions[0].FlaggedSeconds(core::kBeyondLinearRange) == Approx(0.030).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kHeldBack) == Approx(0.012).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kSegmentationOff) == Approx(0.007).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kShapeOffContacts) == 0.0);
   CHECK(j.transitions[0].verdict == plan::Verdict::kInfeasible);
 }

@@ -3,6 +3,8 @@
 // transition a verdict (architecture.md, docs/evaluate.md). A state counts once the core has
 // kept it for the plan's dwell; the counted sequence is matched against the plan.
 
+#include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -18,6 +20,37 @@ namespace tubeplan::plan {
 enum class Verdict { kFeasible, kFeasibleWithDetour, kInfeasible };
 const char* ToString(Verdict verdict);  ///< "feasible", "feasible-with-detour", "infeasible"
 
+/// The core's flags a verdict warns about, in one place (the core may rename its flags; this
+/// table is the one mapping from them): per transition the time spent in ticks carrying each is
+/// summed (TransitionVerdict::flagged_s, in this order), reported under `key` in the JSON report
+/// and as a warning in the text and the HTML (FlagWarning).
+struct WarnedFlag {
+  std::uint32_t flag;   ///< a core::StepFlag bit
+  const char* key;      ///< the report's field [s], e.g. "fault_s"
+  const char* meaning;  ///< what those ticks mean for the verdict (after "for X s ")
+};
+inline constexpr std::array<WarnedFlag, 5> kWarnedFlags = {{
+    {core::kSolverFault, "fault_s",
+     "the core's solver failed (flag fault): it held the tube still and sent no force, and its "
+     "contact formation there reads {} whatever the tube touched (the judge kept the state of the "
+     "ticks before): the verdict rests on ticks the core did not resolve"},
+    {core::kBeyondLinearRange, "beyond_linear_s",
+     "the linear model drew the tube beyond its range (tip deflection above l/3): the verdict "
+     "rests on a shape the tube cannot take"},
+    {core::kShapeOffContacts, "shape_off_s",
+     "the tube's shape was off the points its contacts were solved at (flag shape_off): the "
+     "verdict rests on ticks the core did not resolve"},
+    {core::kHeldBack, "held_s",
+     "the core held the tube back from going through a part (flag held): the tube did not follow "
+     "the plan's hand there"},
+    {core::kSegmentationOff, "segmentation_off_s",
+     "the segmented rule was outside its range (flag segmentation_off: it left out more than "
+     "eps/10 at a load point): the verdict rests on forces the coupled rule would correct "
+     "(multi_contact: coupled)"},
+}};
+/// "for 0.012 s the core held the tube back ...": the warning for kWarnedFlags[i].
+std::string FlagWarning(std::size_t i, double seconds);
+
 struct TransitionVerdict {
   std::string from, to;  ///< planned CFs
   Verdict verdict = Verdict::kInfeasible;
@@ -27,19 +60,10 @@ struct TransitionVerdict {
   double peak_force_N = 0.0;
   double friction_work_J = 0.0;  ///< sum over sliding PCs of |F_f| times the slip
   double energy_entry_J = 0.0, energy_exit_J = 0.0;
-  /// Time the linear model drew the tube beyond its range (core flag beyond_linear: tip
-  /// deflection above l/3): the verdict then rests on a shape the tube cannot take.
-  double beyond_linear_s = 0.0;
-  /// Time the shape under the tick's loads was off the points the tick's contacts were solved
-  /// at (core flag shape_off): the verdict then rests on ticks the core did not resolve.
-  double shape_off_s = 0.0;
-  /// Time the core held the tube back from going through a part (core flag held): there the
-  /// tube did not follow the hand, and the operator felt the coupling's spring.
-  double held_s = 0.0;
-  /// Time the paper's segmented rule was outside its range (core flag segmentation_off: it left
-  /// out more than eps / 10 of displacement at a load point): the verdict then rests on forces
-  /// off by more than K eps / 10; the coupled rule has no such error.
-  double segmentation_off_s = 0.0;
+  /// Time in ticks carrying each flag of kWarnedFlags (same order) [s].
+  std::array<double, kWarnedFlags.size()> flagged_s{};
+  /// The time for one flag of kWarnedFlags (0 for a flag not in it).
+  double FlaggedSeconds(std::uint32_t flag) const;
 };
 
 struct Observation {

@@ -1,0 +1,104 @@
+// The judge on synthetic ticks: ticks the core flags as faults neither count as a state nor pass
+// without a warning.
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/plan/judge.hpp>
+
+#include "cli/report.hpp"
+
+namespace {
+
+using namespace tubeplan;
+
+// States by number: 0 is {} (no contact), i > 0 one PC on part element i, named kNames[i].
+const std::vector<std::string> kNames = {"{}", "{Fe - floor.top}", "{Fs n floor.top}",
+                                         "{Fs - floor.top}", "{Fs - right.top}"};
+
+// One synthetic tick: the state, the operator force along x and the bending energy.
+struct SyntheticTick {
+  int state = 0;
+  double force_N = 0.0;
+  double energy_J = 0.0;
+  std::uint32_t flags = 0;
+  double friction_work_J = 0.0;
+};
+
+// Feeds ticks 1 ms apart (t = 1 ms for the first) and returns the judgement.
+plan::Judgement Run(const std::vector<std::string>& states, const std::vector<SyntheticTick>& ticks,
+                    plan::Limits limits = {}) {
+  plan::Judging judging(states, limits, 1e-3);
+  for (std::size_t k = 0; k < ticks.size(); ++k) {
+    core::StepOutput out;
+    const SyntheticTick& s = ticks[k];
+    out.contact_count = s.state > 0 && (s.flags & core::kSolverFault) == 0 ? 1 : 0;
+    out.contacts[0].part_element = s.state;
+    out.contacts[0].friction_work_J = s.friction_work_J;
+    out.force_W_N = Eigen::Vector3d(s.force_N, 0.0, 0.0);
+    out.energy_J = s.energy_J;
+    out.flags = s.flags;
+    judging.Tick(1e-3 * double(k + 1), out,
+                 [&] { return kNames[std::size_t(out.contact_count > 0 ? s.state : 0)]; });
+  }
+  return judging.Finish();
+}
+
+// `count` ticks in `state`, each with energy 1e-3 times its tick number (1-based, so the energy
+// names the tick) and force 0.1 N.
+void Add(std::vector<SyntheticTick>& ticks, int state, int count) {
+  for (int i = 0; i < count; ++i) {
+    const double k = double(ticks.size() + 1);
+    ticks.push_back({state, 0.1, 1e-3 * k});
+  }
+}
+
+std::string Text(const plan::Judgement& j, const std::vector<std::string>& states) {
+  cli::Evaluated e;
+  e.file = "synthetic.yaml";
+  e.plan.name = "synthetic";
+  e.plan.states = states;
+  e.judgement = j;
+  std::ostringstream text;
+  cli::PrintVerdicts(text, e, false);
+  return text.str();
+}
+
+nlohmann::json Json(const plan::Judgement& j, const std::vector<std::string>& states) {
+  cli::Evaluated e;
+  e.file = "synthetic.yaml";
+  e.plan.name = "synthetic";
+  e.plan.states = states;
+  e.judgement = j;
+  return cli::ToJson({e}, {})["plans"][0];
+}
+
+}  // namespace
+
+TEST_CASE("Fault ticks are not a state of the tube and are warned about", "[plan]") {
+  // {} -> {Fe} -> goal; in {Fe} 30 ticks the core flags fault (with penetration and separated,
+  // as it does): their formation reads {}, which the judge must not take for a state.
+  const std::vector<std::string> states = {kNames[0], kNames[1], kNames[3]};
+  std::vector<SyntheticTick> ticks;
+  Add(ticks, 0, 50);
+  Add(ticks, 1, 20);
+  for (int i = 0; i < 30; ++i)
+    ticks.push_back({1, 0.0, 0.0, core::kSolverFault | core::kPenetration | core::kProxySeparated});
+  Add(ticks, 1, 20);
+  Add(ticks, 3, 50);
+  const plan::Judgement j = Run(states, ticks);
+  CHECK(j.feasible);
+  REQUIRE(j.observed.size() == 3);
+  CHECK(j.observed[1].cf == kNames[1]);
+  CHECK(j.observed[2].cf == kNames[3]);
+  CHECK(j.transitions[1].FlaggedSeconds(core::kSolverFault) == Approx(0.030).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kSolverFault) == 0.0);
+  CHECK(Json(j, states)["transitions"][1]["fault_s"] == Approx(0.030).margin(1e-12));
+  const std::string text = Text(j, states);
+  CHECK(text.find("      warning: for 0.03 s the core's solver failed (flag fault)") !=
+        std::string::npos);
+}
