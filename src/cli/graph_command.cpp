@@ -75,11 +75,15 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
       ok = t.is_object() && t.value("from", nlohmann::json()).is_string() &&
            t.value("to", nlohmann::json()).is_string() &&
            t.value("verdict", nlohmann::json()).is_string() &&
-           t.value("t_start_s", nlohmann::json()).is_number() &&
-           t.value("t_end_s", nlohmann::json()).is_number();
+           (t.value("t_start_s", nlohmann::json()).is_number() ||
+            t.value("t_start_s", nlohmann::json(0)).is_null()) &&
+           (t.value("t_end_s", nlohmann::json()).is_number() ||
+            t.value("t_end_s", nlohmann::json(0)).is_null());
+      // A transition the replay never got to has no span (null times): no step falls in it.
       if (ok)
-        r.transitions.push_back(
-            {t["from"], t["to"], t["verdict"] != "infeasible", t["t_start_s"], t["t_end_s"]});
+        r.transitions.push_back({t["from"], t["to"], t["verdict"] != "infeasible",
+                                 t["t_start_s"].is_null() ? 0.0 : t["t_start_s"].get<double>(),
+                                 t["t_end_s"].is_null() ? 0.0 : t["t_end_s"].get<double>()});
     }
     for (std::size_t k = 0; ok && k < p["observed"].size(); ++k) {
       const nlohmann::json& o = p["observed"][k];

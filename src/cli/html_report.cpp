@@ -98,6 +98,37 @@ void MarkExceeded(const ReplayRecording& r, Member member, double limit, const s
   }
 }
 
+// One row of the verdict table: a planned transition.
+std::string VerdictRow(const std::string& number, const plan::TransitionVerdict& v,
+                       const std::string& what) {
+  std::string why = EscapeXml(v.reason);
+  if (!v.detour.empty()) {
+    std::string via = v.reason.empty() ? "via" : "; via";
+    for (const std::string& d : v.detour) via += " " + d;
+    why += EscapeXml(via);
+  }
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    if (v.flagged_s[i] > 0.0)
+      why += "<div class=\"warning\">warning: " + EscapeXml(plan::FlagWarning(i, v.flagged_s[i])) +
+             "</div>";
+  std::ostringstream o;
+  o << "<tr><td>" << number << "</td><td class=\"cf\">" << what
+    << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
+    << plan::ToString(v.verdict) << "</span></td><td>" << why << "</td>";
+  if (v.started) {
+    o << "<td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
+      << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
+      << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
+      << " &rarr; " << Sig(v.energy_exit_J * 1e6) << "</td>";
+  } else {
+    // Not reached: no span and no figures.
+    o << "<td class=\"num\">&ndash;</td><td class=\"num\">&ndash;</td>"
+         "<td class=\"num\">&ndash;</td><td class=\"num\">&ndash;</td>";
+  }
+  o << "</tr>\n";
+  return o.str();
+}
+
 std::string VerdictTable(const Evaluated& e) {
   std::ostringstream o;
   o << "<table class=\"verdicts\"><thead><tr><th>#</th><th>planned transition</th>"
@@ -105,24 +136,7 @@ std::string VerdictTable(const Evaluated& e) {
        "<th>friction work [&micro;J]</th><th>bending energy [&micro;J]</th></tr></thead><tbody>\n";
   for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = e.judgement.transitions[k];
-    std::string why = v.reason;
-    if (!v.detour.empty()) {
-      why += why.empty() ? "via" : "; via";
-      for (const std::string& d : v.detour) why += " " + d;
-    }
-    why = EscapeXml(why);
-    for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
-      if (v.flagged_s[i] > 0.0)
-        why += "<div class=\"warning\">warning: " +
-               EscapeXml(plan::FlagWarning(i, v.flagged_s[i])) + "</div>";
-    o << "<tr><td>" << k + 1 << "</td><td class=\"cf\">" << EscapeXml(v.from) << " &rarr; "
-      << EscapeXml(v.to)
-      << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
-      << plan::ToString(v.verdict) << "</span></td><td>" << why
-      << "</td><td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
-      << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
-      << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
-      << " &rarr; " << Sig(v.energy_exit_J * 1e6) << "</td></tr>\n";
+    o << VerdictRow(std::to_string(k + 1), v, EscapeXml(v.from) + " &rarr; " + EscapeXml(v.to));
   }
   o << "</tbody></table>\n";
   return o.str();
@@ -147,10 +161,8 @@ std::string Timeline(const Evaluated& e, const ReplayRecording& r,
     if (lane.emplace(ob.cf, int(plot.lanes.size())).second) plot.lanes.push_back(ob.cf);
   for (std::size_t k = 0; k < j.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = j.transitions[k];
-    if (v.t_end_s <= v.t_start_s && v.verdict == plan::Verdict::kInfeasible &&
-        v.reason.rfind("not reached", 0) == 0)
-      continue;  // never started
-    plot.bars.push_back({0, v.t_start_s, std::max(v.t_end_s, v.t_start_s), VerdictColour(v.verdict),
+    if (!v.started) continue;  // never reached: no span
+    plot.bars.push_back({0, v.t_start_s, v.t_end_s, VerdictColour(v.verdict),
                          std::to_string(k + 1) + " " + ToString(v.verdict),
                          std::to_string(k + 1) + ": " + v.from + " -> " + v.to + ": " +
                              ToString(v.verdict) +
@@ -204,17 +216,18 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
   spans.insert(spans.end(), strain.spans.begin(), strain.spans.end());
   // The moment a transition was judged infeasible for another reason than a limit (those are
   // shaded above): another state reached, never reached, stalled. A thin line on every chart.
-  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
-    const plan::TransitionVerdict& v = e.judgement.transitions[k];
-    if (v.verdict != plan::Verdict::kInfeasible || v.reason.rfind("limit exceeded", 0) == 0 ||
-        v.reason.rfind("not reached", 0) == 0)
-      continue;
-    const report::Span moment{v.t_end_s, v.t_end_s,
-                              "transition " + std::to_string(k + 1) +
-                                  " infeasible at t = " + Fixed(v.t_end_s, 3) + " s: " + v.reason};
+  const auto mark = [&](const plan::TransitionVerdict& v, const std::string& what) {
+    if (!v.started || v.verdict != plan::Verdict::kInfeasible ||
+        v.reason.find("limit exceeded") != std::string::npos)
+      return;
+    const report::Span moment{
+        v.t_failed_s, v.t_failed_s,
+        what + " infeasible at t = " + Fixed(v.t_failed_s, 3) + " s: " + v.reason};
     spans.push_back(moment);
     for (report::LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
-  }
+  };
+  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k)
+    mark(e.judgement.transitions[k], "transition " + std::to_string(k + 1));
   std::string svg;
   for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
     svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";
@@ -411,8 +424,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
       << " core ticks; limits: force " << Fixed(e.plan.limits.max_force_N, 3) << " N, strain "
       << Fixed(e.plan.limits.max_strain, 3) << ", penetration "
       << Fixed(e.plan.limits.max_penetration_m * 1e3, 3) << " mm, dwell "
-      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n"
-      << VerdictTable(e);
+      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n";
+    o << VerdictTable(e);
     std::vector<report::Span> spans;
     const std::string plots = Plots(e, p.recording, spans);
     o << "<div class=\"plot timeline\">" << Timeline(e, p.recording, spans) << "</div>\n"

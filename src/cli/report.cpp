@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
+#include <sstream>
 
 #include <tubeplan/plan/perturb.hpp>
 
@@ -46,26 +48,39 @@ nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
       {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
 }
 
+namespace {
+
+// One transition's verdict and figures. A transition the replay never got to has null times and
+// figures.
+nlohmann::json SpanJson(const plan::TransitionVerdict& v) {
+  const auto figure = [&](double value) {
+    return v.started ? nlohmann::json(value) : nlohmann::json(nullptr);
+  };
+  nlohmann::json j = {{"from", v.from},
+                      {"to", v.to},
+                      {"verdict", plan::ToString(v.verdict)},
+                      {"reason", v.reason},
+                      {"detour", v.detour},
+                      {"t_start_s", figure(v.t_start_s)},
+                      {"t_end_s", figure(v.t_end_s)},
+                      {"peak_force_N", figure(v.peak_force_N)},
+                      {"friction_work_J", figure(v.friction_work_J)},
+                      {"energy_entry_J", figure(v.energy_entry_J)},
+                      {"energy_exit_J", figure(v.energy_exit_J)}};
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    j[plan::kWarnedFlags[i].key] = figure(v.flagged_s[i]);
+  return j;
+}
+
+}  // namespace
+
 nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope) {
   nlohmann::json plans = nlohmann::json::array();
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
     nlohmann::json transitions = nlohmann::json::array();
     for (std::size_t k = 0; k < j.transitions.size(); ++k) {
-      const plan::TransitionVerdict& v = j.transitions[k];
-      transitions.push_back({{"from", v.from},
-                             {"to", v.to},
-                             {"verdict", plan::ToString(v.verdict)},
-                             {"reason", v.reason},
-                             {"detour", v.detour},
-                             {"t_start_s", v.t_start_s},
-                             {"t_end_s", v.t_end_s},
-                             {"peak_force_N", v.peak_force_N},
-                             {"friction_work_J", v.friction_work_J},
-                             {"energy_entry_J", v.energy_entry_J},
-                             {"energy_exit_J", v.energy_exit_J}});
-      for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
-        transitions.back()[plan::kWarnedFlags[i].key] = v.flagged_s[i];
+      transitions.push_back(SpanJson(j.transitions[k]));
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -87,6 +102,33 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
   return Report(std::move(plans), scope);
 }
 
+namespace {
+
+// A transition's lines: its verdict (and why), then its figures and its warnings.
+void PrintSpan(std::ostream& t, const std::string& title, const plan::TransitionVerdict& v,
+               const std::string& robust,
+               const std::function<std::string(plan::Verdict, const std::string&)>& paint) {
+  t << "  " << title << ": " << paint(v.verdict, plan::ToString(v.verdict));
+  if (!v.detour.empty()) {
+    t << " via";
+    for (const std::string& d : v.detour) t << " " << d;
+  }
+  if (!v.reason.empty()) t << " (" << v.reason << ")";
+  t << robust;
+  if (!v.started) {
+    t << "\n";
+    return;  // no span, no figures: the replay never got there
+  }
+  t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
+    << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
+    << " -> " << v.energy_exit_J << " J\n";
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    if (v.flagged_s[i] > 0.0)
+      t << "      warning: " << plan::FlagWarning(i, v.flagged_s[i]) << "\n";
+}
+
+}  // namespace
+
 void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
   auto paint = [&](plan::Verdict v, const std::string& text) {
     if (!colour) return text;
@@ -103,25 +145,16 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     << ", " << j.transitions.size()
     << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
     << " s replayed\n";
-  for (const plan::TransitionVerdict& v : j.transitions) {
-    t << "  " << v.from << " -> " << v.to << ": " << paint(v.verdict, plan::ToString(v.verdict));
-    if (!v.detour.empty()) {
-      t << " via";
-      for (const std::string& d : v.detour) t << " " << d;
-    }
-    if (!v.reason.empty()) t << " (" << v.reason << ")";
+  for (std::size_t k = 0; k < j.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = j.transitions[k];
+    std::ostringstream robust;
     if (e.runs > 0) {
-      const std::size_t k = std::size_t(&v - j.transitions.data());
+      robust.precision(3);
       const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
-      t << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
-        << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
+      robust << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
+             << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
     }
-    t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
-      << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
-      << " -> " << v.energy_exit_J << " J\n";
-    for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
-      if (v.flagged_s[i] > 0.0)
-        t << "      warning: " << plan::FlagWarning(i, v.flagged_s[i]) << "\n";
+    PrintSpan(t, v.from + " -> " + v.to, v, robust.str(), paint);
   }
   t.precision(precision);
 }

@@ -66,86 +66,130 @@ Judging::Judging(std::vector<std::string> states, const Limits& limits, double s
   }
 }
 
-void Judging::Fail(std::size_t i, const std::string& reason) {
-  TransitionVerdict& v = j_.transitions[i];
-  if (v.verdict != Verdict::kInfeasible || v.reason.empty()) v.reason = reason;
+// The transition under way; none once the plan failed or the goal was reached.
+TransitionVerdict* Judging::UnderWay() {
+  if (failed_ || at_ >= n_) return nullptr;
+  return j_.transitions[at_].started ? &j_.transitions[at_] : nullptr;
+}
+
+void Judging::Fail(TransitionVerdict& v, const std::string& reason, double t_s) {
+  if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) return;  // the first reason stays
+  v.reason = reason;
   v.verdict = Verdict::kInfeasible;
+  v.t_failed_s = t_s;
+}
+
+// The first tick: the state the replay starts in opens the first transition, or fails it.
+void Judging::Start(double t_s, const core::StepOutput& out, const std::string& cf) {
+  t_first_ = t_s;
+  raw_key_ = core::KeyOf(out);
+  raw_ = stable_ = cf;
+  raw_since_ = t_s;
+  raw_energy_ = out.energy_J;
+  j_.observed.push_back({t_s, cf});
+  TransitionVerdict& first = j_.transitions[0];
+  if (cf != states_[0]) {
+    Fail(first, "the replay starts in " + cf + ", not in the planned " + states_[0], t_s);
+    failed_ = true;
+    return;
+  }
+  first.started = true;
+  first.t_start_s = t_s;
+  first.energy_entry_J = out.energy_J;
+}
+
+// One tick's figures and limits, kept apart until it is known which span they belong to.
+void Judging::Measure(double t_s, const core::StepOutput& out) {
+  Figures& f = pending_;
+  const double force_N = out.force_W_N.norm();
+  f.peak_force_N = std::max(f.peak_force_N, force_N);
+  for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
+    if (out.flags & kWarnedFlags[i].flag) f.flagged_s[i] += step_s_;
+  const auto exceeded = [&](const std::string& reason) {
+    if (f.failure.empty()) f.failure = reason, f.t_failure_s = t_s;
+  };
+  if (force_N > limits_.max_force_N)
+    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+  if (out.max_strain > limits_.max_strain)
+    exceeded(Format("strain", out.max_strain, "", limits_.max_strain, t_s));
+  for (const core::ContactState& c : out.Contacts()) {
+    if (-c.distance_m > limits_.max_penetration_m)
+      exceeded(
+          Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3, t_s));
+    f.friction_work_J += c.friction_work_J;
+  }
+}
+
+void Judging::Flush() {
+  if (TransitionVerdict* v = UnderWay()) {
+    v->peak_force_N = std::max(v->peak_force_N, pending_.peak_force_N);
+    v->friction_work_J += pending_.friction_work_J;
+    for (std::size_t i = 0; i < kWarnedFlags.size(); ++i) v->flagged_s[i] += pending_.flagged_s[i];
+    if (!pending_.failure.empty()) Fail(*v, pending_.failure, pending_.t_failure_s);
+  }
+  pending_ = Figures{};
 }
 
 void Judging::Tick(double t_s, const core::StepOutput& out,
                    const std::function<std::string()>& cf_text) {
   ++j_.ticks;
-  if (j_.ticks == 1) t_first_ = t_s;
+  if (j_.ticks == 1) Start(t_s, out, cf_text());
   t_last_ = t_s;
-  const std::vector<std::string>& states = states_;
-  // Figures and limits of the transition under way.
-  if (!failed_ && at_ < n_) {
-    TransitionVerdict& v = j_.transitions[at_];
-    const double force_N = out.force_W_N.norm();
-    v.peak_force_N = std::max(v.peak_force_N, force_N);
-    for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
-      if (out.flags & kWarnedFlags[i].flag) v.flagged_s[i] += step_s_;
-    if (force_N > limits_.max_force_N && v.reason.empty())
-      Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s));
-    if (out.max_strain > limits_.max_strain && v.reason.empty())
-      Fail(at_, Format("strain", out.max_strain, "", limits_.max_strain, t_s));
-    for (const core::ContactState& c : out.Contacts()) {
-      if (-c.distance_m > limits_.max_penetration_m && v.reason.empty())
-        Fail(at_, Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3,
-                         t_s));
-      v.friction_work_J += c.friction_work_J;
-    }
-  }
+  energy_last_ = out.energy_J;
   stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
 
   // Debounce: a state counts once held `dwell` ticks. A tick the core flags as a fault shows no
-  // state of the tube (it reads {}): after the first tick it neither changes the state nor counts
-  // towards its dwell.
-  const bool first = j_.observed.empty();
-  if (!first && (out.flags & core::kSolverFault)) return;
-  const core::FormationKey key = core::KeyOf(out);
-  if (j_.ticks == 1 || key != raw_key_) {
-    raw_key_ = key;
-    raw_ = cf_text();  // text only when the state changes
-    raw_held_ = 0;
-    raw_since_ = t_s;
-    raw_energy_ = out.energy_J;
+  // state of the tube (it reads {}): it neither changes the state nor counts towards its dwell.
+  const bool fault = (out.flags & core::kSolverFault) != 0;
+  if (!fault && j_.ticks > 1) {
+    const core::FormationKey key = core::KeyOf(out);
+    if (key != raw_key_) {
+      Flush();  // the ticks of the state left were in the span under way
+      raw_key_ = key;
+      raw_ = cf_text();  // text only when the state changes
+      raw_held_ = 0;
+      raw_since_ = t_s;
+      raw_energy_ = out.energy_J;
+    }
   }
+  Measure(t_s, out);
+  if (fault) return;
   ++raw_held_;
-  if (!(first || (raw_held_ == dwell_ && raw_ != stable_))) return;
+  if (j_.ticks == 1 || raw_held_ != dwell_ || raw_ == stable_) return;
   stable_ = raw_;
   j_.observed.push_back({raw_since_, raw_});
-  if (first) {
-    j_.transitions[0].t_start_s = raw_since_;
-    j_.transitions[0].energy_entry_J = raw_energy_;
-    if (raw_ != states[0]) {
-      Fail(0, "the replay starts in " + raw_ + ", not in the planned " + states[0]);
-      failed_ = true;
-    }
-    return;
-  }
+  Counted();
+  Flush();  // the ticks since raw_since_ are in the span the counted state opened, if any
+}
+
+// A new state counted (raw_, entered at raw_since_).
+void Judging::Counted() {
   if (failed_ || at_ >= n_) return;
+  const std::vector<std::string>& states = states_;
   TransitionVerdict& v = j_.transitions[at_];
   if (raw_ == states[at_ + 1]) {
     v.t_end_s = raw_since_;
     v.energy_exit_J = raw_energy_;
     v.detour = passed_;
-    if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
-      failed_ = true;  // a limit was exceeded on the way
-    } else {
-      v.verdict = passed_.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
-    }
     passed_.clear();
     ++at_;
+    if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
+      failed_ = true;  // a limit was exceeded on the way: nothing after it is reached
+      return;
+    }
+    v.verdict = v.detour.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
     if (at_ < n_) {
-      j_.transitions[at_].t_start_s = raw_since_;
-      j_.transitions[at_].energy_entry_J = raw_energy_;
+      TransitionVerdict& next = j_.transitions[at_];
+      next.started = true;
+      next.t_start_s = raw_since_;
+      next.energy_entry_J = raw_energy_;
     }
   } else if (std::find(states.begin() + long(at_) + 2, states.end(), raw_) != states.end()) {
     v.t_end_s = raw_since_;
+    v.energy_exit_J = raw_energy_;
     v.detour = passed_;
-    Fail(at_,
-         "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1]);
+    Fail(v, "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1],
+         raw_since_);
     failed_ = true;
   } else if (raw_ != states[at_]) {
     passed_.push_back(raw_);
@@ -156,9 +200,11 @@ Judgement Judging::Finish() {
   const std::vector<std::string>& states = states_;
   const double t_end = t_last_;
   const double T = step_s_;
-  if (!failed_ && at_ < n_) {
+  Flush();
+  if (!failed_ && at_ < n_ && j_.transitions[at_].started) {
     TransitionVerdict& v = j_.transitions[at_];
     v.t_end_s = t_end;
+    v.energy_exit_J = energy_last_;
     v.detour = passed_;
     if (v.reason.empty()) {
       char buffer[96];
@@ -174,7 +220,7 @@ Judgement Judging::Finish() {
       } else {
         why = "another state reached instead: " + stable_ + " (the trajectory ended there)";
       }
-      Fail(at_, states[at_ + 1] + " never reached: " + why);
+      Fail(v, states[at_ + 1] + " never reached: " + why, t_end);
     }
     failed_ = true;
   }

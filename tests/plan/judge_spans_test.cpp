@@ -1,5 +1,6 @@
-// The judge on synthetic ticks: ticks the core flags as faults neither count as a state nor pass
-// without a warning.
+// The judge on synthetic ticks: each span's figures are those of its own ticks, a transition the
+// replay never got to has no span, and ticks the core flags as faults neither count as a state nor
+// pass without a warning.
 #include <sstream>
 #include <string>
 #include <vector>
@@ -78,6 +79,94 @@ nlohmann::json Json(const plan::Judgement& j, const std::vector<std::string>& st
 }
 
 }  // namespace
+
+TEST_CASE("A transition's figures are those of its span: entering a .. entering b", "[plan]") {
+  // {} for 50 ticks, {Fe} for 50, then the goal {Fs -} for 50. States count after 20 ticks but
+  // are entered at their first tick: the spans are 1..51 ms and 51..101 ms.
+  const std::vector<std::string> states = {kNames[0], kNames[1], kNames[3]};
+  std::vector<SyntheticTick> ticks;
+  Add(ticks, 0, 50);
+  Add(ticks, 1, 50);
+  Add(ticks, 3, 50);
+  // A 2 N spike at the goal's first tick (101) and 1 J of friction work at {Fe}'s first tick (51):
+  // each belongs to the span the state opens (none for the goal), not to the one it ends.
+  ticks[100].force_N = 2.0;
+  ticks[50].friction_work_J = 1.0;
+  const plan::Judgement j = Run(states, ticks);
+  REQUIRE(j.feasible);
+  const plan::TransitionVerdict& a = j.transitions[0];
+  const plan::TransitionVerdict& b = j.transitions[1];
+  CHECK(a.t_start_s == Approx(0.001));
+  CHECK(a.t_end_s == Approx(0.051));
+  CHECK(a.friction_work_J == 0.0);
+  CHECK(b.t_start_s == Approx(0.051));
+  CHECK(b.t_end_s == Approx(0.101));
+  CHECK(b.friction_work_J == 1.0);
+  CHECK(b.peak_force_N == 0.1);
+  // The energies at the span's ends are those of the ticks there.
+  CHECK(a.energy_entry_J == Approx(0.001));
+  CHECK(a.energy_exit_J == Approx(0.051));
+  CHECK(b.energy_entry_J == Approx(0.051));
+  CHECK(b.energy_exit_J == Approx(0.101));
+}
+
+TEST_CASE("A transition never reached has no span and no figures", "[plan]") {
+  const std::vector<std::string> states = {kNames[0], kNames[1], kNames[2], kNames[3]};
+  SECTION("after a limit exceeded on the way") {
+    // 10 N at tick 60 (in {Fe}, transition 2 under way), then {Fs n} is reached at tick 101:
+    // transition 2 is infeasible there and transition 3 never starts.
+    std::vector<SyntheticTick> ticks;
+    Add(ticks, 0, 50);
+    Add(ticks, 1, 50);
+    Add(ticks, 2, 50);
+    Add(ticks, 3, 50);
+    ticks[59].force_N = 10.0;
+    const plan::Judgement j = Run(states, ticks);
+    CHECK_FALSE(j.feasible);
+    CHECK(j.transitions[1].reason == "limit exceeded: operator force 10 N > 8.5 N at t = 0.060 s");
+    CHECK(j.transitions[1].t_end_s == Approx(0.101));
+    const plan::TransitionVerdict& last = j.transitions[2];
+    CHECK_FALSE(last.started);
+    CHECK(last.reason == "not reached: the plan failed at an earlier transition");
+    CHECK(last.friction_work_J == 0.0);
+    CHECK(last.peak_force_N == 0.0);
+    const nlohmann::json json = Json(j, states);
+    CHECK(json["transitions"][2]["t_start_s"].is_null());
+    CHECK(json["transitions"][2]["t_end_s"].is_null());
+    CHECK(json["transitions"][2]["friction_work_J"].is_null());
+    // The text gives the not-reached transition no time span.
+    const std::string text = Text(j, states);
+    CHECK(text.find("{Fs n floor.top} -> {Fs - floor.top}: infeasible (not reached: the plan "
+                    "failed at an earlier transition)\n") != std::string::npos);
+    CHECK(text.find(" .. 0 s") == std::string::npos);
+  }
+  SECTION("when the replay starts elsewhere") {
+    // It starts in {Fe} with 2 J of friction work on its first tick: the first transition is
+    // infeasible and none has a span or figures.
+    std::vector<SyntheticTick> ticks;
+    Add(ticks, 1, 50);
+    ticks[0].friction_work_J = 2.0;
+    const plan::Judgement j = Run(states, ticks);
+    CHECK(j.transitions[0].reason ==
+          "the replay starts in {Fe - floor.top}, not in the planned {}");
+    for (const plan::TransitionVerdict& v : j.transitions) {
+      CHECK_FALSE(v.started);
+      CHECK(v.friction_work_J == 0.0);
+    }
+    CHECK(Text(j, states).find("friction work") == std::string::npos);
+  }
+  SECTION("when another planned state comes first") {
+    // {} then straight to {Fs n} (planned after {Fe}): the exit energy is the one at its entry.
+    std::vector<SyntheticTick> ticks;
+    Add(ticks, 0, 50);
+    Add(ticks, 2, 50);
+    const plan::Judgement j = Run(states, ticks);
+    const plan::TransitionVerdict& v = j.transitions[0];
+    CHECK(v.verdict == plan::Verdict::kInfeasible);
+    CHECK(v.t_end_s == Approx(0.051));
+    CHECK(v.energy_exit_J == Approx(0.051));
+  }
+}
 
 TEST_CASE("Fault ticks are not a state of the tube and are warned about", "[plan]") {
   // {} -> {Fe} -> goal; in {Fe} 30 ticks the core flags fault (with penetration and separated,

@@ -51,15 +51,21 @@ inline constexpr std::array<WarnedFlag, 5> kWarnedFlags = {{
 /// "for 0.012 s the core held the tube back ...": the warning for kWarnedFlags[i].
 std::string FlagWarning(std::size_t i, double seconds);
 
+/// A planned transition a -> b with what the replay did in its span: ticks from entering a
+/// (t_start_s) up to entering b (t_end_s, or the trajectory's last tick); a state is entered when
+/// the core first shows it, the tick it counts from. A transition the replay never got to has no
+/// span and no figures (started false).
 struct TransitionVerdict {
   std::string from, to;  ///< planned CFs
   Verdict verdict = Verdict::kInfeasible;
-  std::string reason;                     ///< empty when feasible
-  std::vector<std::string> detour;        ///< unplanned states passed between from and to
+  std::string reason;               ///< empty when feasible
+  std::vector<std::string> detour;  ///< unplanned states passed between from and to
+  bool started = false;             ///< the replay got to it: t_start_s .. t_end_s and figures hold
   double t_start_s = 0.0, t_end_s = 0.0;  ///< entering `from` .. entering `to` (or the end)
+  double t_failed_s = 0.0;  ///< when it was judged infeasible (the limit's tick, a state's entry)
   double peak_force_N = 0.0;
   double friction_work_J = 0.0;  ///< sum over sliding PCs of |F_f| times the slip
-  double energy_entry_J = 0.0, energy_exit_J = 0.0;
+  double energy_entry_J = 0.0, energy_exit_J = 0.0;  ///< at t_start_s and at t_end_s
   /// Time in ticks carrying each flag of kWarnedFlags (same order) [s].
   std::array<double, kWarnedFlags.size()> flagged_s{};
   /// The time for one flag of kWarnedFlags (0 for a flag not in it).
@@ -105,7 +111,21 @@ class Judging {
   long ticks() const { return j_.ticks; }
 
  private:
-  void Fail(std::size_t i, const std::string& reason);
+  // What ticks not yet given to a span showed: those since the core entered the state it is in
+  // now (raw_), which belong to the span that state opens if it counts, else to the one under
+  // way.
+  struct Figures {
+    double peak_force_N = 0.0, friction_work_J = 0.0;
+    std::array<double, kWarnedFlags.size()> flagged_s{};
+    std::string failure;  // the first limit exceeded, with its time
+    double t_failure_s = 0.0;
+  };
+  void Start(double t_s, const core::StepOutput& out, const std::string& cf);
+  void Measure(double t_s, const core::StepOutput& out);
+  void Flush();  // pending_ into the span under way (or dropped once the plan failed)
+  void Counted();
+  TransitionVerdict* UnderWay();
+  void Fail(TransitionVerdict& v, const std::string& reason, double t_s);
 
   std::vector<std::string> states_;
   Limits limits_;
@@ -117,9 +137,10 @@ class Judging {
   std::string stable_, raw_;
   core::FormationKey raw_key_{};
   int raw_held_ = 0;
-  double raw_since_ = 0.0, raw_energy_ = 0.0, t_first_ = 0.0, t_last_ = 0.0;
+  double raw_since_ = 0.0, raw_energy_ = 0.0, t_first_ = 0.0, t_last_ = 0.0, energy_last_ = 0.0;
   std::vector<std::string> passed_;
   long stuck_ticks_ = 0;
+  Figures pending_;
 };
 
 /// Sees every tick of a replay after the core's step: the tick's time and the core (its last()
