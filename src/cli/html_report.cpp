@@ -98,7 +98,7 @@ void MarkExceeded(const ReplayRecording& r, Member member, double limit, const s
   }
 }
 
-// One row of the verdict table: a planned transition.
+// One row of the verdict table: a planned transition, or the stretch after the goal.
 std::string VerdictRow(const std::string& number, const plan::TransitionVerdict& v,
                        const std::string& what) {
   std::string why = EscapeXml(v.reason);
@@ -138,6 +138,9 @@ std::string VerdictTable(const Evaluated& e) {
     const plan::TransitionVerdict& v = e.judgement.transitions[k];
     o << VerdictRow(std::to_string(k + 1), v, EscapeXml(v.from) + " &rarr; " + EscapeXml(v.to));
   }
+  if (e.judgement.after_goal.started)
+    o << VerdictRow("", e.judgement.after_goal,
+                    "after the goal, in " + EscapeXml(e.judgement.after_goal.to));
   o << "</tbody></table>\n";
   return o.str();
 }
@@ -168,6 +171,11 @@ std::string Timeline(const Evaluated& e, const ReplayRecording& r,
                              ToString(v.verdict) +
                              (v.reason.empty() ? "" : " (" + v.reason + ")")});
   }
+  if (const plan::TransitionVerdict& v = j.after_goal; v.started)
+    plot.bars.push_back({0, v.t_start_s, v.t_end_s, VerdictColour(v.verdict),
+                         std::string("after the goal: ") + ToString(v.verdict),
+                         "after the goal, in " + v.to + ": " + ToString(v.verdict) +
+                             (v.reason.empty() ? "" : " (" + v.reason + ")")});
   const std::vector<std::string>& planned = e.plan.states;
   for (std::size_t k = 0; k < j.observed.size(); ++k) {
     const plan::Observation& ob = j.observed[k];
@@ -228,6 +236,7 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
   };
   for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k)
     mark(e.judgement.transitions[k], "transition " + std::to_string(k + 1));
+  mark(e.judgement.after_goal, "after the goal: the plan");
   std::string svg;
   for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
     svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";

@@ -213,10 +213,17 @@ class Display {
       if (i < at && v.verdict != plan::Verdict::kInfeasible) ++feasible;
       if (v.verdict == plan::Verdict::kInfeasible && !v.reason.empty()) ++infeasible;
     }
+    // After the goal: a limit exceeded or the goal left there is a verdict too.
+    const plan::TransitionVerdict& after = judging.after_goal();
+    const bool failed_after = after.started && after.verdict == plan::Verdict::kInfeasible;
+    infeasible += failed_after;
     std::ostringstream line;
     line << std::fixed << std::setprecision(2);
     line << "t " << std::setw(6) << s.t_s << " s  CF " << judging.current() << "  next "
-         << (at < n ? judging.states()[at + 1] : std::string("(goal reached)")) << "\n";
+         << (at < n          ? judging.states()[at + 1]
+             : failed_after ? std::string("(goal reached, then infeasible)")
+                            : std::string("(goal reached)"))
+         << "\n";
     line << "  progress " << at << "/" << n << "  force " << std::setw(5) << s.force_N << " N of "
          << max_force_N_ << " N  verdicts: " << feasible << " feasible, " << infeasible
          << " infeasible\n";

@@ -50,8 +50,8 @@ nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
 
 namespace {
 
-// One transition's verdict and figures. A transition the replay never got to has null times and
-// figures.
+// One span's verdict and figures: a planned transition, or the stretch after the goal. A span the
+// replay never got to has null times and figures.
 nlohmann::json SpanJson(const plan::TransitionVerdict& v) {
   const auto figure = [&](double value) {
     return v.started ? nlohmann::json(value) : nlohmann::json(nullptr);
@@ -95,6 +95,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
                      {"file", e.file},
                      {"feasible", j.feasible},
                      {"transitions", transitions},
+                     {"after_goal", j.after_goal.started ? SpanJson(j.after_goal) : nullptr},
                      {"observed", observed},
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
@@ -104,7 +105,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
 
 namespace {
 
-// A transition's lines: its verdict (and why), then its figures and its warnings.
+// A span's lines: its verdict (and why), then its figures and its warnings.
 void PrintSpan(std::ostream& t, const std::string& title, const plan::TransitionVerdict& v,
                const std::string& robust,
                const std::function<std::string(plan::Verdict, const std::string&)>& paint) {
@@ -156,6 +157,8 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     }
     PrintSpan(t, v.from + " -> " + v.to, v, robust.str(), paint);
   }
+  if (j.after_goal.started)
+    PrintSpan(t, "after the goal, in " + j.after_goal.to, j.after_goal, "", paint);
   t.precision(precision);
 }
 

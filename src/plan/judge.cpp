@@ -64,17 +64,19 @@ Judging::Judging(std::vector<std::string> states, const Limits& limits, double s
     j_.transitions[i].from = states_[i];
     j_.transitions[i].to = states_[i + 1];
   }
+  j_.after_goal.from = j_.after_goal.to = states_.back();
 }
 
-// The transition under way; none once the plan failed or the goal was reached.
+// The span under way: the transition, or the stretch after the goal; none once the plan failed.
 TransitionVerdict* Judging::UnderWay() {
-  if (failed_ || at_ >= n_) return nullptr;
-  return j_.transitions[at_].started ? &j_.transitions[at_] : nullptr;
+  if (failed_) return nullptr;
+  if (at_ < n_) return j_.transitions[at_].started ? &j_.transitions[at_] : nullptr;
+  return j_.after_goal.started ? &j_.after_goal : nullptr;
 }
 
 void Judging::Fail(TransitionVerdict& v, const std::string& reason, double t_s) {
   if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) return;  // the first reason stays
-  v.reason = reason;
+  v.reason = (&v == &j_.after_goal ? "after the goal: " : "") + reason;
   v.verdict = Verdict::kInfeasible;
   v.t_failed_s = t_s;
 }
@@ -164,7 +166,18 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
 
 // A new state counted (raw_, entered at raw_since_).
 void Judging::Counted() {
-  if (failed_ || at_ >= n_) return;
+  if (failed_) return;
+  if (at_ == n_) {
+    // After the goal: any other state counting leaves it.
+    if (left_goal_for_.empty() && raw_ != states_.back()) {
+      left_goal_for_ = raw_;
+      left_goal_at_s_ = raw_since_;
+      char when[48];
+      std::snprintf(when, sizeof when, " at t = %.3f s", raw_since_);
+      Fail(j_.after_goal, "left the goal for " + raw_ + when, raw_since_);
+    }
+    return;
+  }
   const std::vector<std::string>& states = states_;
   TransitionVerdict& v = j_.transitions[at_];
   if (raw_ == states[at_ + 1]) {
@@ -178,12 +191,11 @@ void Judging::Counted() {
       return;
     }
     v.verdict = v.detour.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
-    if (at_ < n_) {
-      TransitionVerdict& next = j_.transitions[at_];
-      next.started = true;
-      next.t_start_s = raw_since_;
-      next.energy_entry_J = raw_energy_;
-    }
+    TransitionVerdict& next = at_ < n_ ? j_.transitions[at_] : j_.after_goal;
+    next.started = true;
+    next.t_start_s = raw_since_;
+    next.energy_entry_J = raw_energy_;
+    if (at_ == n_) next.verdict = Verdict::kFeasible;
   } else if (std::find(states.begin() + long(at_) + 2, states.end(), raw_) != states.end()) {
     v.t_end_s = raw_since_;
     v.energy_exit_J = raw_energy_;
@@ -224,13 +236,29 @@ Judgement Judging::Finish() {
     }
     failed_ = true;
   }
+  TransitionVerdict& after = j_.after_goal;
+  if (after.started && !failed_) {
+    after.t_end_s = t_end;
+    after.energy_exit_J = energy_last_;
+    // A plan whose trajectory ends outside its goal says so, and where it went first.
+    if (!left_goal_for_.empty() && after.reason.find("left the goal") == std::string::npos) {
+      char when[48];
+      std::snprintf(when, sizeof when, " at t = %.3f s", left_goal_at_s_);
+      after.reason += "; left the goal for " + left_goal_for_ + when;
+    }
+    if (stable_ != states.back())
+      after.reason += "; the trajectory ended in " + stable_ + ", not in the goal";
+    else if (!left_goal_for_.empty())
+      after.reason += "; it was back in the goal at the end";
+  }
   for (std::size_t i = 0; i < n_; ++i) {
     TransitionVerdict& v = j_.transitions[i];
     if (v.verdict == Verdict::kInfeasible && v.reason.empty())
       v.reason = "not reached: the plan failed at an earlier transition";
   }
   j_.feasible = std::all_of(j_.transitions.begin(), j_.transitions.end(),
-                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; });
+                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; }) &&
+                after.started && after.verdict != Verdict::kInfeasible;
   j_.replayed_s = t_end - t_first_;
   return j_;
 }

@@ -1,6 +1,6 @@
 // The judge on synthetic ticks: each span's figures are those of its own ticks, a transition the
-// replay never got to has no span, and ticks the core flags as faults neither count as a state nor
-// pass without a warning.
+// replay never got to has no span, limits and the goal hold after the goal is reached, and ticks
+// the core flags as faults neither count as a state nor pass without a warning.
 #include <sstream>
 #include <string>
 #include <vector>
@@ -89,7 +89,7 @@ TEST_CASE("A transition's figures are those of its span: entering a .. entering 
   Add(ticks, 1, 50);
   Add(ticks, 3, 50);
   // A 2 N spike at the goal's first tick (101) and 1 J of friction work at {Fe}'s first tick (51):
-  // each belongs to the span the state opens (none for the goal), not to the one it ends.
+  // each belongs to the span the state opens, not to the one it ends.
   ticks[100].force_N = 2.0;
   ticks[50].friction_work_J = 1.0;
   const plan::Judgement j = Run(states, ticks);
@@ -108,6 +108,12 @@ TEST_CASE("A transition's figures are those of its span: entering a .. entering 
   CHECK(a.energy_exit_J == Approx(0.051));
   CHECK(b.energy_entry_J == Approx(0.051));
   CHECK(b.energy_exit_J == Approx(0.101));
+  // The stretch after the goal: from the goal's entry to the last tick, with the spike.
+  CHECK(j.after_goal.started);
+  CHECK(j.after_goal.t_start_s == Approx(0.101));
+  CHECK(j.after_goal.t_end_s == Approx(0.150));
+  CHECK(j.after_goal.peak_force_N == 2.0);
+  CHECK(j.after_goal.energy_exit_J == Approx(0.150));
 }
 
 TEST_CASE("A transition never reached has no span and no figures", "[plan]") {
@@ -130,10 +136,12 @@ TEST_CASE("A transition never reached has no span and no figures", "[plan]") {
     CHECK(last.reason == "not reached: the plan failed at an earlier transition");
     CHECK(last.friction_work_J == 0.0);
     CHECK(last.peak_force_N == 0.0);
+    CHECK_FALSE(j.after_goal.started);
     const nlohmann::json json = Json(j, states);
     CHECK(json["transitions"][2]["t_start_s"].is_null());
     CHECK(json["transitions"][2]["t_end_s"].is_null());
     CHECK(json["transitions"][2]["friction_work_J"].is_null());
+    CHECK(json["after_goal"].is_null());
     // The text gives the not-reached transition no time span.
     const std::string text = Text(j, states);
     CHECK(text.find("{Fs n floor.top} -> {Fs - floor.top}: infeasible (not reached: the plan "
@@ -165,6 +173,54 @@ TEST_CASE("A transition never reached has no span and no figures", "[plan]") {
     CHECK(v.verdict == plan::Verdict::kInfeasible);
     CHECK(v.t_end_s == Approx(0.051));
     CHECK(v.energy_exit_J == Approx(0.051));
+  }
+}
+
+TEST_CASE("Limits and the goal hold after the goal is reached", "[plan]") {
+  const std::vector<std::string> states = {kNames[0], kNames[1], kNames[3]};
+  std::vector<SyntheticTick> ticks;
+  Add(ticks, 0, 50);
+  Add(ticks, 1, 50);
+  SECTION("a limit exceeded after the goal") {
+    Add(ticks, 3, 100);
+    ticks[149].force_N = 9.0;  // t = 0.150 s, 49 ms after the goal was entered
+    const plan::Judgement j = Run(states, ticks);
+    for (const plan::TransitionVerdict& v : j.transitions)
+      CHECK(v.verdict == plan::Verdict::kFeasible);
+    CHECK_FALSE(j.feasible);
+    CHECK(j.after_goal.verdict == plan::Verdict::kInfeasible);
+    CHECK(j.after_goal.reason ==
+          "after the goal: limit exceeded: operator force 9 N > 8.5 N at t = 0.150 s");
+    CHECK(Text(j, states).find("INFEASIBLE") != std::string::npos);
+    CHECK(Json(j, states)["after_goal"]["verdict"] == "infeasible");
+  }
+  SECTION("leaving the goal, and ending outside it") {
+    Add(ticks, 3, 50);
+    Add(ticks, 2, 50);  // {Fs n} from t = 0.151 s to the end
+    const plan::Judgement j = Run(states, ticks);
+    CHECK_FALSE(j.feasible);
+    CHECK(j.after_goal.reason ==
+          "after the goal: left the goal for {Fs n floor.top} at t = 0.151 s; the trajectory "
+          "ended in {Fs n floor.top}, not in the goal");
+  }
+  SECTION("leaving the goal and coming back") {
+    Add(ticks, 3, 50);
+    Add(ticks, 2, 30);
+    Add(ticks, 3, 30);
+    const plan::Judgement j = Run(states, ticks);
+    CHECK_FALSE(j.feasible);
+    CHECK(j.after_goal.reason ==
+          "after the goal: left the goal for {Fs n floor.top} at t = 0.151 s; it was back in the "
+          "goal at the end");
+  }
+  SECTION("a flicker shorter than the dwell is not leaving") {
+    Add(ticks, 3, 50);
+    Add(ticks, 2, 10);
+    Add(ticks, 3, 30);
+    const plan::Judgement j = Run(states, ticks);
+    CHECK(j.feasible);
+    CHECK(j.after_goal.verdict == plan::Verdict::kFeasible);
+    CHECK(j.after_goal.reason.empty());
   }
 }
 

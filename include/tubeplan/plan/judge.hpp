@@ -51,10 +51,10 @@ inline constexpr std::array<WarnedFlag, 5> kWarnedFlags = {{
 /// "for 0.012 s the core held the tube back ...": the warning for kWarnedFlags[i].
 std::string FlagWarning(std::size_t i, double seconds);
 
-/// A planned transition a -> b with what the replay did in its span: ticks from entering a
-/// (t_start_s) up to entering b (t_end_s, or the trajectory's last tick); a state is entered when
-/// the core first shows it, the tick it counts from. A transition the replay never got to has no
-/// span and no figures (started false).
+/// A planned transition a -> b, or the stretch after the goal (Judgement::after_goal), with what
+/// the replay did in its span: ticks from entering a (t_start_s) up to entering b (t_end_s, or
+/// the trajectory's last tick); a state is entered when the core first shows it, the tick it
+/// counts from. A transition the replay never got to has no span and no figures (started false).
 struct TransitionVerdict {
   std::string from, to;  ///< planned CFs
   Verdict verdict = Verdict::kInfeasible;
@@ -78,8 +78,13 @@ struct Observation {
 };
 
 struct Judgement {
+  /// Every transition feasible, and the trajectory kept the goal within the limits after it.
   bool feasible = false;
   std::vector<TransitionVerdict> transitions;
+  /// From entering the goal to the trajectory's end (from = to = the goal), started only when
+  /// every transition was feasible: limits hold over the whole trajectory, and leaving the goal
+  /// (another state counting) makes it infeasible, with the reason "after the goal: ...".
+  TransitionVerdict after_goal;
   std::vector<Observation> observed;  ///< counted states, in order
   long ticks = 0;
   double replayed_s = 0.0;  ///< trajectory time replayed
@@ -101,6 +106,7 @@ class Judging {
 
   // The judgement so far (live display).
   const std::vector<TransitionVerdict>& transitions() const { return j_.transitions; }
+  const TransitionVerdict& after_goal() const { return j_.after_goal; }
   const std::vector<Observation>& observed() const { return j_.observed; }
   /// Index of the planned transition under way; states().size() - 1 once all are done.
   std::size_t at() const { return at_; }
@@ -141,6 +147,8 @@ class Judging {
   std::vector<std::string> passed_;
   long stuck_ticks_ = 0;
   Figures pending_;
+  std::string left_goal_for_;  // the first state counted after the goal, and when
+  double left_goal_at_s_ = 0.0;
 };
 
 /// Sees every tick of a replay after the core's step: the tick's time and the core (its last()
