@@ -259,10 +259,11 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
   nlohmann::json t = nlohmann::json::array(), cf = nlohmann::json::array(),
                  line = nlohmann::json::array(), held = nlohmann::json::array(),
                  hand = nlohmann::json::array(), force = nlohmann::json::array(),
-                 contacts = nlohmann::json::array();
+                 force_abs = nlohmann::json::array(), contacts = nlohmann::json::array();
   for (const ReplayRecording::Frame& f : r.frames) {
     t.push_back(Round(f.t_s, 1e-4));
     cf.push_back(f.cf);
+    force_abs.push_back(f.force_N);  // exact: the readout shows the summary's figure
     nlohmann::json c = nlohmann::json::array();
     for (const Eigen::Vector3d& q : f.centreline_W_m)
       for (const double v : Mm(q)) c.push_back(v);
@@ -290,9 +291,11 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
             {"length_mm", s.tube.length_m * 1e3}}},
           {"parts", parts},
           {"cfs", r.cfs},
+          {"peak_frame", r.peak_frame},
           {"frames",
            {{"t_s", t},
             {"cf", cf},
+            {"force_abs_N", force_abs},
             {"centreline_mm", line},
             {"held_mm", held},
             {"hand_mm", hand},
@@ -316,6 +319,21 @@ std::string ScriptSafe(const std::string& json) {
 
 }  // namespace
 
+ReplayRecording::Frame ReplayRecorder::FrameOf(double t_s, const core::Core& core) const {
+  const core::StepOutput& out = core.last();
+  ReplayRecording::Frame f;
+  f.t_s = t_s;
+  f.cf = cf_;
+  f.force_N = out.force_W_N.norm();
+  core.Centreline(f.centreline_W_m);
+  f.p_WH_m = out.X_WH.translation();
+  f.p_W_hand_m = out.X_W_hand.translation();
+  f.force_W_N = out.force_W_N;
+  for (const core::ContactState& c : out.Contacts())
+    f.contacts.push_back({c.p_WC_m, c.normal_W * c.normal_force_N, c.friction_W_N, c.sliding});
+  return f;
+}
+
 void ReplayRecorder::operator()(double t_s, const core::Core& core) {
   const core::StepOutput& out = core.last();
   if (ticks_++ == 0) rec_.t_first_s = t_s;
@@ -329,7 +347,8 @@ void ReplayRecorder::operator()(double t_s, const core::Core& core) {
     friction_N += c.friction_W_N.norm();
     friction_limit_N += c.friction_limit_N;
   }
-  Take(b.force_N, t_s, out.force_W_N.norm(), new_bin);
+  const double force_N = out.force_W_N.norm();
+  Take(b.force_N, t_s, force_N, new_bin);
   Take(b.friction_N, t_s, friction_N, new_bin);
   Take(b.friction_limit_N, t_s, friction_limit_N, new_bin);
   Take(b.energy_J, t_s, out.energy_J, new_bin);
@@ -350,17 +369,23 @@ void ReplayRecorder::operator()(double t_s, const core::Core& core) {
     key_valid_ = true;
     cf_ = index_of(core.FormationText());
   }
+  // The peak's frame: made again whenever the force passes the largest so far.
+  if (!peak_ || force_N > peak_->force_N) peak_ = FrameOf(t_s, core);
   if (!new_bin) return;
-  ReplayRecording::Frame f;
-  f.t_s = t_s;
-  f.cf = cf_;
-  core.Centreline(f.centreline_W_m);
-  f.p_WH_m = out.X_WH.translation();
-  f.p_W_hand_m = out.X_W_hand.translation();
-  f.force_W_N = out.force_W_N;
-  for (const core::ContactState& c : out.Contacts())
-    f.contacts.push_back({c.p_WC_m, c.normal_W * c.normal_force_N, c.friction_W_N, c.sliding});
-  rec_.frames.push_back(std::move(f));
+  rec_.frames.push_back(FrameOf(t_s, core));
+}
+
+ReplayRecording ReplayRecorder::Finish() {
+  if (peak_) {
+    // The bins' frames are in time order; the peak's goes among them (it may be one of them).
+    const auto at =
+        std::lower_bound(rec_.frames.begin(), rec_.frames.end(), peak_->t_s,
+                         [](const ReplayRecording::Frame& f, double t) { return f.t_s < t; });
+    rec_.peak_frame = std::size_t(at - rec_.frames.begin());
+    if (at == rec_.frames.end() || at->t_s != peak_->t_s) rec_.frames.insert(at, std::move(*peak_));
+    peak_.reset();
+  }
+  return std::move(rec_);
 }
 
 std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options) {
@@ -386,8 +411,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "</tr></thead><tbody>\n";
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const Evaluated& e = *plans[i].evaluated;
-    double peak = 0.0;
-    for (const auto& v : e.judgement.transitions) peak = std::max(peak, v.peak_force_N);
+    // The whole replay's peak: the figure the 3D readout shows at the frame it opens on.
+    const double peak = e.judgement.peak_force_N;
     const plan::Verdict verdict =
         e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible;
     o << "<tr><td><a href=\"#plan-" << i << "\">" << EscapeXml(e.plan.name) << "</a></td><td>"
@@ -416,10 +441,9 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "<span class=\"c-friction\">&#8594; friction</span> <span class=\"c-operator\">&#8594; "
        "force on the operator</span> <span class=\"c-hand\">&#9679; hand</span></div></div>\n"
        "<p class=\"note\">Drag to orbit, wheel to zoom, right-drag to pan. Frames every 20 ms "
-       "of the judged replay (the core's own tube shape, Core::Centreline); the arrows' scale is "
-       "in "
-       "the corner box. "
-       "Click a plot below to jump there.</p></section>\n";
+       "of the judged replay (the core's own tube shape, Core::Centreline), and the tick of the "
+       "largest operator force, which the view opens at; the arrows' scale is in the corner "
+       "box. Click a plot below to jump there.</p></section>\n";
 
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const HtmlPlan& p = plans[i];

@@ -6,6 +6,7 @@
 // no second run of the core, no second physics.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,8 @@ namespace tubeplan::cli {
 inline constexpr const char* kTubeColour = "#f07814";
 
 /// One replay decimated for a page: plots keep each bin's minimum and maximum (with when they
-/// happened), so a one-tick spike stays visible; the 3D replay keeps one frame per bin.
+/// happened), so a one-tick spike stays visible; the 3D replay keeps one frame per bin (its first
+/// tick) and the frame of the replay's largest operator force.
 struct ReplayRecording {
   static constexpr int kCentrelinePoints = 24;
   struct Extremes {
@@ -42,7 +44,8 @@ struct ReplayRecording {
   };
   struct Frame {
     double t_s = 0.0;
-    int cf = 0;  ///< index into cfs
+    int cf = 0;            ///< index into cfs
+    double force_N = 0.0;  ///< |force on the operator|, exact
     std::array<Eigen::Vector3d, kCentrelinePoints> centreline_W_m;
     Eigen::Vector3d p_WH_m, p_W_hand_m, force_W_N;
     std::vector<Contact> contacts;
@@ -50,7 +53,8 @@ struct ReplayRecording {
   double bin_s = 0.02;
   double t_first_s = 0.0, t_last_s = 0.0;
   std::vector<Bin> bins;
-  std::vector<Frame> frames;
+  std::vector<Frame> frames;   ///< in time order; the peak's among them
+  std::size_t peak_frame = 0;  ///< the frame of the largest operator force (the first such tick)
   /// The CFs the frames name, in order of first appearance; a tick the core flagged as a fault
   /// is named kFaultCf (its formation there reads {}, which is not the tube's state).
   std::vector<std::string> cfs;
@@ -62,14 +66,17 @@ class ReplayRecorder {
  public:
   explicit ReplayRecorder(double bin_s = 0.02) { rec_.bin_s = bin_s; }
   void operator()(double t_s, const core::Core& core);
-  ReplayRecording Finish() { return std::move(rec_); }
+  ReplayRecording Finish();
 
  private:
+  ReplayRecording::Frame FrameOf(double t_s, const core::Core& core) const;
+
   ReplayRecording rec_;
   long ticks_ = 0;
   core::FormationKey key_{};
   bool key_valid_ = false;
   int cf_ = 0;
+  std::optional<ReplayRecording::Frame> peak_;
 };
 
 struct HtmlPlan {

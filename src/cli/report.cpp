@@ -97,6 +97,10 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
                      {"transitions", transitions},
                      {"after_goal", j.after_goal.started ? SpanJson(j.after_goal) : nullptr},
                      {"observed", observed},
+                     {"peak_force_N", j.peak_force_N},
+                     {"peak_force_t_s", j.peak_force_t_s},
+                     {"peak_strain", j.peak_strain},
+                     {"peak_strain_t_s", j.peak_strain_t_s},
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
   }

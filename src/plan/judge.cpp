@@ -138,6 +138,10 @@ void Judging::Tick(double t_s, const core::StepOutput& out,
   if (j_.ticks == 1) Start(t_s, out, cf_text());
   t_last_ = t_s;
   energy_last_ = out.energy_J;
+  if (const double force_N = out.force_W_N.norm(); force_N > j_.peak_force_N || j_.ticks == 1)
+    j_.peak_force_N = force_N, j_.peak_force_t_s = t_s;
+  if (out.max_strain > j_.peak_strain || j_.ticks == 1)
+    j_.peak_strain = out.max_strain, j_.peak_strain_t_s = t_s;
   stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
 
   // Debounce: a state counts once held `dwell` ticks. A tick the core flags as a fault shows no

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -65,9 +66,17 @@ TEST_CASE("The report's series are the judged replay's ticks, each bin's extreme
   CHECK(long(t_s.size()) == watched.ticks);
 
   // Bins of 20 ms: each bin's minimum and maximum are exactly the extremes of its ticks (a
-  // one-tick spike survives), and one 3D frame per bin.
+  // one-tick spike survives), and one 3D frame per bin, its first tick, and the peak's frame.
   REQUIRE(!r.bins.empty());
-  CHECK(r.frames.size() == r.bins.size());
+  CHECK(r.bin_s == 0.02);
+  CHECK((r.frames.size() == r.bins.size() || r.frames.size() == r.bins.size() + 1));
+  REQUIRE(r.peak_frame < r.frames.size());
+  const double peak_N = *std::max_element(force_N.begin(), force_N.end());
+  CHECK(r.frames[r.peak_frame].force_N == peak_N);
+  CHECK(r.frames[r.peak_frame].t_s ==
+        t_s[std::size_t(std::max_element(force_N.begin(), force_N.end()) - force_N.begin())]);
+  // The judge's peak of the whole replay is the same figure.
+  CHECK(watched.peak_force_N == peak_N);
   std::vector<double> lo(r.bins.size(), 1e300), hi(r.bins.size(), -1e300), e_hi = hi;
   for (std::size_t k = 0; k < t_s.size(); ++k) {
     const auto b = std::size_t(std::floor((t_s[k] - t_s.front()) / r.bin_s));
@@ -128,6 +137,17 @@ TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cl
     CHECK(p["frames"]["centreline_mm"].size() == frames);
     CHECK(p["frames"]["centreline_mm"][0].size() == 3 * cli::ReplayRecording::kCentrelinePoints);
     CHECK(p["parts"].size() == 3);
+    // The summary's peak force is the replay's peak, the frame the 3D view opens at.
+    const std::size_t peak = p["peak_frame"];
+    const std::vector<double> forces = p["frames"]["force_abs_N"];
+    CHECK(forces[peak] == *std::max_element(forces.begin(), forces.end()));
+    char figure[32];
+    std::snprintf(figure, sizeof figure, "%.3f", forces[peak]);
+    const std::size_t row = page.find(">" + p["name"].get<std::string>() + "</a></td>");
+    REQUIRE(row != std::string::npos);
+    const std::size_t row_end = page.find("</tr>", row);
+    CHECK(page.substr(row, row_end - row)
+              .find("<td class=\"num\">" + std::string(figure) + "</td>") != std::string::npos);
   }
   // The verdicts, the timeline, four plots a plan; the gentle plan's force over its 0.2 N limit
   // is marked (a span and a peak marker) on its force plot.

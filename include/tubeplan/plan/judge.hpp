@@ -86,6 +86,9 @@ struct Judgement {
   /// (another state counting) makes it infeasible, with the reason "after the goal: ...".
   TransitionVerdict after_goal;
   std::vector<Observation> observed;  ///< counted states, in order
+  /// The replay's largest operator force and strain over every tick, and when.
+  double peak_force_N = 0.0, peak_force_t_s = 0.0;
+  double peak_strain = 0.0, peak_strain_t_s = 0.0;
   long ticks = 0;
   double replayed_s = 0.0;  ///< trajectory time replayed
   double run_s = 0.0;       ///< wall time of the replay

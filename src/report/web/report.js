@@ -1,7 +1,7 @@
 // The 3D replay of the HTML report (tubeplan evaluate --html): the scene's parts and the tube's
-// deformed centreline per frame (recorded from the judged replay, 20 ms apart), with the contact
-// points and forces, animated with play/pause/scrub. three.js (window.THREE) is embedded before
-// this script. World frame: z up, millimetres.
+// deformed centreline per frame (recorded from the judged replay, 20 ms apart, and at its largest
+// force), with the contact points and forces, animated with play/pause/scrub. three.js
+// (window.THREE) is embedded before this script. World frame: z up, millimetres.
 'use strict';
 (() => {
   const data = JSON.parse(document.getElementById('tubeplan-data').textContent);
@@ -159,7 +159,7 @@
     scrub.value = String(frame);
     time = f.t_s[frame];
     clock.textContent = `t = ${time.toFixed(2)} s`;
-    const force = Math.hypot(...f.force_N[frame]);
+    const force = f.force_abs_N[frame];
     hud.innerHTML = '';
     const over = force > plan.max_force_N;
     const lines = [[`${plan.name}: ${plan.feasible ? 'FEASIBLE' : 'INFEASIBLE'}`, false],
@@ -211,9 +211,9 @@
     scrub.max = String(plan.frames.t_s.length - 1);
     newtonMm = niceScale(plan);
     buildWorld(plan);
-    // Open at the plan's largest force on the operator: where a limit is likeliest crossed.
-    const forces = plan.frames.force_N.map((f) => Math.hypot(...f));
-    showFrame(forces.indexOf(Math.max(...forces)));
+    // Open at the plan's largest force on the operator (the replay's peak tick, which the
+    // recording keeps as a frame): where a limit is likeliest crossed.
+    showFrame(plan.peak_frame);
   }
 
   function resize() {
