@@ -458,6 +458,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
       << Fixed(e.plan.limits.max_strain, 3) << ", penetration "
       << Fixed(e.plan.limits.max_penetration_m * 1e3, 3) << " mm, dwell "
       << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n";
+    if (!e.judgement.strain_warning.empty())
+      o << "<p class=\"warning\">warning: " << EscapeXml(e.judgement.strain_warning) << "</p>\n";
     o << VerdictTable(e);
     std::vector<report::Span> spans;
     const std::string plots = Plots(e, p.recording, spans);

@@ -349,7 +349,7 @@ int RunLive(const LiveOptions& o, Streams io) {
     config.max_stale_ticks = std::max(1, int(std::lround(igtl->options().stale_after_s / T)));
   device::ServoLoop servo(core, *dev, *clock, device::LimitsFor(dev->spec(), scene.device), config,
                           &ring, &status);
-  plan::Judging judging(plan.states, plan.limits, T);
+  plan::Judging judging(plan.states, plan.limits, T, scene.tube);
   const std::vector<scene::PartElement>& elements = core.elements();
 
   const bool stdout_terminal = isatty(STDOUT_FILENO) != 0;

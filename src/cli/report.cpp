@@ -91,6 +91,8 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
     }
     nlohmann::json observed = nlohmann::json::array();
     for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
+    nlohmann::json warnings = nlohmann::json::array();
+    if (!j.strain_warning.empty()) warnings.push_back(j.strain_warning);
     plans.push_back({{"plan", e.plan.name},
                      {"file", e.file},
                      {"feasible", j.feasible},
@@ -101,6 +103,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
                      {"peak_force_t_s", j.peak_force_t_s},
                      {"peak_strain", j.peak_strain},
                      {"peak_strain_t_s", j.peak_strain_t_s},
+                     {"warnings", warnings},
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
   }
@@ -150,6 +153,7 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     << ", " << j.transitions.size()
     << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
     << " s replayed\n";
+  if (!j.strain_warning.empty()) t << "  warning: " << j.strain_warning << "\n";
   for (std::size_t k = 0; k < j.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = j.transitions[k];
     std::ostringstream robust;

@@ -19,6 +19,7 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/judge.hpp>
 
 #include "commands.hpp"
 #include "series_format.hpp"
@@ -140,6 +141,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
 
   const std::size_t tick_count = ticks.count();
   const double duration_s = ticks.TimeOf(tick_count - 1) - ticks.TimeOf(0);
+  // The same warning evaluate gives for a strain beyond the material's elastic range.
+  const std::string strain_warning = plan::StrainWarning(s.tube, peak_strain, peak_strain_t);
   if (o.json) {
     nlohmann::json j;
     j["scene"] = o.scene_path;
@@ -163,6 +166,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["peak_strain"] = peak_strain;
     j["peak_strain_t"] = peak_strain_t;
     j["peak_energy_J"] = peak_energy_J;
+    j["warnings"] =
+        strain_warning.empty() ? nlohmann::json::array() : nlohmann::json::array({strain_warning});
     nlohmann::json flags;
     for (int b = 0; b < core::kStepFlagCount; ++b)
       flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
@@ -192,6 +197,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   text << "peak force " << peak_force_N << " N at t = " << peak_force_t << " s; peak torque "
        << peak_torque_Nm << " N m; peak strain " << peak_strain << " at t = " << peak_strain_t
        << " s; peak bending energy " << peak_energy_J << " J\n";
+  if (!strain_warning.empty()) text << "warning: " << strain_warning << "\n";
   text << "ticks flagged:";
   bool any = false;
   for (int b = 0; b < core::kStepFlagCount; ++b)

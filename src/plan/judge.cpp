@@ -45,16 +45,34 @@ std::string FlagWarning(std::size_t i, double seconds) {
   return buffer + std::string(kWarnedFlags[i].meaning);
 }
 
+double ElasticStrainLimit(const model::TubeSpec& tube) {
+  return tube.youngs_modulus_Pa >= 1e10 ? 0.005 : 0.5;
+}
+
+std::string StrainWarning(const model::TubeSpec& tube, double strain, double t_s) {
+  const double limit = ElasticStrainLimit(tube);
+  if (!(strain > limit)) return "";
+  char buffer[320];
+  std::snprintf(buffer, sizeof buffer,
+                "strain %.4g at t = %.3f s is beyond the tube material's elastic range (%.3g for "
+                "E %s 10 GPa): the beam models bend an elastic tube with small strains, so the "
+                "forces, energies and shapes past it are not the tube's",
+                strain, t_s, limit, tube.youngs_modulus_Pa >= 1e10 ? ">=" : "<");
+  return buffer;
+}
+
 double TransitionVerdict::FlaggedSeconds(std::uint32_t flag) const {
   for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
     if (kWarnedFlags[i].flag == flag) return flagged_s[i];
   return 0.0;
 }
 
-Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s)
+Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s,
+                 std::optional<model::TubeSpec> tube)
     : states_(std::move(states)),
       limits_(limits),
       step_s_(step_s),
+      tube_(std::move(tube)),
       dwell_(std::max(1, static_cast<int>(std::lround(limits.dwell_s / step_s)))) {
   if (states_.size() < 2) throw std::invalid_argument("Judging: a plan needs two states");
   // Per planned transition i (states[i] -> states[i+1]).
@@ -264,6 +282,7 @@ Judgement Judging::Finish() {
                             [](const auto& v) { return v.verdict != Verdict::kInfeasible; }) &&
                 after.started && after.verdict != Verdict::kInfeasible;
   j_.replayed_s = t_end - t_first_;
+  if (tube_) j_.strain_warning = StrainWarning(*tube_, j_.peak_strain, j_.peak_strain_t_s);
   return j_;
 }
 
@@ -282,7 +301,7 @@ Judgement Judge(const scene::Scene& scene, TickSource& ticks,
   const double T = scene.model.time_step_s;
   core::Core core(scene);
   core.Reset(Pose(ticks.Tick(0)));
-  Judging judging(states, limits, T);
+  Judging judging(states, limits, T, scene.tube);
   const auto text = [&core] { return core.FormationText(); };
   for (std::size_t k = 0; k < ticks.count(); ++k) {
     const HandSample sample = ticks.Tick(k);

@@ -103,6 +103,35 @@ TEST_CASE("plans: a goal the tube starts in is said, and no plan is written", "[
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-start"));
 }
 
+TEST_CASE("simulate: a strain beyond the material's elastic range gets evaluate's warning",
+          "[cli]") {
+  // The groove's tube at E = 1 kPa, pushed into the floor: strain 1766 at t = 2.285 s, three and
+  // a half thousand times the 0.5 an elastomer bends elastically to. The insertion's first 2.3 s.
+  const std::string scene =
+      GrooveWith("simulate-soft", "youngs_modulus: 3 MPa", "youngs_modulus: 1e3 Pa");
+  std::string csv;
+  {
+    std::istringstream rows(tubeplan::testing::Slurp(SourcePath("plans/groove-insert.csv")));
+    for (std::string row; std::getline(rows, row) && row.rfind("2.301", 0) != 0;) csv += row + "\n";
+  }
+  const std::string trajectory = tubeplan::testing::WriteScratch("simulate-soft", "t.csv", csv);
+  const Outcome r = RunTool({"simulate", scene, trajectory});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("\nwarning: strain 1766 at t = 2.285 s is beyond the tube material's elastic "
+                   "range (0.5 for E < 10 GPa)") != std::string::npos);
+  const Outcome j = RunTool({"simulate", scene, trajectory, "--json"});
+  REQUIRE(j.exit_code == 0);
+  const nlohmann::json json = nlohmann::json::parse(j.out);
+  REQUIRE(json["warnings"].size() == 1);
+  // The same sentence evaluate gives a plan (one function makes both).
+  CHECK(r.out.find(json["warnings"][0].get<std::string>()) != std::string::npos);
+  // The shipped scene's tube stays within its range: no warning.
+  const Outcome rubber = RunTool({"simulate", SourcePath("scenes/groove.yaml"), trajectory});
+  CHECK(rubber.out.find("warning:") == std::string::npos);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("simulate-soft"));
+}
+
 TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli]") {
   Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "1", "--jobs", "2"});
   CHECK(r.exit_code == 1);  // one sweep does not reach the goal

@@ -6,10 +6,12 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <tubeplan/core/core.hpp>
+#include <tubeplan/model/tube.hpp>
 #include <tubeplan/plan/plan.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
@@ -51,6 +53,14 @@ inline constexpr std::array<WarnedFlag, 5> kWarnedFlags = {{
 /// "for 0.012 s the core held the tube back ...": the warning for kWarnedFlags[i].
 std::string FlagWarning(std::size_t i, double seconds);
 
+/// The warning for a strain beyond the tube material's elastic range (ElasticStrainLimit), or ""
+/// when `strain` is within it: what `simulate` and `evaluate` print.
+std::string StrainWarning(const model::TubeSpec& tube, double strain, double t_s);
+/// The largest strain the tube's material bends elastically to, as far as bending theory goes:
+/// 0.5 % for a material of E >= 10 GPa (metals and hard plastics yield near it), 50 % below
+/// (elastomers stay elastic far beyond, but small-strain bending theory degrades past it).
+double ElasticStrainLimit(const model::TubeSpec& tube);
+
 /// A planned transition a -> b, or the stretch after the goal (Judgement::after_goal), with what
 /// the replay did in its span: ticks from entering a (t_start_s) up to entering b (t_end_s, or
 /// the trajectory's last tick); a state is entered when the core first shows it, the tick it
@@ -89,6 +99,9 @@ struct Judgement {
   /// The replay's largest operator force and strain over every tick, and when.
   double peak_force_N = 0.0, peak_force_t_s = 0.0;
   double peak_strain = 0.0, peak_strain_t_s = 0.0;
+  /// StrainWarning of the peak strain ("" within the material's elastic range, or when the judge
+  /// was not given the tube).
+  std::string strain_warning;
   long ticks = 0;
   double replayed_s = 0.0;  ///< trajectory time replayed
   double run_s = 0.0;       ///< wall time of the replay
@@ -98,8 +111,10 @@ struct Judgement {
 /// output of every tick, so both give the same verdicts for the same ticks.
 class Judging {
  public:
-  /// `states`: planned CFs (canonical, at least two); `step_s`: the core's step.
-  Judging(std::vector<std::string> states, const Limits& limits, double step_s);
+  /// `states`: planned CFs (canonical, at least two); `step_s`: the core's step; `tube`: the
+  /// replayed tube, for the warning on strains beyond its material's elastic range.
+  Judging(std::vector<std::string> states, const Limits& limits, double step_s,
+          std::optional<model::TubeSpec> tube = std::nullopt);
 
   /// One tick at t_s. `cf_text` gives the CF's canonical text (core::Core::FormationText()); it is
   /// called only on a tick whose formation key differs from the last one's.
@@ -139,6 +154,7 @@ class Judging {
   std::vector<std::string> states_;
   Limits limits_;
   double step_s_;
+  std::optional<model::TubeSpec> tube_;
   int dwell_;
   Judgement j_;
   std::size_t n_ = 0, at_ = 0;
