@@ -38,6 +38,16 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
+// A bin's width as the page says it: "20 ms", "2.56 s".
+std::string Duration(double s) {
+  char buf[48];
+  if (s < 1.0)
+    std::snprintf(buf, sizeof buf, "%.3g ms", s * 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g s", s);
+  return buf;
+}
+
 // Three significant digits: energies and work span many decades.
 std::string Sig(double v) {
   char buf[48];
@@ -58,6 +68,7 @@ std::vector<report::PlotPoint> Envelope(const ReplayRecording& r, Member member)
   std::vector<report::PlotPoint> points;
   points.reserve(r.bins.size() * 2);
   for (const ReplayRecording::Bin& b : r.bins) {
+    if (b.ticks == 0) continue;
     const ReplayRecording::Extremes& e = b.*member;
     if (e.t_min_s <= e.t_max_s) {
       points.push_back({e.t_min_s, e.min, ""});
@@ -76,13 +87,13 @@ template <typename Member>
 void MarkExceeded(const ReplayRecording& r, Member member, double limit, const std::string& unit,
                   const std::string& what, report::LinePlot& plot) {
   for (std::size_t i = 0; i < r.bins.size();) {
-    if (!((r.bins[i].*member).max > limit)) {
+    if (r.bins[i].ticks == 0 || !((r.bins[i].*member).max > limit)) {
       ++i;
       continue;
     }
     report::Span span{(r.bins[i].*member).t_max_s, 0.0, ""};
     report::PlotPoint peak{0.0, -1e300, ""};
-    for (; i < r.bins.size() && (r.bins[i].*member).max > limit; ++i) {
+    for (; i < r.bins.size() && r.bins[i].ticks > 0 && (r.bins[i].*member).max > limit; ++i) {
       const ReplayRecording::Extremes& e = r.bins[i].*member;
       span.x0 = std::min(span.x0, std::min(e.t_min_s, e.t_max_s));
       span.x1 = std::max(span.x1, e.t_max_s);
@@ -201,7 +212,8 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
   };
   using Bin = ReplayRecording::Bin;
   report::LinePlot force = base("Operator force |F|", "N");
-  force.series = {{"|F| (min/max per 20 ms)", "#0072B2", Envelope(r, &Bin::force_N)}};
+  force.series = {
+      {"|F| (min/max per " + Duration(r.bin_s) + ")", "#0072B2", Envelope(r, &Bin::force_N)}};
   force.limits = {{limits.max_force_N, "limit " + Fixed(limits.max_force_N, 3) + " N"}};
   MarkExceeded(r, &Bin::force_N, limits.max_force_N, "N", "operator force", force);
 
@@ -291,6 +303,7 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
             {"length_mm", s.tube.length_m * 1e3}}},
           {"parts", parts},
           {"cfs", r.cfs},
+          {"bin_s", r.bin_s},
           {"peak_frame", r.peak_frame},
           {"frames",
            {{"t_s", t},
@@ -319,6 +332,11 @@ std::string ScriptSafe(const std::string& json) {
 
 }  // namespace
 
+ReplayRecorder::ReplayRecorder(double bin_s, std::size_t max_bins)
+    : max_bins_(std::max<std::size_t>(2, max_bins)) {
+  rec_.bin_s = bin_s;
+}
+
 ReplayRecording::Frame ReplayRecorder::FrameOf(double t_s, const core::Core& core) const {
   const core::StepOutput& out = core.last();
   ReplayRecording::Frame f;
@@ -334,14 +352,54 @@ ReplayRecording::Frame ReplayRecorder::FrameOf(double t_s, const core::Core& cor
   return f;
 }
 
+void ReplayRecorder::Halve() {
+  using Bin = ReplayRecording::Bin;
+  const auto merge = [](ReplayRecording::Extremes& into, const ReplayRecording::Extremes& e) {
+    if (e.min < into.min) into.min = e.min, into.t_min_s = e.t_min_s;
+    if (e.max > into.max) into.max = e.max, into.t_max_s = e.t_max_s;
+  };
+  std::vector<Bin> bins((rec_.bins.size() + 1) / 2);
+  for (std::size_t i = 0; i < rec_.bins.size(); ++i) {
+    const Bin& b = rec_.bins[i];
+    Bin& into = bins[i / 2];
+    if (b.ticks == 0) continue;
+    if (into.ticks == 0) {
+      into = b;
+      continue;
+    }
+    into.ticks += b.ticks;
+    merge(into.force_N, b.force_N);
+    merge(into.friction_N, b.friction_N);
+    merge(into.friction_limit_N, b.friction_limit_N);
+    merge(into.energy_J, b.energy_J);
+    merge(into.strain, b.strain);
+  }
+  rec_.bins = std::move(bins);
+  // A merged bin's frame is its first tick's: the first frame of the pair.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < rec_.frames.size(); ++i) {
+    ReplayRecording::Frame& f = rec_.frames[i];
+    f.bin /= 2;
+    if (kept > 0 && rec_.frames[kept - 1].bin == f.bin) continue;
+    if (kept != i) rec_.frames[kept] = std::move(f);
+    ++kept;
+  }
+  rec_.frames.resize(kept);
+  rec_.bin_s *= 2.0;
+}
+
 void ReplayRecorder::operator()(double t_s, const core::Core& core) {
   const core::StepOutput& out = core.last();
   if (ticks_++ == 0) rec_.t_first_s = t_s;
   rec_.t_last_s = t_s;
-  const auto bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
-  const bool new_bin = rec_.bins.size() <= bin;
-  if (new_bin) rec_.bins.resize(bin + 1);
+  auto bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
+  while (bin >= max_bins_) {
+    Halve();
+    bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
+  }
+  if (rec_.bins.size() <= bin) rec_.bins.resize(bin + 1);
   ReplayRecording::Bin& b = rec_.bins[bin];
+  const bool new_bin = b.ticks++ == 0;
   double friction_N = 0.0, friction_limit_N = 0.0;
   for (const core::ContactState& c : out.Contacts()) {
     friction_N += c.friction_W_N.norm();
@@ -370,9 +428,13 @@ void ReplayRecorder::operator()(double t_s, const core::Core& core) {
     cf_ = index_of(core.FormationText());
   }
   // The peak's frame: made again whenever the force passes the largest so far.
-  if (!peak_ || force_N > peak_->force_N) peak_ = FrameOf(t_s, core);
+  if (!peak_ || force_N > peak_->force_N) {
+    peak_ = FrameOf(t_s, core);
+    peak_->bin = bin;
+  }
   if (!new_bin) return;
   rec_.frames.push_back(FrameOf(t_s, core));
+  rec_.frames.back().bin = bin;
 }
 
 ReplayRecording ReplayRecorder::Finish() {
@@ -381,8 +443,13 @@ ReplayRecording ReplayRecorder::Finish() {
     const auto at =
         std::lower_bound(rec_.frames.begin(), rec_.frames.end(), peak_->t_s,
                          [](const ReplayRecording::Frame& f, double t) { return f.t_s < t; });
-    rec_.peak_frame = std::size_t(at - rec_.frames.begin());
-    if (at == rec_.frames.end() || at->t_s != peak_->t_s) rec_.frames.insert(at, std::move(*peak_));
+    if (at != rec_.frames.end() && at->t_s == peak_->t_s) {
+      rec_.peak_frame = std::size_t(at - rec_.frames.begin());
+    } else {
+      peak_->bin = at == rec_.frames.begin() ? 0 : std::prev(at)->bin;
+      rec_.peak_frame = std::size_t(at - rec_.frames.begin());
+      rec_.frames.insert(at, std::move(*peak_));
+    }
     peak_.reset();
   }
   return std::move(rec_);
@@ -441,9 +508,12 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "<span class=\"c-friction\">&#8594; friction</span> <span class=\"c-operator\">&#8594; "
        "force on the operator</span> <span class=\"c-hand\">&#9679; hand</span></div></div>\n"
        "<p class=\"note\">Drag to orbit, wheel to zoom, right-drag to pan. Frames every 20 ms "
-       "of the judged replay (the core's own tube shape, Core::Centreline), and the tick of the "
-       "largest operator force, which the view opens at; the arrows' scale is in the corner "
-       "box. Click a plot below to jump there.</p></section>\n";
+       "of the judged replay (every 20 ms or wider for a long one: a page holds at most "
+    << ReplayRecording::kMaxBins
+    << " frames a plan, the plan's own spacing in its section), the core's own tube shape "
+       "(Core::Centreline), and the tick of the largest operator force, which the view opens "
+       "at; the arrows' scale is in the corner box. Click a plot below to jump there.</p>"
+       "</section>\n";
 
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const HtmlPlan& p = plans[i];
@@ -457,7 +527,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
       << " core ticks; limits: force " << Fixed(e.plan.limits.max_force_N, 3) << " N, strain "
       << Fixed(e.plan.limits.max_strain, 3) << ", penetration "
       << Fixed(e.plan.limits.max_penetration_m * 1e3, 3) << " mm, dwell "
-      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n";
+      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms; plots and 3D frames every "
+      << Duration(p.recording.bin_s) << "</p>\n";
     if (!e.judgement.strain_warning.empty())
       o << "<p class=\"warning\">warning: " << EscapeXml(e.judgement.strain_warning) << "</p>\n";
     o << VerdictTable(e);

@@ -23,15 +23,20 @@ namespace tubeplan::cli {
 /// The tube's colour in the 3D replay (the browser test counts pixels of it).
 inline constexpr const char* kTubeColour = "#f07814";
 
-/// One replay decimated for a page: plots keep each bin's minimum and maximum (with when they
-/// happened), so a one-tick spike stays visible; the 3D replay keeps one frame per bin (its first
-/// tick) and the frame of the replay's largest operator force.
+/// One replay decimated for a page, bounded whatever its length: at most `max_bins` bins (50 Hz,
+/// 20 ms bins, until a replay is longer than max_bins of them; then the bins double in width as
+/// often as needed, pairs merged). Plots keep each bin's minimum and maximum (with when they
+/// happened), so a one-tick spike stays visible at any length; the 3D replay keeps one frame per
+/// bin (its first tick) and the frame of the replay's largest operator force.
 struct ReplayRecording {
   static constexpr int kCentrelinePoints = 24;
+  /// Bins a page keeps at most per plan (a page of plots 900 px wide needs no more).
+  static constexpr std::size_t kMaxBins = 2048;
   struct Extremes {
     double t_min_s = 0.0, min = 0.0, t_max_s = 0.0, max = 0.0;
   };
   struct Bin {
+    long ticks = 0;             ///< 0: no tick fell in it (a step longer than a bin)
     Extremes force_N;           ///< |force on the operator|
     Extremes friction_N;        ///< sum over PCs of |friction force|
     Extremes friction_limit_N;  ///< sum over PCs of the friction capacity f_max
@@ -44,6 +49,7 @@ struct ReplayRecording {
   };
   struct Frame {
     double t_s = 0.0;
+    std::size_t bin = 0;   ///< the bin it is the first tick of
     int cf = 0;            ///< index into cfs
     double force_N = 0.0;  ///< |force on the operator|, exact
     std::array<Eigen::Vector3d, kCentrelinePoints> centreline_W_m;
@@ -61,17 +67,20 @@ struct ReplayRecording {
 };
 inline constexpr const char* kFaultCf = "{} (solver fault: the core held the tube still)";
 
-/// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default).
+/// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default), at most
+/// `max_bins` of them (wider bins beyond).
 class ReplayRecorder {
  public:
-  explicit ReplayRecorder(double bin_s = 0.02) { rec_.bin_s = bin_s; }
+  explicit ReplayRecorder(double bin_s = 0.02, std::size_t max_bins = ReplayRecording::kMaxBins);
   void operator()(double t_s, const core::Core& core);
   ReplayRecording Finish();
 
  private:
+  void Halve();  // bins of twice the width: pairs merged, one frame kept per pair
   ReplayRecording::Frame FrameOf(double t_s, const core::Core& core) const;
 
   ReplayRecording rec_;
+  std::size_t max_bins_;
   long ticks_ = 0;
   core::FormationKey key_{};
   bool key_valid_ = false;
