@@ -3,7 +3,9 @@
 // the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
 // JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <iomanip>
 #include <map>
 #include <memory>
@@ -12,13 +14,16 @@
 #include <sstream>
 #include <thread>
 #include <tuple>
+#include <unistd.h>
 #include <variant>
 
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/motion.hpp>
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
@@ -42,7 +47,8 @@ struct GraphOptions {
   std::uint64_t seed = 1;
   int random = 120;
   int budget = 3000;
-  int jobs = 0;  // 0: the machine's cores
+  double time_limit_s = 0.0;  // 0: none
+  int jobs = 0;               // 0: the machine's cores
   std::string weights;
   std::optional<double> tolerance;
   std::string verdicts_path;  // graph only: an evaluate report
@@ -55,9 +61,10 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   const nlohmann::json report =
       text ? nlohmann::json::parse(*text, nullptr, false) : nlohmann::json();
   std::vector<graph::ReplayedPlan> plans;
-  bool ok = text && !report.is_discarded() && report.is_object() &&
-            report.value("tubeplan_evaluate", 0) == 1 && report.contains("plans") &&
-            report["plans"].is_array();
+  bool ok =
+      text && !report.is_discarded() && report.is_object() &&
+      (report.value("tubeplan_evaluate", 0) == 1 || report.value("tubeplan_evaluate", 0) == 2) &&
+      report.contains("plans") && report["plans"].is_array();
   for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
     const nlohmann::json& p = report["plans"][i];
     graph::ReplayedPlan r;
@@ -68,11 +75,15 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
       ok = t.is_object() && t.value("from", nlohmann::json()).is_string() &&
            t.value("to", nlohmann::json()).is_string() &&
            t.value("verdict", nlohmann::json()).is_string() &&
-           t.value("t_start_s", nlohmann::json()).is_number() &&
-           t.value("t_end_s", nlohmann::json()).is_number();
+           (t.value("t_start_s", nlohmann::json()).is_number() ||
+            t.value("t_start_s", nlohmann::json(0)).is_null()) &&
+           (t.value("t_end_s", nlohmann::json()).is_number() ||
+            t.value("t_end_s", nlohmann::json(0)).is_null());
+      // A transition the replay never got to has no span (null times): no step falls in it.
       if (ok)
-        r.transitions.push_back(
-            {t["from"], t["to"], t["verdict"] != "infeasible", t["t_start_s"], t["t_end_s"]});
+        r.transitions.push_back({t["from"], t["to"], t["verdict"] != "infeasible",
+                                 t["t_start_s"].is_null() ? 0.0 : t["t_start_s"].get<double>(),
+                                 t["t_end_s"].is_null() ? 0.0 : t["t_end_s"].get<double>()});
     }
     for (std::size_t k = 0; ok && k < p["observed"].size(); ++k) {
       const nlohmann::json& o = p["observed"][k];
@@ -85,7 +96,7 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   if (!ok) {
     err << path
         << ": error: not a readable tubeplan evaluate report, expected the JSON that "
-           "`tubeplan evaluate --report` writes (version 1)\n";
+           "`tubeplan evaluate --report` writes (version 1 or 2)\n";
     return std::nullopt;
   }
   return plans;
@@ -127,7 +138,11 @@ struct Built {
 };
 
 // Loads the scene, explores and prunes; on bad input reports and returns the exit code.
-std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
+// `before` (may be empty) sees the scene before the exploration and may end the command there
+// with an exit code.
+std::variant<Built, int> BuildGraph(
+    const GraphOptions& o, Streams io,
+    const std::function<std::optional<int>(const scene::Scene&)>& before = {}) {
   io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
   io.err << loaded.diagnostics.FormatAll();
   if (!loaded.scene) return kExitBadInput;
@@ -151,13 +166,30 @@ std::variant<Built, int> BuildGraph(const GraphOptions& o, Streams io) {
   explore.seed = o.seed;
   explore.random_motions = o.random;
   explore.max_motions = o.budget;
+  explore.time_limit_s = o.time_limit_s;
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
+  // Progress on a terminal only, about once a second, on one line (a log stays clean).
+  if (isatty(STDERR_FILENO) != 0) {
+    explore.status = [&io, path = o.scene_path](const graph::ExploreStatus& st) {
+      char line[200];
+      std::snprintf(line, sizeof line,
+                    "\rexploring %s: %s, %d motions done, %d started; the graph so far %d CFs, "
+                    "%d transitions; %.0f s\033[K",
+                    path.c_str(), st.phase.c_str(), st.motions_done, st.motions_started, st.nodes,
+                    st.arcs, st.seconds);
+      io.err << line << std::flush;
+    };
+  }
   std::optional<std::vector<graph::ReplayedPlan>> verdicts;
   if (!o.verdicts_path.empty()) {
     verdicts = ReadVerdicts(o.verdicts_path, io.err);
     if (!verdicts) return kExitBadInput;
   }
+  if (before)
+    if (const std::optional<int> code = before(s)) return *code;
   graph::ContactGraph g = graph::Explore(s, explore);
+  if (explore.status) io.err << "\r\033[K" << std::flush;
+  explore.status = nullptr;
   graph::Prune(g, weights);
   if (verdicts) graph::ApplyVerdicts(g, *verdicts);
   return Built{s, std::move(g), explore, weights};
@@ -171,9 +203,15 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,
-                  "stop after this many motions in all, saturated or not (said in the output)")
+                  "run at most this many motions in all (a motion: one list of guarded moves of "
+                  "the hand from the start pose; docs/graph.md), saturated or not (said in the "
+                  "output)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
+  sub->add_option("--time-limit", o.time_limit_s,
+                  "stop exploring after this many seconds of wall time, saturated or not (said in "
+                  "the output; default: no limit)")
+      ->check(CLI::Range(0.001, 1e7));
   sub->add_option("--jobs", o.jobs, "threads (default: the machine's cores)")
       ->check(CLI::Range(1, 256));
   sub->add_option("--weights", o.weights,
@@ -264,11 +302,17 @@ int RunGraph(const GraphOptions& o, Streams io) {
       << kProbes << " small motions (" << explore.probe_step_m * 1e3
       << " mm along and against 3 directions, " << explore.probe_turn_rad * 180.0 / std::numbers::pi
       << " deg about 2 axes), the last round found no new state)\n";
+  } else if (g.end == graph::ExploreEnd::kTimeLimit) {
+    t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
+      << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
+      << " states probed)\n";
   } else {
-    t << "  (NOT saturated: the budget of " << explore.max_motions << " motions ran out with "
+    t << "  (NOT saturated: stopped by the budget of " << explore.max_motions << " motions, with "
       << g.probed << " of " << g.nodes.size() << " states probed)\n";
   }
-  t << "start " << g.nodes[std::size_t(g.start)].cf << "; goal " << states::ToString(s.goal)
+  t << "start "
+    << (g.start >= 0 ? g.nodes[std::size_t(g.start)].cf : "not reached (no motion ended)")
+    << "; goal " << states::ToString(s.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
   t << "part elements touched: " << g.reached_elements.size()
     << "; never touched: " << g.unreached_elements.size();
@@ -339,10 +383,29 @@ int RunPlans(const PlansOptions& o, Streams io) {
     if (!OutputsApart("plans", outputs, {{"the scene", o.graph.scene_path}}, io.err))
       return kExitBadInput;
   }
-  std::variant<Built, int> built = BuildGraph(o.graph, io);
+  // A goal the tube starts in leaves nothing to plan: said before any exploration.
+  const auto nothing_to_plan = [&](const scene::Scene& s, const std::string& start) {
+    io.err << o.graph.scene_path << ": nothing to plan: the goal " << states::ToString(s.goal)
+           << " is the state the tube starts in (" << start
+           << " at the scene's start pose), so a plan would be that one state and no move; no "
+              "plan written. Give the scene a goal the tube has to be moved to\n";
+    return kExitNegative;
+  };
+  std::variant<Built, int> built =
+      BuildGraph(o.graph, io, [&](const scene::Scene& s) -> std::optional<int> {
+        core::Core core(s);
+        core.Reset(graph::MotionStart(s));
+        core.Step(s.model.time_step_s, graph::MotionStart(s));
+        const std::string start = core.FormationText();
+        if (start != states::ToString(s.goal)) return std::nullopt;
+        return nothing_to_plan(s, start);
+      });
   if (const int* code = std::get_if<int>(&built)) return *code;
   const Built& b = std::get<Built>(built);
   const graph::ContactGraph& g = b.graph;
+  // The explorer's start state can differ from a tick at rest (its first tick moves the hand).
+  if (g.goal >= 0 && g.goal == g.start)
+    return nothing_to_plan(b.scene, g.nodes[std::size_t(g.start)].cf);
   if (g.goal < 0) {
     io.err << o.graph.scene_path << ": error: exploration never reached the goal "
            << states::ToString(b.scene.goal) << ", so there is no plan to extract; expected a "

@@ -25,19 +25,22 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   nlohmann::json j;
   j["tubeplan_graph"] = kGraphJsonVersion;
   j["scene"] = scene_path;
-  j["parameters"] = {{"seed", explore.seed},
-                     {"random_motions", explore.random_motions},
-                     {"budget", explore.max_motions},
-                     {"probe_step_m", explore.probe_step_m},
-                     {"probe_turn_rad", explore.probe_turn_rad},
-                     {"push_N", explore.push_N},
-                     {"speed_m_per_s", explore.speed_m_per_s},
-                     {"substeps", explore.substeps},
-                     {"weights",
-                      {{"friction", weights.friction},
-                       {"energy", weights.energy},
-                       {"distance", weights.distance}}},
-                     {"tolerance", weights.tolerance}};
+  j["parameters"] = {
+      {"seed", explore.seed},
+      {"random_motions", explore.random_motions},
+      {"budget", explore.max_motions},
+      {"time_limit_s",
+       explore.time_limit_s > 0.0 ? nlohmann::json(explore.time_limit_s) : nlohmann::json(nullptr)},
+      {"probe_step_m", explore.probe_step_m},
+      {"probe_turn_rad", explore.probe_turn_rad},
+      {"push_N", explore.push_N},
+      {"speed_m_per_s", explore.speed_m_per_s},
+      {"substeps", explore.substeps},
+      {"weights",
+       {{"friction", weights.friction},
+        {"energy", weights.energy},
+        {"distance", weights.distance}}},
+      {"tolerance", weights.tolerance}};
   j["start"] = g.start >= 0 ? nlohmann::json(g.nodes[std::size_t(g.start)].cf) : nullptr;
   j["goal"] = g.goal >= 0 ? nlohmann::json(g.nodes[std::size_t(g.goal)].cf) : nullptr;
   nlohmann::json nodes = nlohmann::json::array();
@@ -96,10 +99,17 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
     if (m.prefix_ticks > 0) motions.back()["prefix_ticks"] = m.prefix_ticks;
   }
   j["motions"] = motions;
-  j["stats"] = {{"motions", g.motions.size()},  {"ticks", g.ticks},
-                {"refinements", g.refinements}, {"held_back", g.held_back},
-                {"probed", g.probed},           {"saturated", g.saturated},
-                {"seconds", g.seconds},         {"jobs", explore.jobs}};
+  j["stats"] = {{"motions", g.motions.size()},
+                {"ticks", g.ticks},
+                {"refinements", g.refinements},
+                {"held_back", g.held_back},
+                {"probed", g.probed},
+                {"saturated", g.saturated},
+                {"ended_by", g.end == graph::ExploreEnd::kSaturated ? "saturation"
+                             : g.end == graph::ExploreEnd::kBudget  ? "budget"
+                                                                    : "time_limit"},
+                {"seconds", g.seconds},
+                {"jobs", explore.jobs}};
   return j;
 }
 

@@ -38,6 +38,16 @@ std::string Fixed(double v, int digits) {
   return buf;
 }
 
+// A bin's width as the page says it: "20 ms", "2.56 s".
+std::string Duration(double s) {
+  char buf[48];
+  if (s < 1.0)
+    std::snprintf(buf, sizeof buf, "%.3g ms", s * 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%.3g s", s);
+  return buf;
+}
+
 // Three significant digits: energies and work span many decades.
 std::string Sig(double v) {
   char buf[48];
@@ -58,6 +68,7 @@ std::vector<report::PlotPoint> Envelope(const ReplayRecording& r, Member member)
   std::vector<report::PlotPoint> points;
   points.reserve(r.bins.size() * 2);
   for (const ReplayRecording::Bin& b : r.bins) {
+    if (b.ticks == 0) continue;
     const ReplayRecording::Extremes& e = b.*member;
     if (e.t_min_s <= e.t_max_s) {
       points.push_back({e.t_min_s, e.min, ""});
@@ -76,13 +87,13 @@ template <typename Member>
 void MarkExceeded(const ReplayRecording& r, Member member, double limit, const std::string& unit,
                   const std::string& what, report::LinePlot& plot) {
   for (std::size_t i = 0; i < r.bins.size();) {
-    if (!((r.bins[i].*member).max > limit)) {
+    if (r.bins[i].ticks == 0 || !((r.bins[i].*member).max > limit)) {
       ++i;
       continue;
     }
     report::Span span{(r.bins[i].*member).t_max_s, 0.0, ""};
     report::PlotPoint peak{0.0, -1e300, ""};
-    for (; i < r.bins.size() && (r.bins[i].*member).max > limit; ++i) {
+    for (; i < r.bins.size() && r.bins[i].ticks > 0 && (r.bins[i].*member).max > limit; ++i) {
       const ReplayRecording::Extremes& e = r.bins[i].*member;
       span.x0 = std::min(span.x0, std::min(e.t_min_s, e.t_max_s));
       span.x1 = std::max(span.x1, e.t_max_s);
@@ -98,6 +109,37 @@ void MarkExceeded(const ReplayRecording& r, Member member, double limit, const s
   }
 }
 
+// One row of the verdict table: a planned transition, or the stretch after the goal.
+std::string VerdictRow(const std::string& number, const plan::TransitionVerdict& v,
+                       const std::string& what) {
+  std::string why = EscapeXml(v.reason);
+  if (!v.detour.empty()) {
+    std::string via = v.reason.empty() ? "via" : "; via";
+    for (const std::string& d : v.detour) via += " " + d;
+    why += EscapeXml(via);
+  }
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    if (v.flagged_s[i] > 0.0)
+      why += "<div class=\"warning\">warning: " + EscapeXml(plan::FlagWarning(i, v.flagged_s[i])) +
+             "</div>";
+  std::ostringstream o;
+  o << "<tr><td>" << number << "</td><td class=\"cf\">" << what
+    << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
+    << plan::ToString(v.verdict) << "</span></td><td>" << why << "</td>";
+  if (v.started) {
+    o << "<td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
+      << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
+      << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
+      << " &rarr; " << Sig(v.energy_exit_J * 1e6) << "</td>";
+  } else {
+    // Not reached: no span and no figures.
+    o << "<td class=\"num\">&ndash;</td><td class=\"num\">&ndash;</td>"
+         "<td class=\"num\">&ndash;</td><td class=\"num\">&ndash;</td>";
+  }
+  o << "</tr>\n";
+  return o.str();
+}
+
 std::string VerdictTable(const Evaluated& e) {
   std::ostringstream o;
   o << "<table class=\"verdicts\"><thead><tr><th>#</th><th>planned transition</th>"
@@ -105,20 +147,11 @@ std::string VerdictTable(const Evaluated& e) {
        "<th>friction work [&micro;J]</th><th>bending energy [&micro;J]</th></tr></thead><tbody>\n";
   for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = e.judgement.transitions[k];
-    std::string why = v.reason;
-    if (!v.detour.empty()) {
-      why += why.empty() ? "via" : "; via";
-      for (const std::string& d : v.detour) why += " " + d;
-    }
-    o << "<tr><td>" << k + 1 << "</td><td class=\"cf\">" << EscapeXml(v.from) << " &rarr; "
-      << EscapeXml(v.to)
-      << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(v.verdict) << "\">"
-      << plan::ToString(v.verdict) << "</span></td><td>" << EscapeXml(why)
-      << "</td><td class=\"num\">" << Fixed(v.t_start_s, 3) << " &ndash; " << Fixed(v.t_end_s, 3)
-      << "</td><td class=\"num\">" << Fixed(v.peak_force_N, 3) << "</td><td class=\"num\">"
-      << Sig(v.friction_work_J * 1e6) << "</td><td class=\"num\">" << Sig(v.energy_entry_J * 1e6)
-      << " &rarr; " << Sig(v.energy_exit_J * 1e6) << "</td></tr>\n";
+    o << VerdictRow(std::to_string(k + 1), v, EscapeXml(v.from) + " &rarr; " + EscapeXml(v.to));
   }
+  if (e.judgement.after_goal.started)
+    o << VerdictRow("", e.judgement.after_goal,
+                    "after the goal, in " + EscapeXml(e.judgement.after_goal.to));
   o << "</tbody></table>\n";
   return o.str();
 }
@@ -142,15 +175,18 @@ std::string Timeline(const Evaluated& e, const ReplayRecording& r,
     if (lane.emplace(ob.cf, int(plot.lanes.size())).second) plot.lanes.push_back(ob.cf);
   for (std::size_t k = 0; k < j.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = j.transitions[k];
-    if (v.t_end_s <= v.t_start_s && v.verdict == plan::Verdict::kInfeasible &&
-        v.reason.rfind("not reached", 0) == 0)
-      continue;  // never started
-    plot.bars.push_back({0, v.t_start_s, std::max(v.t_end_s, v.t_start_s), VerdictColour(v.verdict),
+    if (!v.started) continue;  // never reached: no span
+    plot.bars.push_back({0, v.t_start_s, v.t_end_s, VerdictColour(v.verdict),
                          std::to_string(k + 1) + " " + ToString(v.verdict),
                          std::to_string(k + 1) + ": " + v.from + " -> " + v.to + ": " +
                              ToString(v.verdict) +
                              (v.reason.empty() ? "" : " (" + v.reason + ")")});
   }
+  if (const plan::TransitionVerdict& v = j.after_goal; v.started)
+    plot.bars.push_back({0, v.t_start_s, v.t_end_s, VerdictColour(v.verdict),
+                         std::string("after the goal: ") + ToString(v.verdict),
+                         "after the goal, in " + v.to + ": " + ToString(v.verdict) +
+                             (v.reason.empty() ? "" : " (" + v.reason + ")")});
   const std::vector<std::string>& planned = e.plan.states;
   for (std::size_t k = 0; k < j.observed.size(); ++k) {
     const plan::Observation& ob = j.observed[k];
@@ -176,7 +212,8 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
   };
   using Bin = ReplayRecording::Bin;
   report::LinePlot force = base("Operator force |F|", "N");
-  force.series = {{"|F| (min/max per 20 ms)", "#0072B2", Envelope(r, &Bin::force_N)}};
+  force.series = {
+      {"|F| (min/max per " + Duration(r.bin_s) + ")", "#0072B2", Envelope(r, &Bin::force_N)}};
   force.limits = {{limits.max_force_N, "limit " + Fixed(limits.max_force_N, 3) + " N"}};
   MarkExceeded(r, &Bin::force_N, limits.max_force_N, "N", "operator force", force);
 
@@ -199,17 +236,19 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
   spans.insert(spans.end(), strain.spans.begin(), strain.spans.end());
   // The moment a transition was judged infeasible for another reason than a limit (those are
   // shaded above): another state reached, never reached, stalled. A thin line on every chart.
-  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k) {
-    const plan::TransitionVerdict& v = e.judgement.transitions[k];
-    if (v.verdict != plan::Verdict::kInfeasible || v.reason.rfind("limit exceeded", 0) == 0 ||
-        v.reason.rfind("not reached", 0) == 0)
-      continue;
-    const report::Span moment{v.t_end_s, v.t_end_s,
-                              "transition " + std::to_string(k + 1) +
-                                  " infeasible at t = " + Fixed(v.t_end_s, 3) + " s: " + v.reason};
+  const auto mark = [&](const plan::TransitionVerdict& v, const std::string& what) {
+    if (!v.started || v.verdict != plan::Verdict::kInfeasible ||
+        v.reason.find("limit exceeded") != std::string::npos)
+      return;
+    const report::Span moment{
+        v.t_failed_s, v.t_failed_s,
+        what + " infeasible at t = " + Fixed(v.t_failed_s, 3) + " s: " + v.reason};
     spans.push_back(moment);
     for (report::LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
-  }
+  };
+  for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k)
+    mark(e.judgement.transitions[k], "transition " + std::to_string(k + 1));
+  mark(e.judgement.after_goal, "after the goal: the plan");
   std::string svg;
   for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
     svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";
@@ -232,10 +271,11 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
   nlohmann::json t = nlohmann::json::array(), cf = nlohmann::json::array(),
                  line = nlohmann::json::array(), held = nlohmann::json::array(),
                  hand = nlohmann::json::array(), force = nlohmann::json::array(),
-                 contacts = nlohmann::json::array();
+                 force_abs = nlohmann::json::array(), contacts = nlohmann::json::array();
   for (const ReplayRecording::Frame& f : r.frames) {
     t.push_back(Round(f.t_s, 1e-4));
     cf.push_back(f.cf);
+    force_abs.push_back(f.force_N);  // exact: the readout shows the summary's figure
     nlohmann::json c = nlohmann::json::array();
     for (const Eigen::Vector3d& q : f.centreline_W_m)
       for (const double v : Mm(q)) c.push_back(v);
@@ -263,9 +303,12 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
             {"length_mm", s.tube.length_m * 1e3}}},
           {"parts", parts},
           {"cfs", r.cfs},
+          {"bin_s", r.bin_s},
+          {"peak_frame", r.peak_frame},
           {"frames",
            {{"t_s", t},
             {"cf", cf},
+            {"force_abs_N", force_abs},
             {"centreline_mm", line},
             {"held_mm", held},
             {"hand_mm", hand},
@@ -289,44 +332,127 @@ std::string ScriptSafe(const std::string& json) {
 
 }  // namespace
 
-void ReplayRecorder::operator()(double t_s, const core::Core& core) {
-  const core::StepOutput& out = core.last();
-  if (ticks_++ == 0) rec_.t_first_s = t_s;
-  rec_.t_last_s = t_s;
-  const auto bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
-  const bool new_bin = rec_.bins.size() <= bin;
-  if (new_bin) rec_.bins.resize(bin + 1);
-  ReplayRecording::Bin& b = rec_.bins[bin];
-  double friction_N = 0.0, friction_limit_N = 0.0;
-  for (const core::ContactState& c : out.Contacts()) {
-    friction_N += c.friction_W_N.norm();
-    friction_limit_N += c.friction_limit_N;
-  }
-  Take(b.force_N, t_s, out.force_W_N.norm(), new_bin);
-  Take(b.friction_N, t_s, friction_N, new_bin);
-  Take(b.friction_limit_N, t_s, friction_limit_N, new_bin);
-  Take(b.energy_J, t_s, out.energy_J, new_bin);
-  Take(b.strain, t_s, out.max_strain, new_bin);
+ReplayRecorder::ReplayRecorder(double bin_s, std::size_t max_bins)
+    : max_bins_(std::max<std::size_t>(2, max_bins)) {
+  rec_.bin_s = bin_s;
+}
 
-  // The CF's text only when it changes (it allocates); its index for every frame.
-  const core::FormationKey key = core::KeyOf(out);
-  if (rec_.cfs.empty() || key != key_) {
-    key_ = key;
-    const std::string text = core.FormationText();
-    cf_ = int(std::find(rec_.cfs.begin(), rec_.cfs.end(), text) - rec_.cfs.begin());
-    if (cf_ == int(rec_.cfs.size())) rec_.cfs.push_back(text);
-  }
-  if (!new_bin) return;
+ReplayRecording::Frame ReplayRecorder::FrameOf(double t_s, const core::Core& core) const {
+  const core::StepOutput& out = core.last();
   ReplayRecording::Frame f;
   f.t_s = t_s;
   f.cf = cf_;
+  f.force_N = out.force_W_N.norm();
   core.Centreline(f.centreline_W_m);
   f.p_WH_m = out.X_WH.translation();
   f.p_W_hand_m = out.X_W_hand.translation();
   f.force_W_N = out.force_W_N;
   for (const core::ContactState& c : out.Contacts())
     f.contacts.push_back({c.p_WC_m, c.normal_W * c.normal_force_N, c.friction_W_N, c.sliding});
-  rec_.frames.push_back(std::move(f));
+  return f;
+}
+
+void ReplayRecorder::Halve() {
+  using Bin = ReplayRecording::Bin;
+  const auto merge = [](ReplayRecording::Extremes& into, const ReplayRecording::Extremes& e) {
+    if (e.min < into.min) into.min = e.min, into.t_min_s = e.t_min_s;
+    if (e.max > into.max) into.max = e.max, into.t_max_s = e.t_max_s;
+  };
+  std::vector<Bin> bins((rec_.bins.size() + 1) / 2);
+  for (std::size_t i = 0; i < rec_.bins.size(); ++i) {
+    const Bin& b = rec_.bins[i];
+    Bin& into = bins[i / 2];
+    if (b.ticks == 0) continue;
+    if (into.ticks == 0) {
+      into = b;
+      continue;
+    }
+    into.ticks += b.ticks;
+    merge(into.force_N, b.force_N);
+    merge(into.friction_N, b.friction_N);
+    merge(into.friction_limit_N, b.friction_limit_N);
+    merge(into.energy_J, b.energy_J);
+    merge(into.strain, b.strain);
+  }
+  rec_.bins = std::move(bins);
+  // A merged bin's frame is its first tick's: the first frame of the pair.
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < rec_.frames.size(); ++i) {
+    ReplayRecording::Frame& f = rec_.frames[i];
+    f.bin /= 2;
+    if (kept > 0 && rec_.frames[kept - 1].bin == f.bin) continue;
+    if (kept != i) rec_.frames[kept] = std::move(f);
+    ++kept;
+  }
+  rec_.frames.resize(kept);
+  rec_.bin_s *= 2.0;
+}
+
+void ReplayRecorder::operator()(double t_s, const core::Core& core) {
+  const core::StepOutput& out = core.last();
+  if (ticks_++ == 0) rec_.t_first_s = t_s;
+  rec_.t_last_s = t_s;
+  auto bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
+  while (bin >= max_bins_) {
+    Halve();
+    bin = static_cast<std::size_t>(std::floor((t_s - rec_.t_first_s) / rec_.bin_s));
+  }
+  if (rec_.bins.size() <= bin) rec_.bins.resize(bin + 1);
+  ReplayRecording::Bin& b = rec_.bins[bin];
+  const bool new_bin = b.ticks++ == 0;
+  double friction_N = 0.0, friction_limit_N = 0.0;
+  for (const core::ContactState& c : out.Contacts()) {
+    friction_N += c.friction_W_N.norm();
+    friction_limit_N += c.friction_limit_N;
+  }
+  const double force_N = out.force_W_N.norm();
+  Take(b.force_N, t_s, force_N, new_bin);
+  Take(b.friction_N, t_s, friction_N, new_bin);
+  Take(b.friction_limit_N, t_s, friction_limit_N, new_bin);
+  Take(b.energy_J, t_s, out.energy_J, new_bin);
+  Take(b.strain, t_s, out.max_strain, new_bin);
+
+  // The CF's text only when it changes (it allocates); its index for every frame. A fault tick
+  // shows no state of the tube: it is named so.
+  const auto index_of = [&](const std::string& text) {
+    const int i = int(std::find(rec_.cfs.begin(), rec_.cfs.end(), text) - rec_.cfs.begin());
+    if (i == int(rec_.cfs.size())) rec_.cfs.push_back(text);
+    return i;
+  };
+  if (out.flags & core::kSolverFault) {
+    cf_ = index_of(kFaultCf);
+    key_valid_ = false;
+  } else if (const core::FormationKey key = core::KeyOf(out); !key_valid_ || key != key_) {
+    key_ = key;
+    key_valid_ = true;
+    cf_ = index_of(core.FormationText());
+  }
+  // The peak's frame: made again whenever the force passes the largest so far.
+  if (!peak_ || force_N > peak_->force_N) {
+    peak_ = FrameOf(t_s, core);
+    peak_->bin = bin;
+  }
+  if (!new_bin) return;
+  rec_.frames.push_back(FrameOf(t_s, core));
+  rec_.frames.back().bin = bin;
+}
+
+ReplayRecording ReplayRecorder::Finish() {
+  if (peak_) {
+    // The bins' frames are in time order; the peak's goes among them (it may be one of them).
+    const auto at =
+        std::lower_bound(rec_.frames.begin(), rec_.frames.end(), peak_->t_s,
+                         [](const ReplayRecording::Frame& f, double t) { return f.t_s < t; });
+    if (at != rec_.frames.end() && at->t_s == peak_->t_s) {
+      rec_.peak_frame = std::size_t(at - rec_.frames.begin());
+    } else {
+      peak_->bin = at == rec_.frames.begin() ? 0 : std::prev(at)->bin;
+      rec_.peak_frame = std::size_t(at - rec_.frames.begin());
+      rec_.frames.insert(at, std::move(*peak_));
+    }
+    peak_.reset();
+  }
+  return std::move(rec_);
 }
 
 std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options) {
@@ -352,8 +478,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "</tr></thead><tbody>\n";
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const Evaluated& e = *plans[i].evaluated;
-    double peak = 0.0;
-    for (const auto& v : e.judgement.transitions) peak = std::max(peak, v.peak_force_N);
+    // The whole replay's peak: the figure the 3D readout shows at the frame it opens on.
+    const double peak = e.judgement.peak_force_N;
     const plan::Verdict verdict =
         e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible;
     o << "<tr><td><a href=\"#plan-" << i << "\">" << EscapeXml(e.plan.name) << "</a></td><td>"
@@ -382,10 +508,12 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "<span class=\"c-friction\">&#8594; friction</span> <span class=\"c-operator\">&#8594; "
        "force on the operator</span> <span class=\"c-hand\">&#9679; hand</span></div></div>\n"
        "<p class=\"note\">Drag to orbit, wheel to zoom, right-drag to pan. Frames every 20 ms "
-       "of the judged replay (the core's own tube shape, Core::Centreline); the arrows' scale is "
-       "in "
-       "the corner box. "
-       "Click a plot below to jump there.</p></section>\n";
+       "of the judged replay (every 20 ms or wider for a long one: a page holds at most "
+    << ReplayRecording::kMaxBins
+    << " frames a plan, the plan's own spacing in its section), the core's own tube shape "
+       "(Core::Centreline), and the tick of the largest operator force, which the view opens "
+       "at; the arrows' scale is in the corner box. Click a plot below to jump there.</p>"
+       "</section>\n";
 
   for (std::size_t i = 0; i < plans.size(); ++i) {
     const HtmlPlan& p = plans[i];
@@ -399,8 +527,11 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
       << " core ticks; limits: force " << Fixed(e.plan.limits.max_force_N, 3) << " N, strain "
       << Fixed(e.plan.limits.max_strain, 3) << ", penetration "
       << Fixed(e.plan.limits.max_penetration_m * 1e3, 3) << " mm, dwell "
-      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms</p>\n"
-      << VerdictTable(e);
+      << Fixed(e.plan.limits.dwell_s * 1e3, 1) << " ms; plots and 3D frames every "
+      << Duration(p.recording.bin_s) << "</p>\n";
+    if (!e.judgement.strain_warning.empty())
+      o << "<p class=\"warning\">warning: " << EscapeXml(e.judgement.strain_warning) << "</p>\n";
+    o << VerdictTable(e);
     std::vector<report::Span> spans;
     const std::string plots = Plots(e, p.recording, spans);
     o << "<div class=\"plot timeline\">" << Timeline(e, p.recording, spans) << "</div>\n"

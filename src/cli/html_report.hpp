@@ -6,6 +6,7 @@
 // no second run of the core, no second physics.
 
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,14 +23,20 @@ namespace tubeplan::cli {
 /// The tube's colour in the 3D replay (the browser test counts pixels of it).
 inline constexpr const char* kTubeColour = "#f07814";
 
-/// One replay decimated for a page: plots keep each bin's minimum and maximum (with when they
-/// happened), so a one-tick spike stays visible; the 3D replay keeps one frame per bin.
+/// One replay decimated for a page, bounded whatever its length: at most `max_bins` bins (50 Hz,
+/// 20 ms bins, until a replay is longer than max_bins of them; then the bins double in width as
+/// often as needed, pairs merged). Plots keep each bin's minimum and maximum (with when they
+/// happened), so a one-tick spike stays visible at any length; the 3D replay keeps one frame per
+/// bin (its first tick) and the frame of the replay's largest operator force.
 struct ReplayRecording {
   static constexpr int kCentrelinePoints = 24;
+  /// Bins a page keeps at most per plan (a page of plots 900 px wide needs no more).
+  static constexpr std::size_t kMaxBins = 2048;
   struct Extremes {
     double t_min_s = 0.0, min = 0.0, t_max_s = 0.0, max = 0.0;
   };
   struct Bin {
+    long ticks = 0;             ///< 0: no tick fell in it (a step longer than a bin)
     Extremes force_N;           ///< |force on the operator|
     Extremes friction_N;        ///< sum over PCs of |friction force|
     Extremes friction_limit_N;  ///< sum over PCs of the friction capacity f_max
@@ -42,7 +49,9 @@ struct ReplayRecording {
   };
   struct Frame {
     double t_s = 0.0;
-    int cf = 0;  ///< index into cfs
+    std::size_t bin = 0;   ///< the bin it is the first tick of
+    int cf = 0;            ///< index into cfs
+    double force_N = 0.0;  ///< |force on the operator|, exact
     std::array<Eigen::Vector3d, kCentrelinePoints> centreline_W_m;
     Eigen::Vector3d p_WH_m, p_W_hand_m, force_W_N;
     std::vector<Contact> contacts;
@@ -50,22 +59,33 @@ struct ReplayRecording {
   double bin_s = 0.02;
   double t_first_s = 0.0, t_last_s = 0.0;
   std::vector<Bin> bins;
-  std::vector<Frame> frames;
-  std::vector<std::string> cfs;  ///< the CFs the frames name, in order of first appearance
+  std::vector<Frame> frames;   ///< in time order; the peak's among them
+  std::size_t peak_frame = 0;  ///< the frame of the largest operator force (the first such tick)
+  /// The CFs the frames name, in order of first appearance; a tick the core flagged as a fault
+  /// is named kFaultCf (its formation there reads {}, which is not the tube's state).
+  std::vector<std::string> cfs;
 };
+inline constexpr const char* kFaultCf = "{} (solver fault: the core held the tube still)";
 
-/// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default).
+/// Records a replay tick by tick (plan::TickWatcher): bins of `bin_s` (50 Hz by default), at most
+/// `max_bins` of them (wider bins beyond).
 class ReplayRecorder {
  public:
-  explicit ReplayRecorder(double bin_s = 0.02) { rec_.bin_s = bin_s; }
+  explicit ReplayRecorder(double bin_s = 0.02, std::size_t max_bins = ReplayRecording::kMaxBins);
   void operator()(double t_s, const core::Core& core);
-  ReplayRecording Finish() { return std::move(rec_); }
+  ReplayRecording Finish();
 
  private:
+  void Halve();  // bins of twice the width: pairs merged, one frame kept per pair
+  ReplayRecording::Frame FrameOf(double t_s, const core::Core& core) const;
+
   ReplayRecording rec_;
+  std::size_t max_bins_;
   long ticks_ = 0;
   core::FormationKey key_{};
+  bool key_valid_ = false;
   int cf_ = 0;
+  std::optional<ReplayRecording::Frame> peak_;
 };
 
 struct HtmlPlan {

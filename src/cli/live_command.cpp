@@ -214,10 +214,17 @@ class Display {
       if (i < at && v.verdict != plan::Verdict::kInfeasible) ++feasible;
       if (v.verdict == plan::Verdict::kInfeasible && !v.reason.empty()) ++infeasible;
     }
+    // After the goal: a limit exceeded or the goal left there is a verdict too.
+    const plan::TransitionVerdict& after = judging.after_goal();
+    const bool failed_after = after.started && after.verdict == plan::Verdict::kInfeasible;
+    infeasible += failed_after;
     std::ostringstream line;
     line << std::fixed << std::setprecision(2);
     line << "t " << std::setw(6) << s.t_s << " s  CF " << judging.current() << "  next "
-         << (at < n ? judging.states()[at + 1] : std::string("(goal reached)")) << "\n";
+         << (at < n          ? judging.states()[at + 1]
+             : failed_after ? std::string("(goal reached, then infeasible)")
+                            : std::string("(goal reached)"))
+         << "\n";
     line << "  progress " << at << "/" << n << "  force " << std::setw(5) << s.force_N << " N of "
          << max_force_N_ << " N  verdicts: " << feasible << " feasible, " << infeasible
          << " infeasible\n";
@@ -351,7 +358,7 @@ int RunLive(const LiveOptions& o, Streams io) {
     config.max_stale_ticks = std::max(1, int(std::lround(igtl->options().stale_after_s / T)));
   device::ServoLoop servo(core, *dev, *clock, device::LimitsFor(dev->spec(), scene.device), config,
                           &ring, &status);
-  plan::Judging judging(plan.states, plan.limits, T);
+  plan::Judging judging(plan.states, plan.limits, T, scene.tube);
   const std::vector<scene::PartElement>& elements = core.elements();
 
   const bool stdout_terminal = isatty(STDOUT_FILENO) != 0;
@@ -443,7 +450,11 @@ int RunLive(const LiveOptions& o, Streams io) {
   e.plan = plan;
   e.judgement = judging.Finish();
   e.replayed_s = e.judgement.replayed_s;
-  nlohmann::json report = ToJson({e});
+  // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
+  ReportScope scope;
+  scope.plan_set_id = PlanSetId({CanonicalPlanPath(o.plan)});
+  scope.plan_set_plans = 1;
+  nlohmann::json report = ToJson({e}, scope);
   report["servo"] = {{"ticks", stats.ticks},
                      {"overruns", stats.overruns},
                      {"median_us", stats.median_us},

@@ -1,14 +1,38 @@
 #include "report.hpp"
 
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
 #include <iomanip>
+#include <sstream>
 
 #include <tubeplan/plan/perturb.hpp>
 
 namespace tubeplan::cli {
 
-// A report's plans in file order and its summary: what both `evaluate` and `merge` write, so a
-// merge of shard reports is the report of the unsharded run.
-nlohmann::json Report(nlohmann::json plans) {
+std::string CanonicalPlanPath(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
+  return (ec ? absolute.lexically_normal() : canonical).string();
+}
+
+std::string PlanSetId(std::vector<std::string> canonical_paths) {
+  std::sort(canonical_paths.begin(), canonical_paths.end());
+  std::uint64_t h = 1469598103934665603ull;
+  for (const std::string& path : canonical_paths) {
+    for (const unsigned char c : path) h = (h ^ c) * 1099511628211ull;
+    h = (h ^ static_cast<unsigned char>('\n')) * 1099511628211ull;
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  return hex;
+}
+
+// A report's plans in file order, what it covers and its summary: what both `evaluate` and
+// `merge` write, so a merge of shard reports is the report of the unsharded run.
+nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
   std::stable_sort(plans.begin(), plans.end(),
                    [](const nlohmann::json& a, const nlohmann::json& b) {
                      return a["file"].get<std::string>() < b["file"].get<std::string>();
@@ -18,30 +42,45 @@ nlohmann::json Report(nlohmann::json plans) {
   const long count = static_cast<long>(plans.size());
   return {
       {"tubeplan_evaluate", kEvaluateJsonVersion},
+      {"plan_set", {{"id", scope.plan_set_id}, {"plans", scope.plan_set_plans}}},
+      {"shard", {{"index", scope.shard_index}, {"count", scope.shard_count}}},
       {"plans", plans},
       {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
 }
 
-nlohmann::json ToJson(const std::vector<Evaluated>& results) {
+namespace {
+
+// One span's verdict and figures: a planned transition, or the stretch after the goal. A span the
+// replay never got to has null times and figures.
+nlohmann::json SpanJson(const plan::TransitionVerdict& v) {
+  const auto figure = [&](double value) {
+    return v.started ? nlohmann::json(value) : nlohmann::json(nullptr);
+  };
+  nlohmann::json j = {{"from", v.from},
+                      {"to", v.to},
+                      {"verdict", plan::ToString(v.verdict)},
+                      {"reason", v.reason},
+                      {"detour", v.detour},
+                      {"t_start_s", figure(v.t_start_s)},
+                      {"t_end_s", figure(v.t_end_s)},
+                      {"peak_force_N", figure(v.peak_force_N)},
+                      {"friction_work_J", figure(v.friction_work_J)},
+                      {"energy_entry_J", figure(v.energy_entry_J)},
+                      {"energy_exit_J", figure(v.energy_exit_J)}};
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    j[plan::kWarnedFlags[i].key] = figure(v.flagged_s[i]);
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope) {
   nlohmann::json plans = nlohmann::json::array();
   for (const Evaluated& e : results) {
     const plan::Judgement& j = e.judgement;
     nlohmann::json transitions = nlohmann::json::array();
     for (std::size_t k = 0; k < j.transitions.size(); ++k) {
-      const plan::TransitionVerdict& v = j.transitions[k];
-      transitions.push_back({{"from", v.from},
-                             {"to", v.to},
-                             {"verdict", plan::ToString(v.verdict)},
-                             {"reason", v.reason},
-                             {"detour", v.detour},
-                             {"t_start_s", v.t_start_s},
-                             {"t_end_s", v.t_end_s},
-                             {"peak_force_N", v.peak_force_N},
-                             {"friction_work_J", v.friction_work_J},
-                             {"energy_entry_J", v.energy_entry_J},
-                             {"energy_exit_J", v.energy_exit_J},
-                             {"beyond_linear_s", v.beyond_linear_s},
-                             {"unconverged_s", v.unconverged_s}});
+      transitions.push_back(SpanJson(j.transitions[k]));
       if (e.runs > 0) {
         const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
@@ -52,16 +91,51 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results) {
     }
     nlohmann::json observed = nlohmann::json::array();
     for (const plan::Observation& o : j.observed) observed.push_back({{"t", o.t_s}, {"cf", o.cf}});
+    nlohmann::json warnings = nlohmann::json::array();
+    if (!j.strain_warning.empty()) warnings.push_back(j.strain_warning);
     plans.push_back({{"plan", e.plan.name},
                      {"file", e.file},
                      {"feasible", j.feasible},
                      {"transitions", transitions},
+                     {"after_goal", j.after_goal.started ? SpanJson(j.after_goal) : nullptr},
                      {"observed", observed},
+                     {"peak_force_N", j.peak_force_N},
+                     {"peak_force_t_s", j.peak_force_t_s},
+                     {"peak_strain", j.peak_strain},
+                     {"peak_strain_t_s", j.peak_strain_t_s},
+                     {"warnings", warnings},
                      {"ticks", j.ticks},
                      {"replayed_s", j.replayed_s}});
   }
-  return Report(std::move(plans));
+  return Report(std::move(plans), scope);
 }
+
+namespace {
+
+// A span's lines: its verdict (and why), then its figures and its warnings.
+void PrintSpan(std::ostream& t, const std::string& title, const plan::TransitionVerdict& v,
+               const std::string& robust,
+               const std::function<std::string(plan::Verdict, const std::string&)>& paint) {
+  t << "  " << title << ": " << paint(v.verdict, plan::ToString(v.verdict));
+  if (!v.detour.empty()) {
+    t << " via";
+    for (const std::string& d : v.detour) t << " " << d;
+  }
+  if (!v.reason.empty()) t << " (" << v.reason << ")";
+  t << robust;
+  if (!v.started) {
+    t << "\n";
+    return;  // no span, no figures: the replay never got there
+  }
+  t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
+    << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
+    << " -> " << v.energy_exit_J << " J\n";
+  for (std::size_t i = 0; i < plan::kWarnedFlags.size(); ++i)
+    if (v.flagged_s[i] > 0.0)
+      t << "      warning: " << plan::FlagWarning(i, v.flagged_s[i]) << "\n";
+}
+
+}  // namespace
 
 void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
   auto paint = [&](plan::Verdict v, const std::string& text) {
@@ -79,31 +153,20 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
     << ", " << j.transitions.size()
     << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
     << " s replayed\n";
-  for (const plan::TransitionVerdict& v : j.transitions) {
-    t << "  " << v.from << " -> " << v.to << ": " << paint(v.verdict, plan::ToString(v.verdict));
-    if (!v.detour.empty()) {
-      t << " via";
-      for (const std::string& d : v.detour) t << " " << d;
-    }
-    if (!v.reason.empty()) t << " (" << v.reason << ")";
+  if (!j.strain_warning.empty()) t << "  warning: " << j.strain_warning << "\n";
+  for (std::size_t k = 0; k < j.transitions.size(); ++k) {
+    const plan::TransitionVerdict& v = j.transitions[k];
+    std::ostringstream robust;
     if (e.runs > 0) {
-      const std::size_t k = std::size_t(&v - j.transitions.data());
+      robust.precision(3);
       const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
-      t << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
-        << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
+      robust << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
+             << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
     }
-    t << "\n      t " << v.t_start_s << " .. " << v.t_end_s << " s, peak force " << v.peak_force_N
-      << " N, friction work " << v.friction_work_J << " J, bending energy " << v.energy_entry_J
-      << " -> " << v.energy_exit_J << " J\n";
-    if (v.beyond_linear_s > 0.0)
-      t << "      warning: for " << v.beyond_linear_s
-        << " s the linear model drew the tube beyond its range (tip deflection above l/3): "
-           "the verdict rests on a shape the tube cannot take\n";
-    if (v.unconverged_s > 0.0)
-      t << "      warning: for " << v.unconverged_s
-        << " s the core's solve stopped short of its tolerance (flag unconverged): the tube was "
-           "snapping through, or the hand jumped, and was between equilibria there\n";
+    PrintSpan(t, v.from + " -> " + v.to, v, robust.str(), paint);
   }
+  if (j.after_goal.started)
+    PrintSpan(t, "after the goal, in " + j.after_goal.to, j.after_goal, "", paint);
   t.precision(precision);
 }
 

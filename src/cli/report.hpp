@@ -13,7 +13,25 @@
 
 namespace tubeplan::cli {
 
-inline constexpr int kEvaluateJsonVersion = 1;
+/// Version 2 added the plan set and the shard a report covers (`plan_set`, `shard`).
+inline constexpr int kEvaluateJsonVersion = 2;
+
+/// What a report covers: shard `shard_index` of `shard_count` of one plan set, named by
+/// PlanSetId of its plans' canonical paths (`plan_set_plans` plans in the whole set). An
+/// unsharded run, a merge and a live run cover shard 1 of 1.
+struct ReportScope {
+  std::string plan_set_id;
+  long plan_set_plans = 0;
+  int shard_index = 1;
+  int shard_count = 1;
+};
+
+/// The identity of a plan set: 16 hex digits of FNV-1a over its plans' canonical paths (absolute,
+/// symbolic links and "." resolved), sorted, each ended by a newline. Two spellings of one file
+/// give one path, so the same set named another way has the same identity.
+std::string PlanSetId(std::vector<std::string> canonical_paths);
+/// The canonical path of a plan file as PlanSetId takes it (weakly canonical, absolute).
+std::string CanonicalPlanPath(const std::string& path);
 
 /// One judged plan.
 struct Evaluated {
@@ -26,10 +44,10 @@ struct Evaluated {
   double run_s = 0.0;       // wall time of those replays
 };
 
-/// A report's plans in file order and its summary.
-nlohmann::json Report(nlohmann::json plans);
+/// A report's plans in file order, what it covers and its summary.
+nlohmann::json Report(nlohmann::json plans, const ReportScope& scope);
 /// The report of judged plans.
-nlohmann::json ToJson(const std::vector<Evaluated>& results);
+nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope);
 /// One plan's verdicts as text: its line, then each transition with its figures.
 void PrintVerdicts(std::ostream& out, const Evaluated& e, bool colour);
 

@@ -19,6 +19,7 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/judge.hpp>
 
 #include "commands.hpp"
 #include "series_format.hpp"
@@ -37,6 +38,7 @@ struct SimulateOptions {
 struct Visit {
   double t_s = 0.0;
   std::string cf;
+  bool fault = false;  // entered on a tick the core flagged fault: {} there is not the tube's state
 };
 
 int RunSimulate(const SimulateOptions& o, Streams io) {
@@ -116,7 +118,9 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     core_s += tick_s;
     worst_tick_s = std::max(worst_tick_s, tick_s);
     cf_text = core.FormationText();
-    if (visits.empty() || visits.back().cf != cf_text) visits.push_back({sample.t_s, cf_text});
+    const bool fault = (out.flags & core::kSolverFault) != 0;
+    if (visits.empty() || visits.back().cf != cf_text || visits.back().fault != fault)
+      visits.push_back({sample.t_s, cf_text, fault});
     const double force_N = out.force_W_N.norm();
     if (force_N > peak_force_N) peak_force_N = force_N, peak_force_t = sample.t_s;
     if (out.max_strain > peak_strain) peak_strain = out.max_strain, peak_strain_t = sample.t_s;
@@ -140,6 +144,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
 
   const std::size_t tick_count = ticks.count();
   const double duration_s = ticks.TimeOf(tick_count - 1) - ticks.TimeOf(0);
+  // The same warning evaluate gives for a strain beyond the material's elastic range.
+  const std::string strain_warning = plan::StrainWarning(s.tube, peak_strain, peak_strain_t);
   if (o.json) {
     nlohmann::json j;
     j["scene"] = o.scene_path;
@@ -149,7 +155,10 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["duration_s"] = duration_s;
     j["elements"] = core.element_count();
     nlohmann::json v = nlohmann::json::array();
-    for (const Visit& visit : visits) v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
+    for (const Visit& visit : visits) {
+      v.push_back({{"t", visit.t_s}, {"cf", visit.cf}});
+      if (visit.fault) v.back()["fault"] = true;
+    }
     j["visits"] = v;
     j["final_cf"] = cf_text;
     j["goal"] = states::ToString(s.goal);
@@ -160,6 +169,8 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
     j["peak_strain"] = peak_strain;
     j["peak_strain_t"] = peak_strain_t;
     j["peak_energy_J"] = peak_energy_J;
+    j["warnings"] =
+        strain_warning.empty() ? nlohmann::json::array() : nlohmann::json::array({strain_warning});
     nlohmann::json flags;
     for (int b = 0; b < core::kStepFlagCount; ++b)
       flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
@@ -179,7 +190,9 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   text << "contact formations, in order (t = entry time):\n";
   const std::size_t shown = std::min<std::size_t>(visits.size(), 40);
   for (std::size_t i = 0; i < shown; ++i)
-    text << "  t = " << std::setw(7) << visits[i].t_s << " s  " << visits[i].cf << "\n";
+    text << "  t = " << std::setw(7) << visits[i].t_s << " s  " << visits[i].cf
+         << (visits[i].fault ? "  (solver fault: the core held the tube still; not its state)" : "")
+         << "\n";
   if (visits.size() > shown)
     text << "  ... " << visits.size() - shown << " more changes (the series in --out has all)\n";
   text << "final: " << cf_text << (cf_text == states::ToString(s.goal) ? " (the goal)" : "")
@@ -187,6 +200,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   text << "peak force " << peak_force_N << " N at t = " << peak_force_t << " s; peak torque "
        << peak_torque_Nm << " N m; peak strain " << peak_strain << " at t = " << peak_strain_t
        << " s; peak bending energy " << peak_energy_J << " J\n";
+  if (!strain_warning.empty()) text << "warning: " << strain_warning << "\n";
   text << "ticks flagged:";
   bool any = false;
   for (int b = 0; b < core::kStepFlagCount; ++b)

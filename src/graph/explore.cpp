@@ -3,10 +3,13 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <set>
 #include <thread>
@@ -32,6 +35,13 @@ constexpr int kCheckpointTicks = 64;
 
 using core::KeyOf;
 using CfKey = core::FormationKey;
+using Clock = std::chrono::steady_clock;
+
+// The time limit: none, or the moment after which no motion starts and those under way stop.
+struct Deadline {
+  std::optional<Clock::time_point> at;
+  bool Passed() const { return at && Clock::now() >= *at; }
+};
 
 struct Sample {  // what a node keeps of its witness tick
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
@@ -97,6 +107,7 @@ struct MotionResult {
   long ticks = 0;
   int refinements = 0;
   bool held_back = false;  // cut where the core held the tube back from going through a part
+  bool timed_out = false;  // stopped by the time limit before its end: not a result
   // Per stay: the run's point at or before its witness, from which its CF's probe can start,
   // kept for the first stay of each CF (refined or not) that could become that probe's start
   // (Merger::MayEnter); null for the others.
@@ -139,7 +150,7 @@ std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Mot
 using MayEnter = std::function<bool(const std::string&, bool, int)>;
 MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion, int index,
                        const ExploreOptions& options, const RunPointPtr& resume,
-                       const MayEnter& may_enter) {
+                       const MayEnter& may_enter, const Deadline& deadline) {
   MotionResult result;
   const double step_s = core.scene().model.time_step_s;
   const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
@@ -237,6 +248,11 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   };
 
   for (; k <= kMaxTicksPerMotion && !runner.Done(); ++k) {
+    // The clock is read every kCheckpointTicks ticks: a motion stops within that many ticks.
+    if (k % kCheckpointTicks == 0 && deadline.Passed()) {
+      result.timed_out = true;
+      return result;
+    }
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
     if (out.flags & core::kProxySeparated) {
       // The coupling is stretched beyond the device's force: the tube no longer follows the
@@ -505,27 +521,57 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
 }
 
 // Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each; motion
-// first + i goes on from resumes[i] where there is one.
+// first + i goes on from resumes[i] where there is one. With `waiting`, the calling thread runs no
+// motion: it calls waiting(motions done, motions started) about every `interval_s` until all
+// have ended. A motion the deadline stopped, or that it kept from starting, is timed_out.
 std::vector<MotionResult> RunAll(const scene::Scene& scene, const std::vector<Motion>& motions,
                                  int first, int count, const std::vector<RunPointPtr>& resumes,
                                  const MayEnter& may_enter, const ExploreOptions& o,
-                                 std::vector<std::unique_ptr<core::Core>>& cores) {
+                                 std::vector<std::unique_ptr<core::Core>>& cores,
+                                 const Deadline& deadline,
+                                 const std::function<void(int, int)>& waiting) {
   std::vector<MotionResult> results(static_cast<std::size_t>(count));
   const int jobs = std::clamp(o.jobs, 1, std::max(1, count));
   while (static_cast<int>(cores.size()) < 2 * jobs)
     cores.push_back(std::make_unique<core::Core>(scene));
-  std::atomic<int> next{0};
+  std::atomic<int> next{0}, done{0};
+  std::mutex mutex;
+  std::condition_variable ended;
+  int running = 0;
   auto work = [&](int worker) {
     for (int i = next++; i < count; i = next++) {
-      results[std::size_t(i)] =
-          RunMotion(*cores[std::size_t(2 * worker)], *cores[std::size_t(2 * worker + 1)],
+      MotionResult& r = results[std::size_t(i)];
+      if (deadline.Passed()) {
+        r.timed_out = true;
+        continue;
+      }
+      r = RunMotion(*cores[std::size_t(2 * worker)], *cores[std::size_t(2 * worker + 1)],
                     motions[std::size_t(first + i)], first + i, o,
-                    std::size_t(i) < resumes.size() ? resumes[std::size_t(i)] : nullptr, may_enter);
+                    std::size_t(i) < resumes.size() ? resumes[std::size_t(i)] : nullptr, may_enter,
+                    deadline);
+      ++done;
     }
   };
   std::vector<std::thread> threads;
-  for (int w = 1; w < jobs; ++w) threads.emplace_back(work, w);
-  work(0);
+  if (!waiting) {
+    for (int w = 1; w < jobs; ++w) threads.emplace_back(work, w);
+    work(0);
+  } else {
+    running = jobs;
+    for (int w = 0; w < jobs; ++w)
+      threads.emplace_back([&, w] {
+        work(w);
+        const std::lock_guard lock(mutex);
+        --running;
+        ended.notify_one();
+      });
+    const auto interval = std::chrono::duration<double>(o.status_interval_s);
+    std::unique_lock lock(mutex);
+    while (running > 0) {
+      ended.wait_for(lock, interval, [&] { return running == 0; });
+      if (running > 0) waiting(done.load(), std::min(next.load(), count));
+    }
+  }
   for (std::thread& t : threads) t.join();
   return results;
 }
@@ -798,74 +844,117 @@ std::vector<Motion> RandomMotions(const scene::Scene& scene, std::uint64_t seed,
 
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
                      const std::function<void(const SaturationPoint&)>& progress) {
-  const auto clock_start = std::chrono::steady_clock::now();
+  const auto clock_start = Clock::now();
+  Deadline deadline;
+  if (o.time_limit_s > 0.0)
+    deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
+                                    std::chrono::duration<double>(o.time_limit_s));
   ContactGraph graph;
   Merger merger(graph);
   std::vector<std::unique_ptr<core::Core>> cores;
   cores.push_back(std::make_unique<core::Core>(scene));
   core::Core& probe = *cores.front();
   const Box box = PartsBox(scene, probe.reachable_parts());
-  // Sweeps and aims run whole, merged in order (saturation counts random motions only).
   std::size_t probed = 0;  // nodes [0, probed) have had their probe motion
-  // Read by the threads of a batch, while the merger stands still.
+  // Read by the threads of a group, while the merger stands still.
   const MayEnter may_enter = [&](const std::string& cf, bool refined, int ticks) {
     return merger.MayEnter(cf, refined, ticks, probed);
   };
-  auto run = [&](std::vector<Motion> batch) {
+  std::optional<ExploreEnd> stopped;  // the budget or the time limit, whichever came first
+  const auto stop = [&](ExploreEnd why) {
+    if (!stopped) stopped = why;
+  };
+  const auto room = [&] {
+    return std::max(0, o.max_motions - static_cast<int>(graph.motions.size()));
+  };
+  std::string phase;
+  const auto status = [&](int done, int started) {
+    if (!o.status) return;
+    o.status({phase, done, started, static_cast<int>(graph.nodes.size()),
+              static_cast<int>(graph.arcs.size()),
+              std::chrono::duration<double>(Clock::now() - clock_start).count()});
+  };
+  // Runs a group of motions whole, or as much of it as the budget leaves, and merges the results
+  // in motion order up to the first the time limit stopped (that one and those after it are
+  // dropped, and so is the rest of the exploration). Returns how many were merged.
+  const auto run = [&](std::vector<Motion> group, const std::vector<RunPointPtr>& resumes) {
+    if (stopped == ExploreEnd::kTimeLimit) return 0;
+    if (static_cast<int>(group.size()) > room()) {
+      group.resize(std::size_t(room()));
+      stop(ExploreEnd::kBudget);
+    }
     const int first = static_cast<int>(graph.motions.size());
-    const int count = static_cast<int>(batch.size());
-    for (Motion& m : batch) graph.motions.push_back(std::move(m));
-    for (const MotionResult& r :
-         RunAll(scene, graph.motions, first, count, {}, may_enter, o, cores)) {
+    const int count = static_cast<int>(group.size());
+    if (count == 0) return 0;
+    for (Motion& m : group) graph.motions.push_back(std::move(m));
+    const std::function<void(int, int)> waiting =
+        o.status ? std::function<void(int, int)>(
+                       [&](int done, int started) { status(first + done, first + started); })
+                 : nullptr;
+    const std::vector<MotionResult> results =
+        RunAll(scene, graph.motions, first, count, resumes, may_enter, o, cores, deadline, waiting);
+    int merged = 0;
+    for (const MotionResult& r : results) {
+      if (r.timed_out) break;
       merger.Add(r);
+      ++merged;
       if (progress) progress(graph.saturation.back());
     }
+    if (merged < count) {
+      graph.motions.resize(std::size_t(first + merged));
+      stop(ExploreEnd::kTimeLimit);
+    }
+    status(first + merged, first + merged);
+    return merged;
   };
 
-  run(Sweeps(scene, box, o));
-  graph.start = 0;  // the first stay of the first motion is at the start pose
-  {
+  // Sweeps and aims run whole unless a limit cuts them, merged in order.
+  phase = "sweeps";
+  run(Sweeps(scene, box, o), {});
+  graph.start = graph.nodes.empty() ? -1 : 0;  // the first stay of the first motion: the start
+  if (!stopped) {
     // Aim at the elements of reachable parts that no PC has touched yet.
     const std::set<std::string> reached = ReachedElements(graph);
     std::vector<int> unseen;
     for (std::size_t e = 0; e < probe.elements().size(); ++e)
       if (!reached.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
-    run(Aims(scene, probe, unseen, o));
+    phase = "aims";
+    run(Aims(scene, probe, unseen, o), {});
   }
   // Random motions from the seed, all merged (they reach pressed, tipped and wedged states the
   // sweeps and aims do not).
-  const int random =
-      std::min(o.random_motions, o.max_motions - static_cast<int>(graph.motions.size()));
-  if (random > 0) run(RandomMotionsIn(scene, box, o.seed, 0, random, o));
+  if (!stopped && o.random_motions > 0) {
+    phase = "random motions";
+    run(RandomMotionsIn(scene, box, o.seed, 0, o.random_motions, o), {});
+  }
   // Neighbour probing in rounds, each probing the nodes found since the last, until a round finds
   // no new node: saturated. Every node has then been probed, and probing one again from the same
   // stay replays the same motion (the core is deterministic), which finds nothing new; the
   // effort is stated by the probe set (Probes) and the random motions before it.
-  while (probed < graph.nodes.size()) {
-    const int first = static_cast<int>(graph.motions.size());
-    const int count =
-        std::min(static_cast<int>(graph.nodes.size() - probed), o.max_motions - first);
+  phase = "probes";
+  while (!stopped && probed < graph.nodes.size()) {
+    const int wanted = static_cast<int>(graph.nodes.size() - probed);
+    const int count = std::min(wanted, room());
+    if (count < wanted) stop(ExploreEnd::kBudget);
     if (count <= 0) break;
     // Each goes on from the run point kept at its start stay, if there is one: the same bits as
     // replaying its prefix.
+    std::vector<Motion> group;
     std::vector<RunPointPtr> resumes;
     for (int i = 0; i < count; ++i) {
-      graph.motions.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
+      group.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
       resumes.push_back(merger.TakeProbePoint(static_cast<int>(probed) + i));
     }
     probed += std::size_t(count);
-    for (const MotionResult& r :
-         RunAll(scene, graph.motions, first, count, resumes, may_enter, o, cores)) {
-      merger.Add(r);
-      if (progress) progress(graph.saturation.back());
-    }
+    const int merged = run(std::move(group), resumes);
+    probed -= std::size_t(count - merged);
   }
   graph.probed = static_cast<int>(probed);
-  graph.saturated = probed == graph.nodes.size();
+  graph.end = stopped.value_or(ExploreEnd::kSaturated);
+  graph.saturated = !stopped && probed == graph.nodes.size();
 
   graph.goal = graph.FindNode(states::ToString(scene.goal));
-  if (graph.start >= 0 && graph.start < static_cast<int>(graph.nodes.size()))
-    graph.nodes[std::size_t(graph.start)].start = true;
+  if (graph.start >= 0) graph.nodes[std::size_t(graph.start)].start = true;
   if (graph.goal >= 0) {
     Node& goal = graph.nodes[std::size_t(graph.goal)];
     goal.goal = true;
@@ -880,8 +969,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   graph.reached_elements.assign(reached.begin(), reached.end());
   for (const scene::PartElement& e : probe.elements())
     if (!reached.contains(e.name)) graph.unreached_elements.push_back(e.name);
-  graph.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  graph.seconds = std::chrono::duration<double>(Clock::now() - clock_start).count();
   return graph;
 }
 

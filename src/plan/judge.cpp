@@ -52,10 +52,40 @@ const char* ToString(Verdict verdict) {
   return "infeasible";
 }
 
-Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s)
+std::string FlagWarning(std::size_t i, double seconds) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "for %.3g s ", seconds);
+  return buffer + std::string(kWarnedFlags[i].meaning);
+}
+
+double ElasticStrainLimit(const model::TubeSpec& tube) {
+  return tube.youngs_modulus_Pa >= 1e10 ? 0.005 : 0.5;
+}
+
+std::string StrainWarning(const model::TubeSpec& tube, double strain, double t_s) {
+  const double limit = ElasticStrainLimit(tube);
+  if (!(strain > limit)) return "";
+  char buffer[320];
+  std::snprintf(buffer, sizeof buffer,
+                "strain %.4g at t = %.3f s is beyond the tube material's elastic range (%.3g for "
+                "E %s 10 GPa): the beam models bend an elastic tube with small strains, so the "
+                "forces, energies and shapes past it are not the tube's",
+                strain, t_s, limit, tube.youngs_modulus_Pa >= 1e10 ? ">=" : "<");
+  return buffer;
+}
+
+double TransitionVerdict::FlaggedSeconds(std::uint32_t flag) const {
+  for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
+    if (kWarnedFlags[i].flag == flag) return flagged_s[i];
+  return 0.0;
+}
+
+Judging::Judging(std::vector<std::string> states, const Limits& limits, double step_s,
+                 std::optional<model::TubeSpec> tube)
     : states_(std::move(states)),
       limits_(limits),
       step_s_(step_s),
+      tube_(std::move(tube)),
       dwell_(std::max(1, static_cast<int>(std::lround(limits.dwell_s / step_s)))) {
   if (states_.size() < 2) throw std::invalid_argument("Judging: a plan needs two states");
   // Per planned transition i (states[i] -> states[i+1]).
@@ -65,90 +95,148 @@ Judging::Judging(std::vector<std::string> states, const Limits& limits, double s
     j_.transitions[i].from = states_[i];
     j_.transitions[i].to = states_[i + 1];
   }
+  j_.after_goal.from = j_.after_goal.to = states_.back();
 }
 
-void Judging::Fail(std::size_t i, const std::string& reason) {
-  TransitionVerdict& v = j_.transitions[i];
-  if (v.verdict != Verdict::kInfeasible || v.reason.empty()) v.reason = reason;
+// The span under way: the transition, or the stretch after the goal; none once the plan failed.
+TransitionVerdict* Judging::UnderWay() {
+  if (failed_) return nullptr;
+  if (at_ < n_) return j_.transitions[at_].started ? &j_.transitions[at_] : nullptr;
+  return j_.after_goal.started ? &j_.after_goal : nullptr;
+}
+
+void Judging::Fail(TransitionVerdict& v, const std::string& reason, double t_s) {
+  if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) return;  // the first reason stays
+  v.reason = (&v == &j_.after_goal ? "after the goal: " : "") + reason;
   v.verdict = Verdict::kInfeasible;
+  v.t_failed_s = t_s;
+}
+
+// The first tick: the state the replay starts in opens the first transition, or fails it.
+void Judging::Start(double t_s, const core::StepOutput& out, const std::string& cf) {
+  t_first_ = t_s;
+  raw_key_ = core::KeyOf(out);
+  raw_ = stable_ = cf;
+  raw_since_ = t_s;
+  raw_energy_ = out.energy_J;
+  j_.observed.push_back({t_s, cf});
+  TransitionVerdict& first = j_.transitions[0];
+  if (cf != states_[0]) {
+    Fail(first, "the replay starts in " + cf + ", not in the planned " + states_[0], t_s);
+    failed_ = true;
+    return;
+  }
+  first.started = true;
+  first.t_start_s = t_s;
+  first.energy_entry_J = out.energy_J;
+}
+
+// One tick's figures and limits, kept apart until it is known which span they belong to.
+void Judging::Measure(double t_s, const core::StepOutput& out) {
+  Figures& f = pending_;
+  const double force_N = out.force_W_N.norm();
+  f.peak_force_N = std::max(f.peak_force_N, force_N);
+  for (std::size_t i = 0; i < kWarnedFlags.size(); ++i)
+    if (out.flags & kWarnedFlags[i].flag) f.flagged_s[i] += step_s_;
+  const auto exceeded = [&](const std::string& reason) {
+    if (f.failure.empty()) f.failure = reason, f.t_failure_s = t_s;
+  };
+  if (force_N > limits_.max_force_N)
+    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+  if (out.max_strain > limits_.max_strain)
+    exceeded(Format("strain", out.max_strain, "", limits_.max_strain, t_s));
+  for (const core::ContactState& c : out.Contacts()) {
+    if (-c.distance_m > limits_.max_penetration_m)
+      exceeded(
+          Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3, t_s));
+    f.friction_work_J += c.friction_work_J;
+  }
+}
+
+void Judging::Flush() {
+  if (TransitionVerdict* v = UnderWay()) {
+    v->peak_force_N = std::max(v->peak_force_N, pending_.peak_force_N);
+    v->friction_work_J += pending_.friction_work_J;
+    for (std::size_t i = 0; i < kWarnedFlags.size(); ++i) v->flagged_s[i] += pending_.flagged_s[i];
+    if (!pending_.failure.empty()) Fail(*v, pending_.failure, pending_.t_failure_s);
+  }
+  pending_ = Figures{};
 }
 
 void Judging::Tick(double t_s, const core::StepOutput& out,
                    const std::function<std::string()>& cf_text) {
   ++j_.ticks;
-  if (j_.ticks == 1) t_first_ = t_s;
+  if (j_.ticks == 1) Start(t_s, out, cf_text());
   t_last_ = t_s;
-  const std::vector<std::string>& states = states_;
-  // Figures and limits of the transition under way.
-  if (!failed_ && at_ < n_) {
-    TransitionVerdict& v = j_.transitions[at_];
-    const double force_N = out.force_W_N.norm();
-    v.peak_force_N = std::max(v.peak_force_N, force_N);
-    if (out.flags & core::kBeyondLinearRange) v.beyond_linear_s += step_s_;
-    if (out.flags & core::kNotConverged) v.unconverged_s += step_s_;
-    // At the device's clamp the force is the most the device renders, which a plan's limit is
-    // often set to: said so, rather than "8.5 N > 8.5 N".
-    if (force_N > limits_.max_force_N && v.reason.empty())
-      Fail(at_, Format("operator force", force_N, "N", limits_.max_force_N, t_s,
-                       (out.flags & core::kForceClamped)
-                           ? " (the device's clamp was reached: it renders no more)"
-                           : ""));
-    if (out.max_strain > limits_.max_strain && v.reason.empty())
-      Fail(at_, Format("strain", out.max_strain, "", limits_.max_strain, t_s));
-    for (const core::ContactState& c : out.Contacts()) {
-      if (-c.distance_m > limits_.max_penetration_m && v.reason.empty())
-        Fail(at_, Format("penetration", -c.distance_m * 1e3, "mm", limits_.max_penetration_m * 1e3,
-                         t_s));
-      v.friction_work_J += c.friction_work_J;
-    }
-  }
+  energy_last_ = out.energy_J;
+  if (const double force_N = out.force_W_N.norm(); force_N > j_.peak_force_N || j_.ticks == 1)
+    j_.peak_force_N = force_N, j_.peak_force_t_s = t_s;
+  if (out.max_strain > j_.peak_strain || j_.ticks == 1)
+    j_.peak_strain = out.max_strain, j_.peak_strain_t_s = t_s;
   stuck_ticks_ = (out.flags & core::kProxySeparated) ? stuck_ticks_ + 1 : 0;
 
-  // Debounce: a state counts once held `dwell` ticks.
-  const core::FormationKey key = core::KeyOf(out);
-  if (j_.ticks == 1 || key != raw_key_) {
-    raw_key_ = key;
-    raw_ = cf_text();  // text only when the state changes
-    raw_held_ = 0;
-    raw_since_ = t_s;
-    raw_energy_ = out.energy_J;
+  // Debounce: a state counts once held `dwell` ticks. A tick the core flags as a fault shows no
+  // state of the tube (it reads {}): it neither changes the state nor counts towards its dwell.
+  const bool fault = (out.flags & core::kSolverFault) != 0;
+  if (!fault && j_.ticks > 1) {
+    const core::FormationKey key = core::KeyOf(out);
+    if (key != raw_key_) {
+      Flush();  // the ticks of the state left were in the span under way
+      raw_key_ = key;
+      raw_ = cf_text();  // text only when the state changes
+      raw_held_ = 0;
+      raw_since_ = t_s;
+      raw_energy_ = out.energy_J;
+    }
   }
+  Measure(t_s, out);
+  if (fault) return;
   ++raw_held_;
-  const bool first = j_.observed.empty();
-  if (!(first || (raw_held_ == dwell_ && raw_ != stable_))) return;
+  if (j_.ticks == 1 || raw_held_ != dwell_ || raw_ == stable_) return;
   stable_ = raw_;
   j_.observed.push_back({raw_since_, raw_});
-  if (first) {
-    j_.transitions[0].t_start_s = raw_since_;
-    j_.transitions[0].energy_entry_J = raw_energy_;
-    if (raw_ != states[0]) {
-      Fail(0, "the replay starts in " + raw_ + ", not in the planned " + states[0]);
-      failed_ = true;
+  Counted();
+  Flush();  // the ticks since raw_since_ are in the span the counted state opened, if any
+}
+
+// A new state counted (raw_, entered at raw_since_).
+void Judging::Counted() {
+  if (failed_) return;
+  if (at_ == n_) {
+    // After the goal: any other state counting leaves it.
+    if (left_goal_for_.empty() && raw_ != states_.back()) {
+      left_goal_for_ = raw_;
+      left_goal_at_s_ = raw_since_;
+      char when[48];
+      std::snprintf(when, sizeof when, " at t = %.3f s", raw_since_);
+      Fail(j_.after_goal, "left the goal for " + raw_ + when, raw_since_);
     }
     return;
   }
-  if (failed_ || at_ >= n_) return;
+  const std::vector<std::string>& states = states_;
   TransitionVerdict& v = j_.transitions[at_];
   if (raw_ == states[at_ + 1]) {
     v.t_end_s = raw_since_;
     v.energy_exit_J = raw_energy_;
     v.detour = passed_;
-    if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
-      failed_ = true;  // a limit was exceeded on the way
-    } else {
-      v.verdict = passed_.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
-    }
     passed_.clear();
     ++at_;
-    if (at_ < n_) {
-      j_.transitions[at_].t_start_s = raw_since_;
-      j_.transitions[at_].energy_entry_J = raw_energy_;
+    if (v.verdict == Verdict::kInfeasible && !v.reason.empty()) {
+      failed_ = true;  // a limit was exceeded on the way: nothing after it is reached
+      return;
     }
+    v.verdict = v.detour.empty() ? Verdict::kFeasible : Verdict::kFeasibleWithDetour;
+    TransitionVerdict& next = at_ < n_ ? j_.transitions[at_] : j_.after_goal;
+    next.started = true;
+    next.t_start_s = raw_since_;
+    next.energy_entry_J = raw_energy_;
+    if (at_ == n_) next.verdict = Verdict::kFeasible;
   } else if (std::find(states.begin() + long(at_) + 2, states.end(), raw_) != states.end()) {
     v.t_end_s = raw_since_;
+    v.energy_exit_J = raw_energy_;
     v.detour = passed_;
-    Fail(at_,
-         "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1]);
+    Fail(v, "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1],
+         raw_since_);
     failed_ = true;
   } else if (raw_ != states[at_]) {
     passed_.push_back(raw_);
@@ -159,9 +247,11 @@ Judgement Judging::Finish() {
   const std::vector<std::string>& states = states_;
   const double t_end = t_last_;
   const double T = step_s_;
-  if (!failed_ && at_ < n_) {
+  Flush();
+  if (!failed_ && at_ < n_ && j_.transitions[at_].started) {
     TransitionVerdict& v = j_.transitions[at_];
     v.t_end_s = t_end;
+    v.energy_exit_J = energy_last_;
     v.detour = passed_;
     if (v.reason.empty()) {
       char buffer[96];
@@ -177,9 +267,24 @@ Judgement Judging::Finish() {
       } else {
         why = "another state reached instead: " + stable_ + " (the trajectory ended there)";
       }
-      Fail(at_, states[at_ + 1] + " never reached: " + why);
+      Fail(v, states[at_ + 1] + " never reached: " + why, t_end);
     }
     failed_ = true;
+  }
+  TransitionVerdict& after = j_.after_goal;
+  if (after.started && !failed_) {
+    after.t_end_s = t_end;
+    after.energy_exit_J = energy_last_;
+    // A plan whose trajectory ends outside its goal says so, and where it went first.
+    if (!left_goal_for_.empty() && after.reason.find("left the goal") == std::string::npos) {
+      char when[48];
+      std::snprintf(when, sizeof when, " at t = %.3f s", left_goal_at_s_);
+      after.reason += "; left the goal for " + left_goal_for_ + when;
+    }
+    if (stable_ != states.back())
+      after.reason += "; the trajectory ended in " + stable_ + ", not in the goal";
+    else if (!left_goal_for_.empty())
+      after.reason += "; it was back in the goal at the end";
   }
   for (std::size_t i = 0; i < n_; ++i) {
     TransitionVerdict& v = j_.transitions[i];
@@ -187,8 +292,10 @@ Judgement Judging::Finish() {
       v.reason = "not reached: the plan failed at an earlier transition";
   }
   j_.feasible = std::all_of(j_.transitions.begin(), j_.transitions.end(),
-                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; });
+                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; }) &&
+                after.started && after.verdict != Verdict::kInfeasible;
   j_.replayed_s = t_end - t_first_;
+  if (tube_) j_.strain_warning = StrainWarning(*tube_, j_.peak_strain, j_.peak_strain_t_s);
   return j_;
 }
 
@@ -207,7 +314,7 @@ Judgement Judge(const scene::Scene& scene, TickSource& ticks,
   const double T = scene.model.time_step_s;
   core::Core core(scene);
   core.Reset(Pose(ticks.Tick(0)));
-  Judging judging(states, limits, T);
+  Judging judging(states, limits, T, scene.tube);
   const auto text = [&core] { return core.FormationText(); };
   for (std::size_t k = 0; k < ticks.count(); ++k) {
     const HandSample sample = ticks.Tick(k);

@@ -11,6 +11,7 @@
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/model/tube.hpp>
+#include <tubeplan/plan/judge.hpp>
 #include <tubeplan/study/stability.hpp>
 
 #include "format.hpp"
@@ -390,12 +391,11 @@ int FirstDifferentTick(const Run& first, const Run& second) {
 }
 
 // Why a run is outside the model's validity ("" if it is not): the case's own reasons, and the
-// strain beyond the linear-elastic range (judged on what the run reached): metals and hard
-// plastics (E >= 10 GPa) yield near 0.5 %; elastomers stay elastic far beyond, but bending
-// theory's small-strain kinematics degrade past 50 %.
+// strain beyond the material's elastic range (plan::ElasticStrainLimit, the limit `simulate` and
+// `evaluate` warn at; judged on what the run reached).
 std::string Validity(const StabilityCase& c, const Run& run) {
   std::string validity = c.outside_validity;
-  const double strain_limit = c.scene.tube.youngs_modulus_Pa >= 1e10 ? 0.005 : 0.5;
+  const double strain_limit = plan::ElasticStrainLimit(c.scene.tube);
   if (run.max_strain > strain_limit)
     validity += std::string(validity.empty() ? "" : "; ") +
                 Fmt("strain %.3g beyond the linear-elastic %.3g", run.max_strain, strain_limit);

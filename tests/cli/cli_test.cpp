@@ -13,6 +13,7 @@
 
 #include <tubeplan/cli/app.hpp>
 
+#include "../scratch.hpp"
 #include "run_tool.hpp"
 
 namespace {
@@ -77,6 +78,80 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
 }
 
 }  // namespace
+
+// The groove scene with one line changed (`from` replaced by `to`), written to the scratch
+// directory `tag`.
+std::string GrooveWith(const std::string& tag, const std::string& from, const std::string& to) {
+  std::string text = tubeplan::testing::Slurp(SourcePath("scenes/groove.yaml"));
+  const std::size_t at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, from.size(), to);
+  return tubeplan::testing::WriteScratch(tag, "scene.yaml", text);
+}
+
+TEST_CASE("plans: a goal the tube starts in is said, and no plan is written", "[cli]") {
+  const std::string scene = GrooveWith("plans-start", "goal: \"{Fs - floor.top}\"", "goal: \"{}\"");
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-start") / "out";
+  const Outcome r = RunTool({"plans", scene, "--out-dir", dir.string(), "--budget", "20"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.empty());
+  CHECK(r.err == scene +
+                     ": nothing to plan: the goal {} is the state the tube starts in ({} at the "
+                     "scene's start pose), so a plan would be that one state and no move; no plan "
+                     "written. Give the scene a goal the tube has to be moved to\n");
+  CHECK_FALSE(std::filesystem::exists(dir));
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-start"));
+}
+
+TEST_CASE("simulate: a strain beyond the material's elastic range gets evaluate's warning",
+          "[cli]") {
+  // The groove's tube at E = 1 kPa, pushed into the floor: strain 1766 at t = 2.285 s, three and
+  // a half thousand times the 0.5 an elastomer bends elastically to. The insertion's first 2.3 s.
+  const std::string scene =
+      GrooveWith("simulate-soft", "youngs_modulus: 3 MPa", "youngs_modulus: 1e3 Pa");
+  std::string csv;
+  {
+    std::istringstream rows(tubeplan::testing::Slurp(SourcePath("plans/groove-insert.csv")));
+    for (std::string row; std::getline(rows, row) && row.rfind("2.301", 0) != 0;) csv += row + "\n";
+  }
+  const std::string trajectory = tubeplan::testing::WriteScratch("simulate-soft", "t.csv", csv);
+  const Outcome r = RunTool({"simulate", scene, trajectory});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("\nwarning: strain 1766 at t = 2.285 s is beyond the tube material's elastic "
+                   "range (0.5 for E < 10 GPa)") != std::string::npos);
+  const Outcome j = RunTool({"simulate", scene, trajectory, "--json"});
+  REQUIRE(j.exit_code == 0);
+  const nlohmann::json json = nlohmann::json::parse(j.out);
+  REQUIRE(json["warnings"].size() == 1);
+  // The same sentence evaluate gives a plan (one function makes both).
+  CHECK(r.out.find(json["warnings"][0].get<std::string>()) != std::string::npos);
+  // The shipped scene's tube stays within its range: no warning.
+  const Outcome rubber = RunTool({"simulate", SourcePath("scenes/groove.yaml"), trajectory});
+  CHECK(rubber.out.find("warning:") == std::string::npos);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("simulate-soft"));
+}
+
+TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli]") {
+  Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "1", "--jobs", "2"});
+  CHECK(r.exit_code == 1);  // one sweep does not reach the goal
+  CHECK(r.out.find(" from 1 motions (1 sweep)") != std::string::npos);
+  CHECK(r.out.find("(NOT saturated: stopped by the budget of 1 motions, with 0 of ") !=
+        std::string::npos);
+  CHECK(r.out.find("(saturated") == std::string::npos);
+  // A limit shorter than any motion: nothing explored, said so, and no crash on the empty graph.
+  r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--time-limit", "0.001", "--json",
+               tubeplan::testing::ScratchDir("graph-limit").string() + "/g.json"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.out.find("(NOT saturated: stopped by the time limit of 0.001 s after 0 motions") !=
+        std::string::npos);
+  CHECK(r.out.find("start not reached (no motion ended)") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(
+      tubeplan::testing::Slurp(tubeplan::testing::ScratchDir("graph-limit") / "g.json"));
+  CHECK(j["stats"]["ended_by"] == "time_limit");
+  CHECK(j["parameters"]["time_limit_s"] == 0.001);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("graph-limit"));
+}
 
 TEST_CASE("beam --json reports the cantilever's analytic tip figures", "[cli]") {
   const Outcome r = RunTool(Beam({"--tip-force", "0.5 N", "--json", "--at", "0,0,300 mm"}));

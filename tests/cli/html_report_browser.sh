@@ -15,3 +15,14 @@ status=0
 # Exit 1: two shipped plans are infeasible by design.
 [ "$status" -le 1 ] || { cat "$out/evaluate.txt"; exit 1; }
 node "$source/tools/report-web/browser-test.mjs" "$out/report.html" "$out/report.png"
+# A long recording (two minutes of free motion, tools/make-long-trajectory): its page is bounded
+# (bins merged past 2048 a plan) and opens as the short one does; then the same page with its
+# arrays stretched to those of an unbounded hour at 50 Hz (180 000 frames), which the page's
+# script must walk without spreading them into a call.
+"$source/tools/make-long-trajectory" 120 "$out/long" 2> /dev/null
+status=0
+"$tubeplan" evaluate "$out/long/long-120s.yaml" --html "$out/long.html" > "$out/long.txt" || status=$?
+# Exit 1: the long free motion never reaches the goal.
+[ "$status" -le 1 ] || { cat "$out/long.txt"; exit 1; }
+node "$source/tools/report-web/browser-test.mjs" "$out/long.html"
+node "$source/tools/report-web/browser-test.mjs" --stretch-frames 180000 "$out/long.html"

@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <regex>
 #include <sstream>
 
@@ -65,9 +67,17 @@ TEST_CASE("The report's series are the judged replay's ticks, each bin's extreme
   CHECK(long(t_s.size()) == watched.ticks);
 
   // Bins of 20 ms: each bin's minimum and maximum are exactly the extremes of its ticks (a
-  // one-tick spike survives), and one 3D frame per bin.
+  // one-tick spike survives), and one 3D frame per bin, its first tick, and the peak's frame.
   REQUIRE(!r.bins.empty());
-  CHECK(r.frames.size() == r.bins.size());
+  CHECK(r.bin_s == 0.02);
+  CHECK((r.frames.size() == r.bins.size() || r.frames.size() == r.bins.size() + 1));
+  REQUIRE(r.peak_frame < r.frames.size());
+  const double peak_N = *std::max_element(force_N.begin(), force_N.end());
+  CHECK(r.frames[r.peak_frame].force_N == peak_N);
+  CHECK(r.frames[r.peak_frame].t_s ==
+        t_s[std::size_t(std::max_element(force_N.begin(), force_N.end()) - force_N.begin())]);
+  // The judge's peak of the whole replay is the same figure.
+  CHECK(watched.peak_force_N == peak_N);
   std::vector<double> lo(r.bins.size(), 1e300), hi(r.bins.size(), -1e300), e_hi = hi;
   for (std::size_t k = 0; k < t_s.size(); ++k) {
     const auto b = std::size_t(std::floor((t_s[k] - t_s.front()) / r.bin_s));
@@ -96,6 +106,83 @@ TEST_CASE("The report's series are the judged replay's ticks, each bin's extreme
     CHECK(length == Approx(l.scene->tube.length_m).epsilon(0.01));
     CHECK((f.centreline_W_m.front() - f.p_WH_m).norm() < 1e-6);
   }
+}
+
+TEST_CASE("A long replay's recording stays bounded, each bin's extremes kept", "[cli][html]") {
+  // At most 16 bins here (2048 on a page): the 5.5 s replay's 275 bins of 20 ms become 9 bins of
+  // 640 ms (halved five times), each still with the exact extremes of its ticks and one frame,
+  // its first tick.
+  const io::PlanLoadResult l = io::LoadPlanFile(SourcePath("plans/groove-gentle.yaml"));
+  REQUIRE(l.plan);
+  std::vector<double> t_s, force_N, strain;
+  cli::ReplayRecorder recorder(0.02, 16);
+  plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits,
+              [&](double t, const core::Core& core) {
+                recorder(t, core);
+                t_s.push_back(t);
+                force_N.push_back(core.last().force_W_N.norm());
+                strain.push_back(core.last().max_strain);
+              });
+  const cli::ReplayRecording r = recorder.Finish();
+  CHECK(r.bin_s == Approx(0.64));
+  REQUIRE(r.bins.size() == 9);
+  std::vector<double> lo(r.bins.size(), 1e300), hi(r.bins.size(), -1e300), s_hi = hi;
+  std::vector<double> first(r.bins.size(), -1.0);
+  for (std::size_t k = 0; k < t_s.size(); ++k) {
+    const auto b = std::size_t(std::floor((t_s[k] - t_s.front()) / r.bin_s));
+    REQUIRE(b < r.bins.size());
+    lo[b] = std::min(lo[b], force_N[k]);
+    hi[b] = std::max(hi[b], force_N[k]);
+    s_hi[b] = std::max(s_hi[b], strain[k]);
+    if (first[b] < 0.0) first[b] = t_s[k];
+  }
+  for (std::size_t b = 0; b < r.bins.size(); ++b) {
+    CHECK(r.bins[b].force_N.min == lo[b]);
+    CHECK(r.bins[b].force_N.max == hi[b]);
+    CHECK(r.bins[b].strain.max == s_hi[b]);
+  }
+  // One frame per bin at its first tick, and the peak's.
+  std::vector<double> frame_t;
+  for (std::size_t i = 0; i < r.frames.size(); ++i)
+    if (i != r.peak_frame) frame_t.push_back(r.frames[i].t_s);
+  CHECK(frame_t == first);
+  CHECK(r.frames[r.peak_frame].force_N == *std::max_element(force_N.begin(), force_N.end()));
+  for (std::size_t i = 1; i < r.frames.size(); ++i) CHECK(r.frames[i - 1].t_s < r.frames[i].t_s);
+}
+
+TEST_CASE("evaluate --html of a long recording: a bounded page", "[cli][html]") {
+  // Two minutes of the hand in free space above the groove at 1 kHz (as
+  // tools/make-long-trajectory writes): 6000 bins of 20 ms, kept to at most 2048 on the page.
+  const std::filesystem::path dir = TempDir("tubeplan-html-long");
+  {
+    std::ofstream csv(dir / "long.csv");
+    csv << "t,px,py,pz,qw,qx,qy,qz\n";
+    for (int i = 0; i <= 120000; ++i) {
+      const double t = i / 1000.0, roll = -std::numbers::pi / 2 + 0.087 * std::sin(t);
+      csv << t << "," << 0.005 * std::sin(t / 2) << ",-0.09,0.04," << std::cos(roll / 2) << ","
+          << std::sin(roll / 2) << ",0,0\n";
+    }
+    std::ofstream(dir / "long.yaml")
+        << "tubeplan: 1\nplan: long\nscene: " << SourcePath("scenes/groove.yaml")
+        << "\ntrajectory: long.csv\nstates: [\"{}\", goal]\n";
+  }
+  const std::string html = (dir / "report.html").string();
+  const testing::Outcome r = RunTool({"evaluate", (dir / "long.yaml").string(), "--html", html});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 1);  // never reaches the goal
+  const std::string page = Slurp(html);
+  const std::size_t start = page.find("<script type=\"application/json\" id=\"tubeplan-data\">");
+  REQUIRE(start != std::string::npos);
+  const std::size_t body = page.find('>', start) + 1;
+  const nlohmann::json data =
+      nlohmann::json::parse(page.substr(body, page.find("</script>", body) - body));
+  const nlohmann::json& frames = data["plans"][0]["frames"];
+  CHECK(frames["t_s"].size() <= cli::ReplayRecording::kMaxBins + 1);
+  CHECK(frames["t_s"].size() > cli::ReplayRecording::kMaxBins / 2);
+  CHECK(data["plans"][0]["bin_s"] == 0.08);
+  // The page: three.js (0.6 MB), the frames and the plots; 2.4 MB before the bins were bounded.
+  CHECK(page.size() < 2'000'000);
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cli][html]") {
@@ -128,6 +215,17 @@ TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cl
     CHECK(p["frames"]["centreline_mm"].size() == frames);
     CHECK(p["frames"]["centreline_mm"][0].size() == 3 * cli::ReplayRecording::kCentrelinePoints);
     CHECK(p["parts"].size() == 3);
+    // The summary's peak force is the replay's peak, the frame the 3D view opens at.
+    const std::size_t peak = p["peak_frame"];
+    const std::vector<double> forces = p["frames"]["force_abs_N"];
+    CHECK(forces[peak] == *std::max_element(forces.begin(), forces.end()));
+    char figure[32];
+    std::snprintf(figure, sizeof figure, "%.3f", forces[peak]);
+    const std::size_t row = page.find(">" + p["name"].get<std::string>() + "</a></td>");
+    REQUIRE(row != std::string::npos);
+    const std::size_t row_end = page.find("</tr>", row);
+    CHECK(page.substr(row, row_end - row)
+              .find("<td class=\"num\">" + std::string(figure) + "</td>") != std::string::npos);
   }
   // The verdicts, the timeline, four plots a plan; the gentle plan's force over its 0.2 N limit
   // is marked (a span and a peak marker) on its force plot.

@@ -545,3 +545,88 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
 }
 
 }  // namespace
+
+namespace {
+
+// Two explorations give the same graph: nodes, witnesses and arcs.
+void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
+  CHECK(a.motions.size() == b.motions.size());
+  CHECK(a.probed == b.probed);
+  REQUIRE(a.nodes.size() == b.nodes.size());
+  REQUIRE(a.arcs.size() == b.arcs.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+    CHECK(a.nodes[i].cf == b.nodes[i].cf);
+    CHECK(a.nodes[i].ticks == b.nodes[i].ticks);
+    CHECK(a.nodes[i].witness.motion == b.nodes[i].witness.motion);
+    CHECK(a.nodes[i].witness.tick == b.nodes[i].witness.tick);
+  }
+  for (std::size_t i = 0; i < a.arcs.size(); ++i) {
+    CHECK(a.arcs[i].from == b.arcs[i].from);
+    CHECK(a.arcs[i].to == b.arcs[i].to);
+    CHECK(a.arcs[i].count == b.arcs[i].count);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("The budget bounds the motions exactly, the same on any number of threads", "[graph]") {
+  // The groove's sweeps are 14 motions: a budget of 1 cuts them, one of 20 cuts the aims.
+  for (const int budget : {1, 20}) {
+    graph::ExploreOptions o;
+    o.max_motions = budget;
+    o.jobs = 1;
+    const ContactGraph one = graph::Explore(FloorOnly(), o);
+    o.jobs = 2;
+    const ContactGraph two = graph::Explore(FloorOnly(), o);
+    CHECK(one.motions.size() == std::size_t(budget));
+    CHECK(one.saturation.size() == std::size_t(budget));
+    CHECK(one.end == graph::ExploreEnd::kBudget);
+    CHECK_FALSE(one.saturated);
+    CHECK(one.start == 0);
+    CheckSameGraph(one, two);
+  }
+}
+
+TEST_CASE("A tiny tube's exploration ends within its budget", "[graph]") {
+  // A 0.1 mm tube, 1 mm long, on the groove: its sweeps alone are 1202 motions (offsets a
+  // radius apart across 60 mm), which a budget of 3 used not to bound.
+  scene::Scene tiny = Groove();
+  tiny.tube.outer_radius_m = 1e-4;
+  tiny.tube.inner_radius_m = 5e-5;
+  tiny.tube.length_m = 1e-3;
+  graph::ExploreOptions o;
+  o.max_motions = 3;
+  o.jobs = 2;
+  const ContactGraph g = graph::Explore(tiny, o);
+  CHECK(g.motions.size() == 3);
+  CHECK(g.end == graph::ExploreEnd::kBudget);
+  CHECK(g.seconds < 20.0);
+}
+
+TEST_CASE("The time limit stops exploring; the graph is the one of the motions kept", "[graph]") {
+  graph::ExploreOptions o;
+  o.jobs = 2;
+  o.time_limit_s = 0.5;
+  o.status_interval_s = 0.05;
+  std::vector<graph::ExploreStatus> seen;
+  o.status = [&](const graph::ExploreStatus& s) { seen.push_back(s); };
+  const ContactGraph limited = graph::Explore(FloorOnly(), o);
+  CHECK(limited.end == graph::ExploreEnd::kTimeLimit);
+  CHECK_FALSE(limited.saturated);
+  // The motions under way at the limit stop within 64 ticks: well within a second here.
+  CHECK(limited.seconds < 0.5 + 1.0);
+  REQUIRE(!seen.empty());
+  CHECK(seen.back().motions_done == int(limited.motions.size()));
+  CHECK(seen.back().nodes == int(limited.nodes.size()));
+  if (limited.motions.empty()) {
+    // Nothing ended in time (a very busy machine): no start, no goal, an empty graph.
+    CHECK(limited.start == -1);
+    CHECK(limited.nodes.empty());
+    return;
+  }
+  // A budget of the motions it kept explores the same graph.
+  graph::ExploreOptions b;
+  b.jobs = 1;
+  b.max_motions = int(limited.motions.size());
+  CheckSameGraph(limited, graph::Explore(FloorOnly(), b));
+}

@@ -52,7 +52,7 @@ const nlohmann::json& PlanNamed(const nlohmann::json& report, const std::string&
 
 TEST_CASE("The shipped plans get their expected verdicts", "[plan]") {
   const nlohmann::json report = EvaluateShipped("2");
-  CHECK(report["tubeplan_evaluate"] == 1);
+  CHECK(report["tubeplan_evaluate"] == 2);
   CHECK(report["summary"]["plans"] == 5);
   CHECK(report["summary"]["feasible"] == 3);
 
@@ -337,8 +337,9 @@ TEST_CASE("Ticks beyond the linear range or whose solve stopped short are timed"
   }
   const plan::Judgement j = judging.Finish();
   REQUIRE(j.transitions.size() == 1);
-  CHECK(j.transitions[0].beyond_linear_s == Approx(0.030).margin(1e-12));
-  CHECK(j.transitions[0].unconverged_s == Approx(0.012).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kBeyondLinearRange) == Approx(0.030).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kNotConverged) == Approx(0.012).margin(1e-12));
+  CHECK(j.transitions[0].FlaggedSeconds(core::kSolverFault) == 0.0);
   CHECK(j.transitions[0].verdict == plan::Verdict::kInfeasible);
 }
 

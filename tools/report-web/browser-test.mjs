@@ -1,7 +1,10 @@
 // Opens an HTML report of `tubeplan evaluate --html` in headless Chromium (Debian's `chromium`,
 // driven by playwright-core) with the network off, and checks what a user would see:
-//   node browser-test.mjs REPORT.html [SCREENSHOT.png [PLAN_SCREENSHOT.png]]
-// (the screenshots: the top of the page, and the first plan's section with its plots)
+//   node browser-test.mjs [--stretch-frames N] REPORT.html [SCREENSHOT.png [PLAN_SCREENSHOT.png]]
+// (the screenshots: the top of the page, and the first plan's section with its plots;
+// --stretch-frames N: every plan's frames repeated, 1 ms apart, to N of them as the page parses
+// its data, the arrays of an unbounded recording of N / 50 s at 50 Hz: the page's script must
+// cope with arrays of any length)
 // - the page refers to nothing outside itself (no http(s) or protocol-relative src/href/url());
 // - it loads with no console error or warning, no uncaught exception, no request but the file;
 // - the screenshot is not blank (many colours, most of it not the background);
@@ -12,7 +15,13 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { chromium } from 'playwright-core';
 
-const [reportPath, screenshotPath, planShotPath] = process.argv.slice(2);
+const args = process.argv.slice(2);
+let stretchFrames = 0;
+if (args[0] === '--stretch-frames') {
+  stretchFrames = Number(args[1]);
+  args.splice(0, 2);
+}
+const [reportPath, screenshotPath, planShotPath] = args;
 if (!reportPath) {
   console.error('usage: node browser-test.mjs REPORT.html [SCREENSHOT.png]');
   process.exit(2);
@@ -44,6 +53,24 @@ const browser = await chromium.launch({
 });
 const context = await browser.newContext({ offline: true, viewport: { width: 1280, height: 1400 },
                                            deviceScaleFactor: 1 });
+if (stretchFrames > 0) {
+  // Before the page's own script: its data, once parsed, gets every plan's frames repeated (the
+  // same arrays by reference, so the browser holds them cheaply) up to N frames.
+  await context.addInitScript((n) => {
+    const parse = JSON.parse;
+    JSON.parse = function (text, reviver) {
+      const data = parse(text, reviver);
+      for (const p of (data && Array.isArray(data.plans)) ? data.plans : []) {
+        const f = p.frames, k0 = f.t_s.length, t0 = f.t_s[k0 - 1];
+        for (let k = k0; k < n; ++k) {
+          for (const key of Object.keys(f)) if (key !== 't_s') f[key].push(f[key][k % k0]);
+          f.t_s.push(t0 + (k - k0 + 1) * 1e-3);
+        }
+      }
+      return data;
+    };
+  }, stretchFrames);
+}
 const page = await context.newPage();
 page.setDefaultTimeout(0);
 const problems = [];
@@ -54,12 +81,23 @@ page.on('console', (m) => {
   if (m.type() === 'error' || (m.type() === 'warning' && !gpuNote))
     problems.push(`console ${m.type()}: ${m.text()}`);
 });
-page.on('pageerror', (e) => problems.push(`uncaught: ${e.message}`));
+// An uncaught exception also ends the wait for the page to be ready (it never will be).
+let failedToLoad;
+const loadFailure = new Promise((resolve) => { failedToLoad = resolve; });
+page.on('pageerror', (e) => { problems.push(`uncaught: ${e.message}`); failedToLoad(e); });
 const url = 'file://' + resolve(reportPath);
 const requests = [];
 page.on('request', (r) => { if (r.url() !== url) requests.push(r.url()); });
 await page.goto(url, { waitUntil: 'load' });
-await page.waitForFunction(() => document.body.dataset.ready === 'true');
+const error = await Promise.race([
+  page.waitForFunction(() => document.body.dataset.ready === 'true').then(() => null),
+  loadFailure]);
+if (error) {
+  check(false, `the page's script ran to its end (uncaught: ${error.message})`);
+  await browser.close();
+  console.error('browser test: the page did not load');
+  process.exit(1);
+}
 // Two animation frames: the first render has happened.
 const frames = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 await frames();

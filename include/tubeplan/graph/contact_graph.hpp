@@ -57,10 +57,17 @@ struct SaturationPoint {
   int arcs = 0;
 };
 
+/// Why an exploration ended.
+enum class ExploreEnd : unsigned char {
+  kSaturated,  ///< every node probed, the last round found no new one
+  kBudget,     ///< the budget of motions ran out first
+  kTimeLimit,  ///< the time limit passed first
+};
+
 struct ContactGraph {
   std::vector<Node> nodes;
   std::vector<Arc> arcs;
-  int start = -1;  ///< node of the start pose
+  int start = -1;  ///< node of the start pose (-1: no motion ended within the time limit)
   int goal = -1;   ///< node of the scene's goal CF, -1 when exploration never reached it
   std::vector<Motion> motions;  ///< every motion explored, in order (witnesses index it)
   std::vector<SaturationPoint> saturation;      ///< after each motion
@@ -72,7 +79,8 @@ struct ContactGraph {
   int held_back = 0;
   double seconds = 0.0;    ///< wall time of the exploration
   int probed = 0;          ///< nodes whose neighbour probes ran (the first `probed` nodes)
-  bool saturated = false;  ///< every node probed within the budget
+  bool saturated = false;  ///< every node probed, nothing cut by the budget or the time limit
+  ExploreEnd end = ExploreEnd::kSaturated;
 
   int FindNode(const std::string& cf) const;
 };

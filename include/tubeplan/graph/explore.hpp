@@ -8,7 +8,8 @@
 //  3. `random_motions` random guarded motions from a seed;
 //  4. neighbour probes: from a stay of each node (its motion resumed there), small moves
 //     of the hand along and against three directions and small turns, each held and undone;
-//     every node found is probed in turn until all have been (saturated) or the budget is spent.
+//     every node found is probed in turn until all have been (saturated), or until the budget of
+//     motions or the time limit is spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
 // into sub-ticks; what the sub-ticks produce is recorded, and a change that stays multiple is
 // flagged simultaneous. Motions run in parallel on `jobs` threads, each with its own core, and
@@ -16,19 +17,39 @@
 
 #include <cstdint>
 #include <functional>
+#include <string>
 
 #include <tubeplan/graph/contact_graph.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 namespace tubeplan::graph {
 
+/// Where an exploration is, for a progress display.
+struct ExploreStatus {
+  std::string phase;        ///< "sweeps", "aims", "random motions", "probes"
+  int motions_done = 0;     ///< motions run to their end so far
+  int motions_started = 0;  ///< motions handed to the threads so far (done ones included)
+  int nodes = 0, arcs = 0;  ///< the graph as merged so far (it grows after each group)
+  double seconds = 0.0;     ///< wall time since the exploration began
+};
+
 struct ExploreOptions {
   std::uint64_t seed = 1;
   /// Random guarded motions from `seed` run after the sweeps and aims, before probing.
   int random_motions = 120;
-  /// A bound whatever happens (sweeps, aims, random and probe motions together); the graph says
-  /// whether it saturated (every node probed) within it.
+  /// At most this many motions run, whatever happens (sweeps, aims, random and probe motions
+  /// together, in that order: a group is cut where the budget ends). A motion is one entry of
+  /// ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
+  /// node's ten probes after its prefix). The graph says whether it saturated within it.
   int max_motions = 3000;
+  /// Wall time bound [s] (0: none). Once passed, no motion starts and those under way stop
+  /// within 64 ticks and are dropped with every motion after the first of them: the graph is the
+  /// one `max_motions` set to the motions kept would give, on any number of threads.
+  double time_limit_s = 0.0;
+  /// Called on the calling thread about every `status_interval_s` while motions run, and once
+  /// after each group (may be empty; --jobs does not change what is explored).
+  std::function<void(const ExploreStatus&)> status;
+  double status_interval_s = 1.0;
   int jobs = 1;
   double push_N = 2.0;          ///< guard force of the probing moves
   double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)

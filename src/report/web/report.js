@@ -1,7 +1,9 @@
 // The 3D replay of the HTML report (tubeplan evaluate --html): the scene's parts and the tube's
-// deformed centreline per frame (recorded from the judged replay, 20 ms apart), with the contact
-// points and forces, animated with play/pause/scrub. three.js (window.THREE) is embedded before
-// this script. World frame: z up, millimetres.
+// deformed centreline per frame (recorded from the judged replay, 20 ms apart or wider for a long
+// one, and at its largest force), with the contact points and forces, animated with
+// play/pause/scrub. three.js (window.THREE) is embedded before this script. World frame: z up,
+// millimetres. A plan's arrays can be long: they are walked with loops, never spread into a
+// call's arguments (the engine's argument limit is far below a long recording's frames).
 'use strict';
 (() => {
   const data = JSON.parse(document.getElementById('tubeplan-data').textContent);
@@ -58,9 +60,9 @@
   // Arrow scale: the plan's largest force about 40 mm long, at 1, 2 or 5 times a power of ten.
   function niceScale(p) {
     let largest = 1e-6;
-    const take = (f) => { largest = Math.max(largest, Math.hypot(...f)); };
-    p.frames.force_N.forEach(take);
-    p.frames.contacts.forEach((cs) => cs.forEach((c) => { take(c.normal_N); take(c.friction_N); }));
+    const take = (f) => { largest = Math.max(largest, Math.hypot(f[0], f[1], f[2])); };
+    for (const f of p.frames.force_N) take(f);
+    for (const cs of p.frames.contacts) for (const c of cs) { take(c.normal_N); take(c.friction_N); }
     const raw = 40 / largest, magnitude = 10 ** Math.floor(Math.log10(raw));
     return [1, 2, 5, 10].map((m) => m * magnitude).filter((s) => s <= raw).pop();
   }
@@ -159,7 +161,7 @@
     scrub.value = String(frame);
     time = f.t_s[frame];
     clock.textContent = `t = ${time.toFixed(2)} s`;
-    const force = Math.hypot(...f.force_N[frame]);
+    const force = f.force_abs_N[frame];
     hud.innerHTML = '';
     const over = force > plan.max_force_N;
     const lines = [[`${plan.name}: ${plan.feasible ? 'FEASIBLE' : 'INFEASIBLE'}`, false],
@@ -211,9 +213,9 @@
     scrub.max = String(plan.frames.t_s.length - 1);
     newtonMm = niceScale(plan);
     buildWorld(plan);
-    // Open at the plan's largest force on the operator: where a limit is likeliest crossed.
-    const forces = plan.frames.force_N.map((f) => Math.hypot(...f));
-    showFrame(forces.indexOf(Math.max(...forces)));
+    // Open at the plan's largest force on the operator (the replay's peak tick, which the
+    // recording keeps as a frame): where a limit is likeliest crossed.
+    showFrame(plan.peak_frame);
   }
 
   function resize() {
