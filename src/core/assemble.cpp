@@ -14,19 +14,22 @@ int BlockOf(int node) { return node; }
 
 class Assembler {
  public:
-  Assembler(const Model& model, Data& data, bool derivatives)
-      : m_(model), s_(data.scratch), derivatives_(derivatives) {
-    if (derivatives_) {
-      s_.gradient.setZero();
-      s_.hessian.SetZero();
-    }
+  Assembler(Data& data, Derivatives need)
+      : s_(data.scratch),
+        gradient_(need != Derivatives::kNone),
+        hessian_(need == Derivatives::kHessian) {
+    if (gradient_) s_.gradient.setZero();
+    if (hessian_) s_.hessian.SetZero();
   }
+  bool gradient() const { return gradient_; }
+  bool hessian() const { return hessian_; }
 
   void AddStencil(const StencilTerm& t) {
-    if (!derivatives_) return;
+    if (!gradient_) return;
     for (int a = 0; a < t.nodes; ++a) {
       const int ba = BlockOf(t.first + a);
       s_.gradient.segment<3>(3 * ba) += t.gradient.segment<3>(3 * a);
+      if (!hessian_) continue;
       for (int b = 0; b < t.nodes; ++b) {
         const int bb = BlockOf(t.first + b);
         if (ba >= bb) s_.hessian.AddBlock(ba, bb, t.hessian.block<3, 3>(3 * a, 3 * b));
@@ -38,27 +41,28 @@ class Assembler {
   // with respect to the point, mapped through the point's Jacobian.
   void AddAtPoint(const Eigen::Matrix<double, 3, 9>& J, int first, int nodes, const Vec3& g_p,
                   const Mat3& H_p) {
-    if (!derivatives_) return;
+    if (!gradient_) return;
     // Fixed-size products: the columns of a two-node stencil's third node are zero.
     StencilTerm t;
     t.first = first;
     t.nodes = nodes;
     t.gradient.noalias() = J.transpose() * g_p;
-    const Eigen::Matrix<double, 3, 9> HJ = H_p * J;
-    t.hessian.noalias() = J.transpose() * HJ;
+    if (hessian_) {
+      const Eigen::Matrix<double, 3, 9> HJ = H_p * J;
+      t.hessian.noalias() = J.transpose() * HJ;
+    }
     AddStencil(t);
   }
 
   void AddHeldEnd(const Vec3& g, const Mat3& H) {
-    if (!derivatives_) return;
+    if (!gradient_) return;
     s_.gradient.segment<3>(0) += g;
-    s_.hessian.AddBlock(0, 0, H);
+    if (hessian_) s_.hessian.AddBlock(0, 0, H);
   }
 
  private:
-  const Model& m_;
   Scratch& s_;
-  bool derivatives_;
+  bool gradient_, hessian_;
 };
 
 }  // namespace
@@ -123,7 +127,7 @@ namespace {
 // points share it evenly (the whole end face, K), and the end resists tilting as a rigid flat
 // end does, up to the moment that puts the whole force on its rim (docs/core.md).
 double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int first, int end,
-              Assembler& a, bool derivatives) {
+              Assembler& a) {
   const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
   const double tau = kRimSoftness * eps;
   Sample* s = &data.scratch.samples[std::size_t(first)];
@@ -143,7 +147,7 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   }
   const double force = K * depth;
   for (int j = 0; j < count; ++j) s[j].normal_force_N = force * w[std::size_t(j)];
-  if (derivatives) {
+  if (a.gradient()) {
     // d distance / d (x_{N-1}, x_N) of each point, their weighted mean, and the softmin's
     // curvature: H = K m m^T + (F / tau) (sum w g g^T - m m^T).
     Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
@@ -159,8 +163,9 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
     t.first = model.rod.elements - 1;
     t.nodes = 2;
     t.gradient.head<6>() = -force * mean;
-    t.hessian.topLeftCorner<6, 6>() =
-        K * mean * mean.transpose() + (force / tau) * (spread - mean * mean.transpose());
+    if (a.hessian())
+      t.hessian.topLeftCorner<6, 6>() =
+          K * mean * mean.transpose() + (force / tau) * (spread - mean * mean.transpose());
     a.AddStencil(t);
   }
   return 0.5 * K * depth * depth;
@@ -168,12 +173,14 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
 
 }  // namespace
 
-double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool derivatives) {
-  Assembler a(model, data, derivatives);
+double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
+                Derivatives derivatives) {
+  Assembler a(data, derivatives);
   const RodModel& rod = model.rod;
   double energy = 0.0;
   StencilTerm term;
-  StencilTerm* want = derivatives ? &term : nullptr;
+  term.with_hessian = a.hessian();
+  StencilTerm* want = a.gradient() ? &term : nullptr;
 
   // The rod: bending at the grip (against the held end's axis) and at the inner nodes, the
   // stiff axial spring of every element.
@@ -203,7 +210,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
              data.scratch.samples[std::size_t(end)].kind == SampleKind::kRim &&
              data.scratch.samples[std::size_t(end)].part == smp.part)
         ++end;
-      energy += AddRim(model, data, x_W, k, end, a, derivatives);
+      energy += AddRim(model, data, x_W, k, end, a);
       k = end - 1;
       continue;
     }
@@ -213,7 +220,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
     const double kw = K * smp.weight;
     energy += 0.5 * kw * depth * depth;
     smp.normal_force_N = kw * depth;
-    if (!derivatives) continue;
+    if (!a.gradient()) continue;
     const MaterialPoint mp =
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
@@ -233,7 +240,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W, bool 
   // sticks, the kinetic one once it slides, at the normal force its limit was last set for.
   for (int k = 0; k < data.state.friction_count; ++k) {
     const FrictionPoint& f = data.state.friction[std::size_t(k)];
-    const MaterialPoint mp = FrictionMaterial(model, f, x_W, derivatives);
+    const MaterialPoint mp = FrictionMaterial(model, f, x_W, a.gradient());
     const Mat3 P = Mat3::Identity() - f.normal_W * f.normal_W.transpose();
     const Vec3 u = P * (mp.point_W - f.anchor_W);
     const double lu = u.norm();

@@ -18,10 +18,13 @@ int UnknownCount(const Model& model);
 void NodesOf(const Model& model, const Eigen::VectorXd& q, std::span<Eigen::Vector3d> x_W);
 void UnknownsOf(const Model& model, std::span<const Eigen::Vector3d> x_W, Eigen::VectorXd& q);
 
+/// What Assemble computes besides the potential.
+enum class Derivatives { kNone, kGradient, kHessian };
+
 /// The potential at the nodes x_W with the contact points in data.scratch.samples (found at
-/// x_W); with `derivatives`, also its gradient and Hessian in data.scratch.
+/// x_W); and, as asked, its gradient (and Hessian) in data.scratch.
 double Assemble(const Model& model, Data& data, std::span<const Eigen::Vector3d> x_W,
-                bool derivatives);
+                Derivatives derivatives);
 
 /// The coupling's part of the potential at the held end's position: its energy, its gradient
 /// (the force the operator feels) and Hessian.

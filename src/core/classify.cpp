@@ -178,7 +178,11 @@ void Classify(const Model& model, Data& data) {
   // deform; the side is concave or convex by the side of the bend that meets the part, read
   // midway along the piece of tube that leads from the previous contact (or the grip) to it.
   const double deflection = TipDeflection(model, data);
-  const bool bends = deflection > model.contact.bend_threshold_m;
+  // Bending from the threshold on, straight again below half of it: the markers do not flicker
+  // while the tip hovers at the threshold.
+  const double threshold = model.contact.bend_threshold_m * (data.state.bends ? 0.5 : 1.0);
+  const bool bends = deflection > threshold;
+  data.state.bends = bends;
   const double l = model.rod.length_m;
   const double curvature_floor = model.contact.bend_threshold_m / (l * l);
   for (int i = 0; i < count; ++i) {

@@ -55,12 +55,9 @@ class Finder {
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
-      // How far each node's surface is from the part, for the solve's step.
-      for (int i = 0; i <= n_; ++i)
-        s.clearance_m[std::size_t(i)] =
-            std::min(s.clearance_m[std::size_t(i)],
-                     part.geometry.Distance(x_[std::size_t(i)], Entry(p, i)).distance_m -
-                         m_.rod.outer_radius_m);
+      // How far the held end's surface is from the part, for the solve's step (Node and Rim
+      // note the other nodes').
+      Clear(0, part.geometry.Distance(x_[0], Entry(p, 0)).distance_m);
       // The side at the inner nodes and between them, the free end's rim and end face.
       for (int i = 1; i < n_; ++i) Node(p, part, i);
       for (int i = 0; i < n_; ++i) Side(p, part, i);
@@ -70,6 +67,12 @@ class Finder {
   }
 
  private:
+  // Notes node i's clearance: its centre's distance to a part, less the radius.
+  void Clear(int i, double centre_m) {
+    double& c = d_.scratch.clearance_m[std::size_t(i)];
+    c = std::min(c, centre_m - m_.rod.outer_radius_m);
+  }
+
   std::uint8_t Entry(int part, int node) const {
     return d_.state.entry_mask[std::size_t(part * (n_ + 1) + node)];
   }
@@ -163,6 +166,7 @@ class Finder {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& c = x_[std::size_t(i)];
     PartDistance at = part.geometry.Distance(c, Entry(p, i));
+    Clear(i, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
     MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), true);
     const double along = at.normal_W.dot(mp.tangent_W);
@@ -187,7 +191,9 @@ class Finder {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& c = x_[std::size_t(n_)];
     const std::uint8_t entry = Entry(p, n_);
-    if (part.geometry.Distance(c, entry).distance_m - r1 >= eps) return;
+    const double centre_m = part.geometry.Distance(c, entry).distance_m;
+    Clear(n_, centre_m);
+    if (centre_m - r1 >= eps) return;
     const Vec3 t = CarrierTangent(Carrier::kEndNode, x_, n_);
     Vec3 rho, side;
     SectionFrame(part, p, n_, c, t, entry, rho, side);

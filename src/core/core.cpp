@@ -82,6 +82,7 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.state.R_WH = X_WH.linear();
   d.state.p_hand_prev_W = d.state.p_held_prev_W = X_WH.translation();
   d.state.friction_count = 0;
+  d.state.bends = false;
   d.input = TickInput{};
   d.input.p_hand_W = X_WH.translation();
   d.input.X_W_hand = X_WH;

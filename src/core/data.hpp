@@ -100,6 +100,7 @@ struct CarriedState {
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();
   std::array<FrictionPoint, kMaxFrictionPoints> friction{};
   int friction_count = 0;
+  bool bends = false;  ///< the tube was bending (the markers' threshold has hysteresis)
   /// Per (part, node): the direction from the node's section centre to its point nearest the
   /// part, as the last tick found it (a section facing a part squarely keeps it).
   std::vector<Eigen::Vector3d> section_direction_W;

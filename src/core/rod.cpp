@@ -70,6 +70,14 @@ double BendingEnergy(const RodModel& rod, const Vec3& t_H, std::span<const Vec3>
   if (term != nullptr) {
     // E = c (1 - a.b); with g_e = d(a.b)/de = (b - cos a) / |e| and likewise g_f:
     const Vec3 ge = (b - cos_phi * a) / le, gf = (a - cos_phi * b) / lf;
+    if (!term->with_hessian) {
+      term->first = i - 1;
+      term->nodes = 3;
+      term->gradient.segment<3>(0) = c * ge;
+      term->gradient.segment<3>(3) = c * (gf - ge);
+      term->gradient.segment<3>(6) = -c * gf;
+      return 0.5 * c * (a - b).squaredNorm();
+    }
     const Mat3 I = Mat3::Identity();
     const Mat3 dge_de = -(a * ge.transpose() + ge * a.transpose()) / le -
                         cos_phi * (I - a * a.transpose()) / (le * le);

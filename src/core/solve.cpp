@@ -68,7 +68,7 @@ double NegativeCurvature(Scratch& s, Eigen::VectorXd& v) {
   return v.dot(s.work);
 }
 
-enum class Outcome { kStep, kConverged, kFailed };
+enum class Outcome { kStep, kDefiniteStep, kConverged, kFailed };
 
 // The Newton step of the assembled system, damped by `damping` [N/m] on every unknown; at a
 // saddle (a straight column past its buckling load, where the gradient vanishes) it also leaves
@@ -92,15 +92,16 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
     } else if (balanced) {
       return Outcome::kConverged;
     }
+    return Outcome::kStep;
   }
-  return Outcome::kStep;
+  return damping == 0.0 ? Outcome::kDefiniteStep : Outcome::kStep;
 }
 
 // Moves the unknowns along the step, capped so that no point moves farther than the step cap
 // (contacts are found again before a part could be crossed), halving it while the energy does
-// not fall enough (Armijo). True, with the nodes, contacts and energy of the new point, when one
-// was taken.
-bool LineSearch(const Model& model, Data& data, double& energy) {
+// not fall enough (Armijo). Returns the fraction of the step taken (0 for none), with the nodes,
+// contacts, energy and derivatives of the new point.
+double LineSearch(const Model& model, Data& data, double& energy) {
   Scratch& s = data.scratch;
   std::span<Vec3> trial(s.x_trial_W);
   double alpha = StepFraction(model, s, s.step);
@@ -109,21 +110,23 @@ bool LineSearch(const Model& model, Data& data, double& energy) {
     s.unknowns_trial = s.unknowns + alpha * s.step;
     NodesOf(model, s.unknowns_trial, trial);
     FindContacts(model, trial, data, Choices::kPending);
-    // The first trial is taken most often: its derivatives are assembled with its energy.
-    const double e = Assemble(model, data, trial, halving == 0);
+    // The first trial is taken most often: its gradient is assembled with its energy.
+    const double e =
+        Assemble(model, data, trial, halving == 0 ? Derivatives::kGradient : Derivatives::kNone);
     // With room for the rounding of a sum of terms near equilibrium.
     if (e <= energy + 1e-4 * alpha * std::min(slope, 0.0) + 1e-13 * std::abs(energy)) {
       CommitContactChoices(data);
       s.unknowns = s.unknowns_trial;
       std::copy(trial.begin(), trial.end(), data.state.x_W.begin());
-      energy = halving == 0 ? e : Assemble(model, data, data.state.x_W, true);
-      return true;
+      if (halving > 0) Assemble(model, data, data.state.x_W, Derivatives::kGradient);
+      energy = e;
+      return alpha;
     }
   }
   // None taken: the contacts and derivatives of where the search started.
   FindContacts(model, data.state.x_W, data);
-  energy = Assemble(model, data, data.state.x_W, true);
-  return false;
+  energy = Assemble(model, data, data.state.x_W, Derivatives::kHessian);
+  return 0.0;
 }
 
 }  // namespace
@@ -134,14 +137,14 @@ void SolveEquilibrium(const Model& model, Data& data) {
   std::span<Vec3> x(data.state.x_W);
   UnknownsOf(model, x, s.unknowns);
   FindContacts(model, x, data);
-  double energy = Assemble(model, data, x, true);
+  double energy = Assemble(model, data, x, Derivatives::kHessian);
   report.converged = false;
   // The iterations left of the tick's budget, which its friction passes share.
   while (report.iterations < model.solver.max_iterations) {
     report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
-    Outcome o = NewtonStep(model, data, 0.0);
+    const Outcome o = NewtonStep(model, data, 0.0);
     if (o == Outcome::kConverged) report.converged = true;
-    if (o != Outcome::kStep) break;
+    if (o != Outcome::kStep && o != Outcome::kDefiniteStep) break;
     ++report.iterations;
     // Converged when the Newton step would change the energy by less than the rounding of its
     // stiff axial terms (their lengths cancel to ~1e-18 m): what is left is below any figure.
@@ -149,17 +152,28 @@ void SolveEquilibrium(const Model& model, Data& data) {
       s.unknowns += s.step;
       NodesOf(model, s.unknowns, x);
       FindContacts(model, x, data);
-      energy = Assemble(model, data, x, true);
+      energy = Assemble(model, data, x, Derivatives::kGradient);
       report.converged = true;
       break;
     }
     // Where the full step does not lower the energy (a contact it did not foresee), damped
     // steps, shorter and nearer the gradient (Levenberg-Marquardt), from the contact stiffness
     // up.
-    bool moved = LineSearch(model, data, energy);
-    for (double damping = model.contact.stiffness_N_per_m; !moved && damping < 1e5 * model.contact.stiffness_N_per_m; damping *= 10.0) {
+    const double taken = LineSearch(model, data, energy);
+    // A full Newton step from a stable point that lands within the tolerance has converged (the
+    // Hessian barely changed: it is not factored again to be sure).
+    if (o == Outcome::kDefiniteStep && taken == 1.0 &&
+        s.gradient.lpNorm<Eigen::Infinity>() <= model.solver.tolerance_N) {
+      report.converged = true;
+      break;
+    }
+    // The next iteration needs the Hessian where the search ended.
+    if (taken > 0.0) Assemble(model, data, x, Derivatives::kHessian);
+    bool moved = taken > 0.0;
+    for (double damping = model.contact.stiffness_N_per_m;
+         !moved && damping < 1e5 * model.contact.stiffness_N_per_m; damping *= 10.0) {
       if (NewtonStep(model, data, damping) != Outcome::kStep) break;
-      moved = LineSearch(model, data, energy);
+      moved = LineSearch(model, data, energy) > 0.0;
     }
     // Nothing lowers the energy: the last state stands.
     if (!moved) break;
