@@ -141,8 +141,13 @@ void Judging::Measure(double t_s, const core::StepOutput& out) {
   const auto exceeded = [&](const std::string& reason) {
     if (f.failure.empty()) f.failure = reason, f.t_failure_s = t_s;
   };
+  // At the device's clamp the force is the most the device renders, which a plan's limit is
+  // often set to: said so, rather than "8.5 N > 8.5 N".
   if (force_N > limits_.max_force_N)
-    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s,
+                    (out.flags & core::kForceClamped)
+                        ? " (the device's clamp was reached: it renders no more)"
+                        : ""));
   if (out.max_strain > limits_.max_strain)
     exceeded(Format("strain", out.max_strain, "", limits_.max_strain, t_s));
   for (const core::ContactState& c : out.Contacts()) {

@@ -244,6 +244,6 @@ TEST_CASE("Fault ticks are not a state of the tube and are warned about", "[plan
   CHECK(j.transitions[0].FlaggedSeconds(core::kSolverFault) == 0.0);
   CHECK(Json(j, states)["transitions"][1]["fault_s"] == Approx(0.030).margin(1e-12));
   const std::string text = Text(j, states);
-  CHECK(text.find("      warning: for 0.03 s the core's solver failed (flag fault)") !=
+  CHECK(text.find("      warning: for 0.03 s the core could not solve the tick (flag fault") !=
         std::string::npos);
 }
