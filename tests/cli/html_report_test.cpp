@@ -227,9 +227,9 @@ TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cl
     CHECK(page.substr(row, row_end - row)
               .find("<td class=\"num\">" + std::string(figure) + "</td>") != std::string::npos);
   }
-  // The verdicts, the timeline, four plots a plan; the gentle plan's force over its 0.2 N limit
+  // The verdicts, the timeline, four plots a plan; the gentle plan's force over its 0.05 N limit
   // is marked (a span and a peak marker) on its force plot.
-  CHECK(page.find("limit 0.200 N") != std::string::npos);
+  CHECK(page.find("limit 0.050 N") != std::string::npos);
   CHECK(page.find("class=\"marker\"") != std::string::npos);
   CHECK(page.find("planned transitions") != std::string::npos);
   CHECK(page.find("--html-graph") != std::string::npos);  // the note on how to add the graph

@@ -182,7 +182,8 @@ TEST_CASE("The side on a frictionless edge at distance a: 3EI/a^3 in series, con
   const double a = 2.0 * l / 3.0;
   s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
   scene::BoxPart edge = Box("edge", {0.02, 0.1, 0.02}, {0.0, 0.0, 0.0});
-  // Turned 45 deg about y: its edge along y, pointing at the tube (-x).
+  // Turned 45 deg about y: the edge between its top and its +x face (local) points along world
+  // +x, at the tube.
   edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   edge.X_WP.translation() = Eigen::Vector3d(-(r1 + 0.5 * eps) - 0.01 * std::sqrt(2.0), 0.0, a);
   s.parts.push_back(edge);
@@ -198,7 +199,7 @@ TEST_CASE("The side on a frictionless edge at distance a: 3EI/a^3 in series, con
     REQUIRE(out.contact_count == 1);
     const core::ContactState& pc = out.contacts[0];
     CHECK(pc.tube == states::TubeElement::kSide);
-    CHECK(c.elements()[std::size_t(pc.part_element)].name == "edge.top_xneg");
+    CHECK(c.elements()[std::size_t(pc.part_element)].name == "edge.top_xpos");
     // The tube bends round the edge: its convex side meets it.
     CHECK(pc.marker == states::Marker::kConvex);
     CHECK(pc.s_m == Approx(a).margin(1e-3));

@@ -339,13 +339,17 @@ TEST_CASE("Reading and sending over OpenIGTLink allocate nothing in the servo th
   device::DeviceSample s;
   REQUIRE(dev.Read(s));
   dev.Send(limiter.Command(Eigen::Vector3d(0.01, 0, 0), Eigen::Vector3d::Zero()));
+  // No assertion inside the counted loop: a reporter that keeps results would allocate there.
   const std::int64_t before = tubeplan::testing::g_allocations;
+  int reads_failed = 0;
   for (int i = 0; i < 300; ++i) {
-    REQUIRE(dev.Read(s));
+    if (!dev.Read(s)) ++reads_failed;
     dev.Send(limiter.Command(Eigen::Vector3d(0.01, 0, 0), Eigen::Vector3d::Zero()));
     ::usleep(500);
   }
-  CHECK(tubeplan::testing::g_allocations - before == 0);
+  const std::int64_t allocations = tubeplan::testing::g_allocations - before;
+  CHECK(reads_failed == 0);
+  CHECK(allocations == 0);
   dev.Close();
   std::string summary;
   CHECK(bridge.Wait(summary) == 0);

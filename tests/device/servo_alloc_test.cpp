@@ -55,7 +55,7 @@ TEST_CASE("A servo tick allocates nothing", "[device][alloc]") {
   double largest_N = 0.0;
   for (device::TickRecord r; ring.TryPop(r);)
     largest_N = std::max(largest_N, r.force_sent_N.norm());
-  CHECK(largest_N > 0.1);
+  CHECK(largest_N > 0.02);  // free motion sends none; the pressed rim about 0.03 N
   // The counter does count on this thread: the cold path (the CF as text) allocates.
   const std::int64_t before = g_allocations;
   CHECK(!core.FormationText().empty());

@@ -79,6 +79,15 @@ TEST_CASE("The minimal scene of these tests is valid", "[scene]") {
   CHECK(loaded.scene->friction.exponent == 1.0);
 }
 
+TEST_CASE("A model option that no longer chooses anything warns and loads", "[scene]") {
+  const auto loaded = LoadSceneText(kMinimal + "model: {capsules: 16, elements: 24}\n", "t.yaml");
+  REQUIRE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:12:19: warning: model.capsules has no effect: the core solves the rod and all its "
+        "contacts together (model.elements sets the rod's resolution)\n");
+  CHECK(loaded.scene->model.elements == 24);
+}
+
 TEST_CASE("A good scene gives exactly its SI values", "[scene]") {
   const auto loaded = LoadSceneFile(SourcePath("tests/data/scenes/good.yaml"));
   REQUIRE(loaded.diagnostics.FormatAll() == "");
@@ -195,17 +204,17 @@ TEST_CASE("Broken scenes get exactly the right diagnostics", "[scene]") {
        "the device's damping 1 N s/m must exceed K T / 2 + |B| = 1.15 N s/m, expected a softer "
        "spring or less coupling damping\n"},
       {"unknown model", kMinimal + "model: {beam: timoshenko}\n",
-       "t.yaml:12:15: error: model.beam 'timoshenko' is not known (expected one of: linear, "
-       "elastica)\n"},
-      {"capsule count beyond the core's", kMinimal + "model: {capsules: 60}\n",
-       "t.yaml:12:19: error: model.capsules 60 is not a count the core supports, expected "
-       "\"auto\" or a whole number from 8 to 48\n"},
-      {"capsule count not whole", kMinimal + "model: {capsules: 12.5}\n",
-       "t.yaml:12:19: error: model.capsules 12.5 is not a count the core supports, expected "
-       "\"auto\" or a whole number from 8 to 48\n"},
-      {"capsule count not a scalar", kMinimal + "model: {capsules: [16]}\n",
-       "t.yaml:12:19: error: model.capsules must be a count, found a sequence, expected \"auto\" "
-       "or a whole number from 8 to 48\n"},
+       "t.yaml:12:15: error: model.beam 'timoshenko' is not known (expected one of: rod, "
+       "elastica, linear)\n"},
+      {"element count beyond the core's", kMinimal + "model: {elements: 200}\n",
+       "t.yaml:12:19: error: model.elements 200 is not a count the core supports, expected "
+       "\"auto\" or a whole number from 4 to 96\n"},
+      {"element count not whole", kMinimal + "model: {elements: 12.5}\n",
+       "t.yaml:12:19: error: model.elements 12.5 is not a count the core supports, expected "
+       "\"auto\" or a whole number from 4 to 96\n"},
+      {"element count not a scalar", kMinimal + "model: {elements: [16]}\n",
+       "t.yaml:12:19: error: model.elements must be a count, found a sequence, expected \"auto\" "
+       "or a whole number from 4 to 96\n"},
       {"top level not a map", "- 1\n- 2\n",
        "t.yaml:1:1: error: a scene file must be a map, found a sequence, expected keys such as "
        "tubeplan, name, tube, parts\n"},
