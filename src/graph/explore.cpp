@@ -450,6 +450,10 @@ bool FreePose(core::Core& core, const Eigen::Isometry3d& X) {
   return out.contact_count == 0 && (out.flags & core::kPenetration) == 0;
 }
 
+// The force that ends an aim's approach: a touch that bends a soft tube by less than the
+// scene's bend threshold.
+constexpr double kTouchGuard_N = 0.02;
+
 std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
                          const std::vector<int>& elements, const ExploreOptions& o) {
   const Frame f = StartFrame(scene);
@@ -506,8 +510,14 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
         m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
         m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+        // Onto the surface, stopped by the first light push (the element touched, the tube not
+        // yet bent by it) and held there, then pressed.
+        const Eigen::Vector3d touch = aim.hand + gap * aim.push;
+        m.moves.push_back(MoveTo(touch, q, 0.1 * o.speed_m_per_s, kTouchGuard_N, aim.hand));
+        m.moves.push_back(MoveTo(touch, q, o.speed_m_per_s, 0.0, touch));
+        m.moves.back().min_ticks = 100;
         const Eigen::Vector3d pressed = aim.hand + (gap + 3e-3) * aim.push;
-        m.moves.push_back(MoveTo(pressed, q, 0.5 * o.speed_m_per_s, o.push_N, aim.hand));
+        m.moves.push_back(MoveTo(pressed, q, 0.5 * o.speed_m_per_s, o.push_N, touch));
         m.moves.push_back(MoveTo(ClampToWorkspace(scene, pressed + 1.5 * r * aim.slide), q,
                                  0.5 * o.speed_m_per_s, 1.5 * o.push_N, pressed));
         m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 2.5 * r * n_W), q,
@@ -913,11 +923,16 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   run(Sweeps(scene, box, o), {});
   graph.start = graph.nodes.empty() ? -1 : 0;  // the first stay of the first motion: the start
   if (!stopped) {
-    // Aim at the elements of reachable parts that no PC has touched yet.
+    // Aim at the goal's elements first, then at those no PC has touched yet.
     const std::set<std::string> reached = ReachedElements(graph);
+    std::set<std::string> in_goal;
+    for (const states::PrincipalContact& pc : scene.goal.contacts) in_goal.insert(pc.part_element);
     std::vector<int> unseen;
     for (std::size_t e = 0; e < probe.elements().size(); ++e)
-      if (!reached.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
+      if (in_goal.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
+    for (std::size_t e = 0; e < probe.elements().size(); ++e)
+      if (!reached.contains(probe.elements()[e].name) && !in_goal.contains(probe.elements()[e].name))
+        unseen.push_back(static_cast<int>(e));
     phase = "aims";
     run(Aims(scene, probe, unseen, o), {});
   }
