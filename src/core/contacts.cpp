@@ -90,6 +90,8 @@ class Finder {
                  const PartDistance& dist, const MaterialPoint& mp, const Vec3& moving_offset_W) {
     Sample* smp = Add();
     if (smp == nullptr) return nullptr;
+    // Every field from this tick's values: nothing of the slot's last use may reach the solve.
+    *smp = Sample{};
     smp->kind = kind;
     smp->part = part;
     smp->node = node;
@@ -103,9 +105,6 @@ class Finder {
     smp->point_W = mp.point_W;
     smp->offset_W = mp.offset_W;
     smp->moving_offset_W = moving_offset_W;
-    smp->weight_gradient.setZero();
-    smp->weight_nodes = 0;
-    smp->normal_force_N = 0.0;
     return smp;
   }
 
