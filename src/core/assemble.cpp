@@ -225,7 +225,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
-    // A share that fades: its change moves the energy too.
+    // A share that fades: its change moves the energy too (its curvature is left out).
     if (smp.weight_nodes > 0) {
       StencilTerm t;
       t.first = smp.weight_first;

@@ -17,8 +17,8 @@ struct StencilTerm {
   int first = 0;      ///< the stencil's first node
   int nodes = 0;      ///< 1, 2 or 3
   bool with_hessian = true;  ///< whether the term is asked for its Hessian too
-  Eigen::Matrix<double, 9, 1> gradient;
-  Eigen::Matrix<double, 9, 9> hessian;
+  Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();
 };
 
 /// Bending at node i: (EI / h) (1 - cos phi_i), phi_i the angle between the elements on either
