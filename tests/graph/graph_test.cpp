@@ -271,23 +271,18 @@ scene::Scene FloorOnly() {
   return floor;
 }
 
-// The scene the exploration tests explore. Under the sanitizers (15-20x slower) the groove's
-// default exploration takes half an hour of CI per test: there they explore the floor alone,
-// which runs the same code (every kind of motion, probe rounds to saturation, refinements, resumed
-// runs); the release build explores the groove.
-#ifdef TUBEPLAN_SANITIZED
+// The scene the exploration tests explore: the floor alone runs the same code as the groove
+// (every kind of motion, probe rounds to saturation, refinements, resumed runs) in a tenth of
+// the time (its default exploration: 19 s on 2 threads against 196 s).
 scene::Scene ExploredScene() { return FloorOnly(); }
-#else
-scene::Scene ExploredScene() { return Groove(); }
-#endif
 
-// A small exploration of the shipped scene, shared by the tests below (it costs seconds).
+// A small exploration, shared by the tests below (it costs seconds).
 const ContactGraph& SmallGraph(int jobs) {
   static std::map<int, ContactGraph> graphs;
   if (!graphs.contains(jobs)) {
     graph::ExploreOptions o;
     o.random_motions = 5;
-    o.max_motions = 110;  // the 81 sweeps and aims, 5 random motions and 24 probe motions
+    o.max_motions = 110;  // the sweeps and aims, 5 random motions and probe motions
     o.jobs = jobs;
     graphs[jobs] = graph::Explore(ExploredScene(), o);
   }
@@ -521,27 +516,14 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph]"
        << 100.0 * arc_coverage << " %); by use: ticks " << 100.0 * tick_coverage
        << " %, transitions taken " << taken_in << "/" << taken_all << " (" << 100.0 * taken_coverage
        << " %)");
-  // The exploration saturates (every CF it found was probed, docs/graph.md). With the core of
-  // the linear fallback and the world-held stick every CF these motions went through was in the
-  // graph (53/53) and 140 of 143 transitions. With the rod and the stick carried with the
-  // contact (docs/core.md) they reach more states (63-65), and the graph misses 4-5 of them and
-  // 13 of ~170 transitions (measured 92-94 % and 92 %): rare states of a side on the groove's top
-  // edges, its marker flipping (Fs n/u left.top_inner), and wedges against floor and wall, which
-  // the probes from one stay per node do not reach. Since motions end where the core holds the
-  // tube back from going through a part (stop 30), fewer states are reached (47/48 and 90/98
-  // measured). Since a line contact's two points share their PC's friction limit (stop 32) the
-  // exploration from seed 1 no longer finds the side alone on a top inner edge with the edge on
-  // its concave side (Fs u left/right.top_inner: the axial friction's moment at the surface
-  // bends the tube that way); seeds 2 and 3 find them, seed 4 does not, nor does seed 4 with
-  // 200 random motions. Measured then: 45/47 CFs, 80/92 transitions, 1.4 % of the motions' ticks
-  // outside the graph's CFs. Since a stuck load that pulls slides before it is released (stop
-  // 32): 48/51 CFs (those two, and the side on the floor and the right wall's outer face),
-  // 88/99 transitions, 1.7 % of the ticks outside. The floors keep a margin of two CFs and three
-  // transitions, and let the ticks outside the graph grow by half: exploration that misses
-  // common states fails here.
-  CHECK(node_coverage >= 0.90);
-  CHECK(arc_coverage >= 0.85);
-  CHECK(tick_coverage >= 0.975);
+  // The exploration saturates (every CF it found was probed, docs/graph.md), yet probes from
+  // one stay per node miss rare states (a tip hooked under the floor's edge with the side on its
+  // top). On the floor alone these motions reach only a handful of CFs, so one rare miss moves
+  // the CF share by 15 %: the counts allow one missed CF, and the shares by use (ticks spent,
+  // transitions taken) must stay high, so that an exploration missing common states fails.
+  CHECK(std::size_t(covered_nodes) + 1 >= seen_nodes.size());
+  CHECK(tick_coverage >= 0.99);
+  CHECK(taken_coverage >= 0.95);
 }
 
 }  // namespace
