@@ -101,12 +101,24 @@ CouplingTerm Coupling(const Model& model, const Data& data, const Vec3& p_held_W
     t.stiffness_N_per_m = (c.max_force_N / lr) * (Mat3::Identity() - u * u.transpose());
     t.saturated = true;
   }
+  // The damper on the held end's motion relative to the hand's this tick, saturating at the
+  // device's force as the spring does: a hand that jumps cannot drag the tube harder than that.
   const double b = c.damping_Ns_per_m / c.time_step_s;
   const Vec3 slip =
       (p_held_W - data.state.p_held_prev_W) - (data.input.p_hand_W - data.state.p_hand_prev_W);
-  t.energy_J += 0.5 * b * slip.squaredNorm();
-  t.force_N += b * slip;
-  t.stiffness_N_per_m += b * Mat3::Identity();
+  const double ls = slip.norm();
+  const double s_sat = c.max_force_N / b;
+  if (ls <= s_sat) {
+    t.energy_J += 0.5 * b * ls * ls;
+    t.force_N += b * slip;
+    t.stiffness_N_per_m += b * Mat3::Identity();
+  } else {
+    const Vec3 u = slip / ls;
+    t.energy_J += c.max_force_N * (ls - 0.5 * s_sat);
+    t.force_N += c.max_force_N * u;
+    t.stiffness_N_per_m += (c.max_force_N / ls) * (Mat3::Identity() - u * u.transpose());
+    t.saturated = true;
+  }
   return t;
 }
 

@@ -35,6 +35,8 @@ void ClosestSegmentPoints(const Vec3& p0, const Vec3& p1, const Vec3& q0, const 
 
 // Where a node's sphere stops standing for the side: |n.t| from kCapStart, over kCapFade.
 constexpr double kCapStart = 0.3, kCapFade = 0.2;
+// The feature of the held end's sphere, apart from the element sides' edges (0 and up).
+constexpr int kHeldFeature = -1;
 
 // Smooth step from 0 at a = 0 to 1 at a = 1.
 double SmoothStep(double a) {
@@ -59,6 +61,7 @@ class Finder {
       // note the other nodes').
       Clear(0, part.geometry.Distance(x_[0], Entry(p, 0)).distance_m);
       // The side at the inner nodes and between them, the free end's rim and end face.
+      HeldNode(p, part);
       for (int i = 1; i < n_; ++i) Node(p, part, i);
       for (int i = 0; i < n_; ++i) Side(p, part, i);
       Rim(p, part);
@@ -184,6 +187,21 @@ class Finder {
       smp->weight_first = i - 1;
       smp->weight_nodes = 3;
     }
+  }
+
+  // The held end's section: the sphere of radius r1 about node 0, at full share, so that the
+  // coupling cannot pull the grip through a part. A point of the first element (theta 0): the
+  // held end has no element before it.
+  void HeldNode(int p, const PartModel& part) {
+    const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
+    PartDistance at = part.geometry.Distance(x_[0], Entry(p, 0));
+    Clear(0, at.distance_m);
+    if (at.distance_m - r1 >= eps) return;
+    MaterialPoint mp = Material(Carrier::kElement, x_, 0, 0.0, Vec3::Zero(), true);
+    at.distance_m -= r1;
+    mp.offset_W = -r1 * at.normal_W;
+    mp.point_W += mp.offset_W;
+    Record(SampleKind::kSide, p, 0, kHeldFeature, 0.0, 1.0, at, mp, Vec3::Zero());
   }
 
   void Rim(int p, const PartModel& part) {

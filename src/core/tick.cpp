@@ -22,7 +22,10 @@ bool Finite(const Eigen::Isometry3d& X) {
 bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand, Data& data) {
   data.input.t_s = t_s;
   data.input.X_W_hand = X_W_hand;
-  data.input.hand_valid = Finite(X_W_hand) && std::isfinite(t_s);
+  // A pose not finite, or farther than 1 km from the world's origin (no device's: the energies
+  // would overflow), is refused.
+  data.input.hand_valid =
+      Finite(X_W_hand) && std::isfinite(t_s) && X_W_hand.translation().norm() <= 1e3;
   if (!data.input.hand_valid) return false;
   CarriedState& st = data.state;
   Scratch& s = data.scratch;
