@@ -498,6 +498,17 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
     ReadDevice(r, d, s.device);
   if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
     ReadModel(r, m, s.model);
+  // The core keeps its elements at least r1 long (docs/core.md, "Contact points"): a count
+  // beyond that is said, with the count it uses.
+  if (s.model.elements > 0 && s.model.elements != core::ElementCount(s) && s.tube.length_m > 0.0 &&
+      s.tube.outer_radius_m > 0.0) {
+    const YAML::Node n = r.Get(r.Get(root, "model", "scene", false), "elements", "model", false);
+    r.Warning(n, "model.elements " + std::to_string(s.model.elements) +
+                     " asks for elements shorter than the tube's outer radius; the core uses " +
+                     std::to_string(core::ElementCount(s)) +
+                     " (at most length / outer_radius, so that a side's contact stays off the "
+                     "end face)");
+  }
   if (const YAML::Node h = r.Get(root, "heuristics", "scene", false); h.IsDefined())
     ReadHeuristics(r, h, s.heuristics);
   // The coupling a scene asks for must be passive on its device at its step (physics.md): an

@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <tubeplan/core/core.hpp>
+
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/scene/scene.hpp>
 
@@ -86,6 +88,17 @@ TEST_CASE("A model option that no longer chooses anything warns and loads", "[sc
         "t.yaml:12:19: warning: model.capsules has no effect: the core solves the rod and all its "
         "contacts together (model.elements sets the rod's resolution)\n");
   CHECK(loaded.scene->model.elements == 24);
+}
+
+TEST_CASE("An element count beyond the tube's length over its radius is said", "[scene]") {
+  // 150 mm over 5 mm: at most 30 elements.
+  const auto loaded = LoadSceneText(kMinimal + "model: {elements: 48}\n", "t.yaml");
+  REQUIRE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:12:19: warning: model.elements 48 asks for elements shorter than the tube's outer "
+        "radius; the core uses 30 (at most length / outer_radius, so that a side's contact stays "
+        "off the end face)\n");
+  CHECK(tubeplan::core::ElementCount(*loaded.scene) == 30);
 }
 
 TEST_CASE("A good scene gives exactly its SI values", "[scene]") {

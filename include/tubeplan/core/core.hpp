@@ -123,9 +123,9 @@ inline FormationKey KeyOf(const StepOutput& out) {
 inline constexpr int kMinElementCount = 4;
 inline constexpr int kMaxElementCount = 96;
 
-/// The rod's element count for a scene: scene.model.elements when set, else the default
-/// (docs/core.md: the count at which the shipped tubes' forces are within 1 % of the converged
-/// rod's).
+/// The rod's element count for a scene: scene.model.elements when set, else 24; at most the
+/// tube's length over its outer radius (18 for the shipped groove; `tubeplan accuracy` measures
+/// what a count costs in error, docs/accuracy.md).
 int ElementCount(const scene::Scene& scene);
 
 struct Model;
