@@ -1,5 +1,5 @@
 // `tubeplan accuracy [SCENE]`: the error of every model and setting against exact or converged
-// references, and its run time (issue 7; method in docs/accuracy.md). Times are printed, never
+// references, and its run time (method in docs/accuracy.md). Times are printed, never
 // judged.
 #include <cmath>
 #include <iomanip>
@@ -173,7 +173,7 @@ Command AddAccuracyCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<AccuracyOptions>();
   CLI::App* sub = app.add_subcommand(
       "accuracy",
-      "Error of every model and setting (linear/elastica, segmented/coupled, time step, contact "
+      "Error of every model and setting (rod or linear, element count, time step, contact "
       "stiffness and threshold) against the exact elastica and a converged reference rod, with "
       "the run time of each (docs/accuracy.md).");
   sub->add_option("scene", options->scene_path,

@@ -6,17 +6,12 @@
 // batches and reported per call; the percentiles are then over batch means, which hides single slow
 // calls inside a batch — the max column of the per-call scenarios is the honest worst case.
 //
-// The core's own cost against the machine's. On this 2-core VM the slowest ticks of a run are not
-// the core's: timing the same 20000 ticks (core.two_pcs) on two cores with the same history, 54
-// ticks of one took over 20 us and none of those did on the other (stop 26), while the slowest
-// tick of the two's minimum was 12.2 us. Interruptions of ~20-80 us a few hundred times a second
-// land on a tick with a probability proportional to its length, so they set the p99.9 of any
-// tick of a few microseconds. Each core scenario therefore steps kReplicas cores in lockstep (the
-// same scene and hand poses, hence the same state to the bit, checked by their outputs) and
-// times each; a tick's own cost is the least of its kReplicas times. The wall-clock figures of
-// the first core are reported beside it. (Its tick now runs between two other cores' ticks, with
-// their state in the caches too: measured against a single core the medians moved by 2 % at
-// most, within this VM's drift.)
+// The core's own cost against the machine's. On a shared machine the slowest ticks of a run are
+// often not the core's: interruptions of ~20-80 us a few hundred times a second land on a tick
+// with a probability proportional to its length and set the p99.9. Each core scenario therefore
+// steps kReplicas cores in lockstep (the same scene and hand poses, hence the same state to the
+// bit, checked by their outputs) and times each; a tick's own cost is the least of its kReplicas
+// times. The wall-clock figures of the first core are reported beside it.
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -379,8 +374,7 @@ int RunBench(const BenchOptions& o, Streams io) {
     const bool median_met = f.median_s < scenario.target_s;
     const bool p999_met = f.own_p999_s < scenario.target_p999_s;
     if (o.json) {
-      // Field names follow the core's benchmark schema (issue 3): microseconds, and ticks_per_s
-      // meaning calls per second at the median.
+      // Times in microseconds; ticks_per_s means calls per second at the median.
       nlohmann::json entry = {{"name", scenario.name},
                               {"what", scenario.what},
                               {"calls_per_sample", scenario.calls_per_sample},

@@ -312,7 +312,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     } else {
       html.graph_note =
           "Not included: add --html-graph to explore each scene's contact-state graph with the "
-          "core (about 5 s a scene on two cores) and draw it here with this run's verdicts.";
+          "core (its default exploration: minutes a scene) and draw it here with this run's verdicts.";
     }
     std::vector<HtmlPlan> pages;
     for (std::size_t i = 0; i < results.size(); ++i)
@@ -438,9 +438,10 @@ std::optional<ShardReport> ReadShardReport(const std::string& path, std::ostream
   const int version = report["tubeplan_evaluate"].get<int>();
   if (version != kEvaluateJsonVersion) {
     err << path << ": error: a report of version " << version
-        << (version < kEvaluateJsonVersion
-                ? ", which does not say which shard of which plan set it holds; expected version "
-                : ", expected version ")
+        << (version < 2 ? ", which does not say which shard of which plan set it holds; expected "
+                          "version "
+            : version < kEvaluateJsonVersion ? ", made by an earlier core; expected version "
+                                             : ", expected version ")
         << kEvaluateJsonVersion << ": evaluate the shard again with this tubeplan\n";
     return std::nullopt;
   }

@@ -63,7 +63,7 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   std::vector<graph::ReplayedPlan> plans;
   bool ok =
       text && !report.is_discarded() && report.is_object() &&
-      (report.value("tubeplan_evaluate", 0) == 1 || report.value("tubeplan_evaluate", 0) == 2) &&
+      report.value("tubeplan_evaluate", 0) >= 1 && report.value("tubeplan_evaluate", 0) <= 3 &&
       report.contains("plans") && report["plans"].is_array();
   for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
     const nlohmann::json& p = report["plans"][i];
@@ -286,7 +286,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
   bool first = true;
   for (const auto& [kind, n] : kinds) t << (first ? "" : ", ") << n << " " << kind, first = false;
   t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined, " << g.held_back
-    << " motions ended where the tube was held back from going through a part; " << g.seconds
+    << " motions ended where the coupling reached the device's force (the tube no longer followed the hand); " << g.seconds
     << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
   t << "saturation (motions: nodes/arcs):";
   const std::size_t every = std::max<std::size_t>(1, g.saturation.size() / 12);

@@ -13,8 +13,9 @@
 
 namespace tubeplan::cli {
 
-/// Version 2 added the plan set and the shard a report covers (`plan_set`, `shard`).
-inline constexpr int kEvaluateJsonVersion = 2;
+/// Version 2 added the plan set and the shard a report covers (`plan_set`, `shard`); version 3
+/// has the implicit core's flag times (`fault_s`, `beyond_linear_s`, `unconverged_s`).
+inline constexpr int kEvaluateJsonVersion = 3;
 
 /// What a report covers: shard `shard_index` of `shard_count` of one plan set, named by
 /// PlanSetId of its plans' canonical paths (`plan_set_plans` plans in the whole set). An

@@ -232,8 +232,7 @@ void OpenIGTLinkDevice::Receive() {
         return false;
       } else if (errno == ECONNRESET) {
         // A peer that closes with our wrenches still unread in its buffer resets the connection
-        // instead of ending it (RFC 1122, 4.2.2.13): the same hang-up, seen as an error (the
-        // hang-up test failed on it once, in the sanitizer build of a fresh clone, stop 35).
+        // instead of ending it (RFC 1122, 4.2.2.13): the same hang-up, seen as an error.
         if (!stopping_.load())
           FailLink("the bridge closed the connection (reset: it closed with our data unread)");
         return false;

@@ -106,7 +106,7 @@ struct MotionResult {
   std::vector<Change> changes;
   long ticks = 0;
   int refinements = 0;
-  bool held_back = false;  // cut where the core held the tube back from going through a part
+  bool held_back = false;  // cut where the coupling reached the device's force
   bool timed_out = false;  // stopped by the time limit before its end: not a result
   // Per stay: the run's point at or before its witness, from which its CF's probe can start,
   // kept for the first stay of each CF (refined or not) that could become that probe's start

@@ -19,7 +19,7 @@ using testing::SourcePath;
 
 // A shard report as `evaluate --shard I/N --report` writes it, with one feasible plan per file.
 std::string Shard(const std::string& name, const std::string& set, long set_plans, int index,
-                  int count, const std::vector<std::string>& files, int version = 2) {
+                  int count, const std::vector<std::string>& files, int version = 3) {
   nlohmann::json plans = nlohmann::json::array();
   for (const std::string& f : files)
     plans.push_back(

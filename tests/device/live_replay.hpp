@@ -1,6 +1,6 @@
 #pragma once
 // What the live tests share: the shipped insertion plan, and the check that `evaluate` of a live
-// run's recording gives the live run's verdicts (issue 6: batch and live judge the same ticks).
+// run's recording gives the live run's verdicts (batch and live judge the same ticks).
 #include <filesystem>
 #include <sstream>
 #include <string>

@@ -1,5 +1,5 @@
 #pragma once
-// A reference solver for the accuracy study (issue 7), independent of the core's method: a planar,
+// A reference solver for the accuracy study, independent of the core's method: a planar,
 // inextensible Kirchhoff rod (the elastica) discretised into N straight segments whose angles are
 // the unknowns, with the held end on the coupling spring, dead tip loads and penalty contacts
 // against planes and edges, solved to convergence by Newton's method. It is slow (dense Newton,
