@@ -509,6 +509,21 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
                      " (at most length / outer_radius, so that a side's contact stays off the "
                      "end face)");
   }
+  // The penalty's force at a part's middle, K (eps + half its thickness): below the device's
+  // force, a full push can carry the tube out the part's far side.
+  for (const scene::BoxPart& part : s.parts) {
+    const double hold_N = s.contact.stiffness_N_per_m *
+                          (s.contact.threshold_m + 0.5 * part.size_m.minCoeff());
+    if (!(hold_N < s.device.max_force_N) || part.size_m.minCoeff() <= 0.0) continue;
+    std::ostringstream m;
+    m << "part " << part.name << " is " << part.size_m.minCoeff() * 1e3
+      << " mm thin: the contact holds K (eps + half of it) = " << hold_N
+      << " N at its middle, less than the device's " << s.device.max_force_N
+      << " N, so a full push can carry the tube through it; expected a thicker part or a stiffer "
+         "contact";
+    r.Warning(r.Get(root, "contact", "scene", false), m.str());
+    break;
+  }
   if (const YAML::Node h = r.Get(root, "heuristics", "scene", false); h.IsDefined())
     ReadHeuristics(r, h, s.heuristics);
   // The coupling a scene asks for must be passive on its device at its step (physics.md): an

@@ -369,6 +369,17 @@ std::vector<StabilityCase> StabilityCases(bool quick) {
         why += Fmt("penalty too soft: the device's %.3g N presses %.3g m in, more than r1; ",
                    c.scene.device.max_force_N,
                    c.scene.device.max_force_N / c.scene.contact.stiffness_N_per_m);
+      // The penalty's force at a part's middle, K (eps + half its thickness): below the
+      // device's force, a full push carries the tube past the middle and out the far side.
+      double thinnest_m = std::numeric_limits<double>::infinity();
+      for (const scene::BoxPart& part : c.scene.parts)
+        thinnest_m = std::min(thinnest_m, part.size_m.minCoeff());
+      const double hold_N =
+          c.scene.contact.stiffness_N_per_m * (c.scene.contact.threshold_m + 0.5 * thinnest_m);
+      if (std::isfinite(thinnest_m) && hold_N < c.scene.device.max_force_N)
+        why += Fmt("penalty too soft for a %.3g m part: K (eps + half its thickness) = %.3g N, "
+                   "below the device's %.3g N; ",
+                   thinnest_m, hold_N, c.scene.device.max_force_N);
       if (c.scene.contact.threshold_m >= t.outer_radius_m)
         why += "eps >= r1: the contact band is wider than the tube; ";
       if (t.inner_radius_m > 0.95 * t.outer_radius_m)
@@ -425,7 +436,8 @@ Verdict Judge(const StabilityCase& c, const Run& first, int bits, int outside_fr
       {"friction bound", first.fail_friction, first.why_friction, false},
       {"passivity", first.fail_passive, first.why_passive, false},
       // Going through a wall is never acceptable, unless the penalty is too soft to stop the
-      // device's force within the tube's radius (then it is the scene's choice, warned about).
+      // device's force within the tube's radius or the part's middle (then it is the scene's
+      // choice, warned about).
       {"no tunnelling", first.fail_tunnel, first.why_tunnel,
        c.outside_validity.find("penalty too soft") == std::string::npos},
   };
