@@ -366,6 +366,32 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   CHECK_THAT(none.err, Catch::Contains("core.nothing") && Catch::Contains("core.free"));
 }
 
+TEST_CASE("stability: the fast passes hold, or say why the scene cannot", "[cli][stability]") {
+  // A tube pushed at 2 m/s at a 1 mm wall in every variant of the sweep: none goes through,
+  // except where the penalty cannot hold the device's force before the wall's middle, which is
+  // named as outside the model's validity (K = 10 N/mm at eps = 10 um: 5.1 N < 8.5 N).
+  const Outcome r = RunTool({"stability", "--quick", "--only", "fast pass", "--json"});
+  INFO(r.err);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json doc = nlohmann::json::parse(r.out);
+  REQUIRE(doc["cases"].size() >= 10);
+  int outside = 0;
+  for (const nlohmann::json& c : doc["cases"]) {
+    INFO(c.dump());
+    CHECK(c["pass"] == true);
+    if (c["outside_validity"] == true) ++outside;
+    if (c["name"] == "fast pass base") {
+      CHECK(c["outside_validity"] == false);
+      CHECK(c["warning"].is_null());
+    }
+    if (c["name"] == "fast pass eps=1e-05m")
+      CHECK_THAT(c["warning"].get<std::string>(),
+                 Catch::Contains("penalty too soft for a 0.001 m part") &&
+                     Catch::Contains("no tunnelling"));
+  }
+  CHECK(outside < int(doc["cases"].size()) / 2);
+}
+
 TEST_CASE("usage: no subcommand and --version", "[cli]") {
   const std::string commands =
       "; the commands are check, beam, bench, simulate, graph, plans, evaluate, merge, live, "
