@@ -49,7 +49,8 @@ TEST_CASE("graph: bad weights and options are errors before any exploration", "[
   CHECK(r.exit_code == 2);
 }
 
-TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loads", "[cli]") {
+TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loads",
+          "[cli][explore]") {
   const std::string dir = "cli_test_plans";
   std::filesystem::remove_all(dir);
   const Outcome r = RunTool({"plans", SourcePath("scenes/groove.yaml"), "--k", "2", "--budget",

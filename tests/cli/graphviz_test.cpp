@@ -38,7 +38,7 @@ TEST_CASE("Graphviz: SVG from dot, and clear errors when dot is missing or fails
   CHECK(bad.error.find("syntax error") != std::string::npos);
 }
 
-TEST_CASE("graph --svg writes the picture Graphviz draws of the DOT", "[cli][graphviz]") {
+TEST_CASE("graph --svg writes the picture Graphviz draws of the DOT", "[cli][graphviz][explore]") {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / "tubeplan-graph-svg-test";
   std::filesystem::remove_all(dir);

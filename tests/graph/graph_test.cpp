@@ -300,7 +300,7 @@ const ContactGraph& DefaultGraph(int jobs) {
   return graphs[jobs];
 }
 
-TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit", "[graph]") {
+TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit", "[graph][explore]") {
   const scene::Scene s = Groove();
   const graph::ExploreOptions o;
   core::Core core(s), again(s);
@@ -332,7 +332,7 @@ TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit"
   }
 }
 
-TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph]") {
+TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph][explore]") {
   const scene::Scene s = ExploredScene();
   const ContactGraph& g = SmallGraph(2);
   REQUIRE(g.nodes.size() > 20);
@@ -356,7 +356,7 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
   for (const Arc& a : g.arcs) CHECK(a.witness.tick >= 1);
 }
 
-TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them", "[graph]") {
+TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them", "[graph][explore]") {
   // Probes of the second round start from stays found by probes of the first, whose runs were
   // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
   // prefix and every refinement from the motion's start (an independent path to the same bits).
@@ -402,7 +402,7 @@ TEST_CASE("Resuming runs from snapshots explores the same graph as replaying the
   CHECK(resumed.ticks < replayed.ticks);
 }
 
-TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph]") {
+TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph][explore]") {
   const ContactGraph& one = DefaultGraph(1);
   const ContactGraph& two = DefaultGraph(2);
   // Saturated within the default budget: every node probed, the last round found no new one.
@@ -432,7 +432,7 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
   CHECK(one.ticks == two.ticks);
 }
 
-TEST_CASE("Independent random motions stay inside the explored graph", "[graph]") {
+TEST_CASE("Independent random motions stay inside the explored graph", "[graph][explore]") {
   // Motions from another seed, run through the core and debounced here on their own (a CF
   // counts after the same 20 ms dwell), against the graph explored with the default options.
   const scene::Scene s = ExploredScene();
@@ -551,7 +551,7 @@ void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
 
 }  // namespace
 
-TEST_CASE("The budget bounds the motions exactly, the same on any number of threads", "[graph]") {
+TEST_CASE("The budget bounds the motions exactly, the same on any number of threads", "[graph][explore]") {
   // The groove's sweeps are 14 motions: a budget of 1 cuts them, one of 20 cuts the aims.
   for (const int budget : {1, 20}) {
     graph::ExploreOptions o;
@@ -569,7 +569,7 @@ TEST_CASE("The budget bounds the motions exactly, the same on any number of thre
   }
 }
 
-TEST_CASE("A tiny tube's exploration ends within its budget", "[graph]") {
+TEST_CASE("A tiny tube's exploration ends within its budget", "[graph][explore]") {
   // A 0.1 mm tube, 1 mm long, on the groove: its sweeps alone are 1202 motions (offsets a
   // radius apart across 60 mm), which a budget of 3 used not to bound.
   scene::Scene tiny = Groove();
@@ -585,7 +585,7 @@ TEST_CASE("A tiny tube's exploration ends within its budget", "[graph]") {
   CHECK(g.seconds < 20.0);
 }
 
-TEST_CASE("The time limit stops exploring; the graph is the one of the motions kept", "[graph]") {
+TEST_CASE("The time limit stops exploring; the graph is the one of the motions kept", "[graph][explore]") {
   graph::ExploreOptions o;
   o.jobs = 2;
   o.time_limit_s = 0.5;
