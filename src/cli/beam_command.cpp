@@ -46,8 +46,8 @@ int RunBeam(const BeamOptions& o, Streams io) {
     spec = loaded.scene->tube;
     // The rod's large-deflection limit is the elastica.
     beam_model = loaded.scene->model.tube == scene::TubeModel::kLinear
-                      ? model::BeamModel::kLinear
-                      : model::BeamModel::kElastica;
+                     ? model::BeamModel::kLinear
+                     : model::BeamModel::kElastica;
   }
   std::vector<std::string> errors;
   auto quantity = [&](const std::string& text, const char* option, io::Dimension dim,

@@ -312,7 +312,8 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     } else {
       html.graph_note =
           "Not included: add --html-graph to explore each scene's contact-state graph with the "
-          "core (its default exploration: minutes a scene) and draw it here with this run's verdicts.";
+          "core (its default exploration: minutes a scene) and draw it here with this run's "
+          "verdicts.";
     }
     std::vector<HtmlPlan> pages;
     for (std::size_t i = 0; i < results.size(); ++i)

@@ -61,10 +61,10 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   const nlohmann::json report =
       text ? nlohmann::json::parse(*text, nullptr, false) : nlohmann::json();
   std::vector<graph::ReplayedPlan> plans;
-  bool ok =
-      text && !report.is_discarded() && report.is_object() &&
-      report.value("tubeplan_evaluate", 0) >= 1 && report.value("tubeplan_evaluate", 0) <= 3 &&
-      report.contains("plans") && report["plans"].is_array();
+  bool ok = text && !report.is_discarded() && report.is_object() &&
+            report.value("tubeplan_evaluate", 0) >= 1 &&
+            report.value("tubeplan_evaluate", 0) <= 3 && report.contains("plans") &&
+            report["plans"].is_array();
   for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
     const nlohmann::json& p = report["plans"][i];
     graph::ReplayedPlan r;
@@ -286,8 +286,9 @@ int RunGraph(const GraphOptions& o, Streams io) {
   bool first = true;
   for (const auto& [kind, n] : kinds) t << (first ? "" : ", ") << n << " " << kind, first = false;
   t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined, " << g.held_back
-    << " motions ended where the coupling reached the device's force (the tube no longer followed the hand); " << g.seconds
-    << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
+    << " motions ended where the coupling reached the device's force (the tube no longer followed "
+       "the hand); "
+    << g.seconds << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
   t << "saturation (motions: nodes/arcs):";
   const std::size_t every = std::max<std::size_t>(1, g.saturation.size() / 12);
   for (std::size_t i = 0; i < g.saturation.size(); ++i) {

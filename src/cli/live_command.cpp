@@ -221,7 +221,7 @@ class Display {
     std::ostringstream line;
     line << std::fixed << std::setprecision(2);
     line << "t " << std::setw(6) << s.t_s << " s  CF " << judging.current() << "  next "
-         << (at < n          ? judging.states()[at + 1]
+         << (at < n         ? judging.states()[at + 1]
              : failed_after ? std::string("(goal reached, then infeasible)")
                             : std::string("(goal reached)"))
          << "\n";

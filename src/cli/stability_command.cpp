@@ -80,8 +80,8 @@ int ReportStability(std::span<const study::StabilityResult> results, bool json, 
           // "outside": beyond the model's validity; "snaps": some ticks' solves stopped short
           // of their tolerance (the tube snapping through, or the hand jumping).
           std::string notes;
-          for (const auto& [on, note] : {std::pair{r.outside, "outside"},
-                                         std::pair{r.unconverged_ticks > 0, "snaps"}})
+          for (const auto& [on, note] :
+               {std::pair{r.outside, "outside"}, std::pair{r.unconverged_ticks > 0, "snaps"}})
             if (on) notes += (notes.empty() ? "" : ", ") + std::string(note);
           text = (r.pass ? "pass" : "FAIL @" + std::to_string(r.first_failing_tick)) +
                  (notes.empty() ? "" : " (" + notes + ")");

@@ -148,7 +148,8 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   for (int j = 1; j < count; ++j) d_min = std::min(d_min, s[j].distance_m);
   double sum = 0.0;
   std::array<double, kRimSamples> w{};
-  for (int j = 0; j < count; ++j) sum += (w[std::size_t(j)] = std::exp(-(s[j].distance_m - d_min) / tau));
+  for (int j = 0; j < count; ++j)
+    sum += (w[std::size_t(j)] = std::exp(-(s[j].distance_m - d_min) / tau));
   for (int j = 0; j < count; ++j) w[std::size_t(j)] /= sum;
   const double d = d_min - tau * std::log(sum);
   for (int j = 0; j < count; ++j) s[j].contact_distance_m = d;

@@ -50,8 +50,8 @@ double ArcOf(const Model& model, const Sample& s) {
 // a is a boundary element of b, or the same: the rim bounds the end face and the side; on a part,
 // an edge bounds its faces and a vertex its edges and faces.
 bool TubeWithin(TubeElement a, TubeElement b) {
-  return a == b || (a == TubeElement::kEndRim &&
-                    (b == TubeElement::kEndFace || b == TubeElement::kSide));
+  return a == b ||
+         (a == TubeElement::kEndRim && (b == TubeElement::kEndFace || b == TubeElement::kSide));
 }
 bool PartWithin(std::uint8_t a, std::uint8_t b) { return (a & b) == b; }
 
@@ -216,16 +216,18 @@ void Classify(const Model& model, Data& data) {
   int kept_count = 0;
   for (int i = 0; i < count; ++i)
     if (g[std::size_t(i)].merged_into < 0) kept[std::size_t(kept_count++)] = &g[std::size_t(i)].pc;
-  std::sort(kept.begin(), kept.begin() + kept_count,
-            [](const ContactState* a, const ContactState* b) { return a->distance_m < b->distance_m; });
+  std::sort(
+      kept.begin(), kept.begin() + kept_count,
+      [](const ContactState* a, const ContactState* b) { return a->distance_m < b->distance_m; });
   if (kept_count > kMaxContacts) {
     truncated = true;
     kept_count = kMaxContacts;
   }
-  std::sort(kept.begin(), kept.begin() + kept_count, [](const ContactState* a, const ContactState* b) {
-    if (a->tube != b->tube) return a->tube < b->tube;
-    return a->part_element < b->part_element;
-  });
+  std::sort(kept.begin(), kept.begin() + kept_count,
+            [](const ContactState* a, const ContactState* b) {
+              if (a->tube != b->tube) return a->tube < b->tube;
+              return a->part_element < b->part_element;
+            });
   out.contact_count = kept_count;
   for (int i = 0; i < kept_count; ++i) out.contacts[std::size_t(i)] = *kept[std::size_t(i)];
   if (truncated) out.flags |= kContactsTruncated;

@@ -14,8 +14,8 @@ using Vec3 = Eigen::Vector3d;
 
 // Closest points of segments [p0, p1] and [q0, q1]: parameters (s, u) in [0, 1] (Ericson,
 // Real-Time Collision Detection, 5.1.9).
-void ClosestSegmentPoints(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1,
-                          double& s, double& u) {
+void ClosestSegmentPoints(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s,
+                          double& u) {
   const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   const double c = d1.dot(r), b = d1.dot(d2);

@@ -1,8 +1,8 @@
-#include <tubeplan/core/core.hpp>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
+
+#include <tubeplan/core/core.hpp>
 
 #if defined(__SSE__)
 #include <xmmintrin.h>
@@ -11,11 +11,11 @@
 #include <tubeplan/core/coupling.hpp>
 #include <tubeplan/model/tube.hpp>
 
+#include "core/classify.hpp"
 #include "core/data.hpp"
 #include "core/model.hpp"
 #include "core/solve.hpp"
 #include "core/stick_slip.hpp"
-#include "core/classify.hpp"
 #include "core/tick.hpp"
 
 namespace tubeplan::core {

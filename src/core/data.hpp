@@ -41,18 +41,18 @@ struct Sample {
   Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
   int weight_first = 0;
   int weight_nodes = 0;
-  double distance_m = 0.0;     ///< signed distance d of the point to the part
+  double distance_m = 0.0;  ///< signed distance d of the point to the part
   /// The distance its contact presses by: its own, or for the rim's points on one part their
   /// smooth minimum (Assemble), so that every contact's force is K (eps - this).
   double contact_distance_m = 0.0;
-  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< from the part into the tube
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();        ///< from the part into the tube
   Eigen::Matrix3d curvature_per_m = Eigen::Matrix3d::Zero();  ///< d2 distance / d point2
-  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();    ///< on the tube's surface
-  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();   ///< from the centreline to the point
+  Eigen::Vector3d point_W = Eigen::Vector3d::Zero();          ///< on the tube's surface
+  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();         ///< from the centreline to the point
   Eigen::Vector3d moving_offset_W = Eigen::Vector3d::Zero();
   double normal_force_N = 0.0;
   Eigen::Vector3d friction_W_N = Eigen::Vector3d::Zero();  ///< on the tube
-  double friction_ratio = 0.0;   ///< |friction| / its static limit
+  double friction_ratio = 0.0;                             ///< |friction| / its static limit
   double static_limit_N = 0.0;
   double friction_work_J = 0.0;  ///< dissipated this tick
   bool sliding = false;
@@ -80,13 +80,13 @@ struct FrictionPoint {
   int node = 0;
   int feature = 0;
   double theta = 0.0;
-  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();  ///< material offset at the tick's start
-  Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();  ///< where the spring holds the point
-  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ(); ///< tangent plane of the tick
+  Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();   ///< material offset at the tick's start
+  Eigen::Vector3d anchor_W = Eigen::Vector3d::Zero();   ///< where the spring holds the point
+  Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();  ///< tangent plane of the tick
   double limit_N = 0.0;   ///< the force its spring carries at most this pass (static or kinetic)
   double normal_N = 0.0;  ///< its normal force when the limit was set
   bool sliding = false;
-  int sample = -1;        ///< the contact point that carries it this pass, -1 for none
+  int sample = -1;  ///< the contact point that carries it this pass, -1 for none
 };
 
 inline constexpr int kMaxSamples = 512;
@@ -94,7 +94,7 @@ inline constexpr int kMaxFrictionPoints = 256;
 
 /// What a tick carries to the next: the rod, the held end, the hand, friction.
 struct CarriedState {
-  std::vector<Eigen::Vector3d> x_W;  ///< nodes 0..N [m]
+  std::vector<Eigen::Vector3d> x_W;                    ///< nodes 0..N [m]
   Eigen::Matrix3d R_WH = Eigen::Matrix3d::Identity();  ///< the held end's orientation
   Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();

@@ -20,14 +20,14 @@ inline constexpr int kRimSamples = 8;
 inline constexpr double kRimSoftness = 2e-4;
 
 struct RodModel {
-  int elements = 0;                   ///< N segments, N + 1 nodes
-  double length_m = 0.0;              ///< l
-  double segment_m = 0.0;             ///< rest length l / N
-  double outer_radius_m = 0.0;        ///< r1
-  double inner_radius_m = 0.0;        ///< r2
-  double bending_stiffness_Nm2 = 0.0; ///< EI
-  double stretch_stiffness_N = 0.0;   ///< the axial stiffness EA the rod is given [N]
-  bool linear = false;                ///< the paper's small-deflection beam instead of the rod
+  int elements = 0;                    ///< N segments, N + 1 nodes
+  double length_m = 0.0;               ///< l
+  double segment_m = 0.0;              ///< rest length l / N
+  double outer_radius_m = 0.0;         ///< r1
+  double inner_radius_m = 0.0;         ///< r2
+  double bending_stiffness_Nm2 = 0.0;  ///< EI
+  double stretch_stiffness_N = 0.0;    ///< the axial stiffness EA the rod is given [N]
+  bool linear = false;                 ///< the paper's small-deflection beam instead of the rod
 };
 
 struct ContactModel {
@@ -45,9 +45,9 @@ struct CouplingModel {
 };
 
 struct SolverModel {
-  int max_iterations = 0;      ///< Newton iterations a tick at most
-  double tolerance_N = 0.0;    ///< converged when no generalised force exceeds it
-  double step_cap_m = 0.0;     ///< no point moves farther than this in one iteration
+  int max_iterations = 0;    ///< Newton iterations a tick at most
+  double tolerance_N = 0.0;  ///< converged when no generalised force exceeds it
+  double step_cap_m = 0.0;   ///< no point moves farther than this in one iteration
 };
 
 struct PartModel {

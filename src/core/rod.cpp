@@ -15,8 +15,8 @@ Mat3 UnitDerivative(const Vec3& a, double length) {
 }
 
 // Maps a Hessian over the element vectors (e, f) = (x1 - x0, x2 - x1) to the three nodes.
-void EdgesToNodes(const Mat3& hee, const Mat3& hef, const Mat3& hff, const Vec3& ge,
-                  const Vec3& gf, StencilTerm& term) {
+void EdgesToNodes(const Mat3& hee, const Mat3& hef, const Mat3& hff, const Vec3& ge, const Vec3& gf,
+                  StencilTerm& term) {
   term.nodes = 3;
   term.gradient.segment<3>(0) = -ge;
   term.gradient.segment<3>(3) = ge - gf;
@@ -113,8 +113,8 @@ double StretchEnergy(const RodModel& rod, std::span<const Vec3> x_W, int i, Sten
   return 0.5 * k * strain_m * strain_m;
 }
 
-double LinearBendingEnergy(const RodModel& rod, const Mat3& R_WH, std::span<const Vec3> x_W,
-                           int i, StencilTerm* term) {
+double LinearBendingEnergy(const RodModel& rod, const Mat3& R_WH, std::span<const Vec3> x_W, int i,
+                           StencilTerm* term) {
   const double h = rod.segment_m;
   const double c = rod.bending_stiffness_Nm2 / (h * h * h);
   // Lateral projector of the held frame: the beam bends in its x and y only.
@@ -135,7 +135,8 @@ double LinearBendingEnergy(const RodModel& rod, const Mat3& R_WH, std::span<cons
     }
     return c * b.squaredNorm();
   }
-  const Vec3 b = P * (x_W[std::size_t(i + 1)] - 2.0 * x_W[std::size_t(i)] + x_W[std::size_t(i - 1)]);
+  const Vec3 b =
+      P * (x_W[std::size_t(i + 1)] - 2.0 * x_W[std::size_t(i)] + x_W[std::size_t(i - 1)]);
   if (term != nullptr) {
     term->first = i - 1;
     term->nodes = 3;

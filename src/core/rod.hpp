@@ -14,8 +14,8 @@ namespace tubeplan::core {
 /// An energy term's gradient and Hessian over a stencil of up to three consecutive nodes.
 /// Only the first 3 `nodes` rows and columns are read, and each term writes them all.
 struct StencilTerm {
-  int first = 0;      ///< the stencil's first node
-  int nodes = 0;      ///< 1, 2 or 3
+  int first = 0;             ///< the stencil's first node
+  int nodes = 0;             ///< 1, 2 or 3
   bool with_hessian = true;  ///< whether the term is asked for its Hessian too
   Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
   Eigen::Matrix<double, 9, 9> hessian = Eigen::Matrix<double, 9, 9>::Zero();

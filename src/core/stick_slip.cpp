@@ -51,8 +51,7 @@ void Match(const Model& model, Data& data) {
     for (int f = 0; f < st.friction_count; ++f) {
       const FrictionPoint& fp = st.friction[std::size_t(f)];
       if (fp.sample >= 0 || fp.part != smp.part) continue;
-      const double d_m =
-          (FrictionMaterial(model, fp, st.x_W).point_W - smp.point_W).norm();
+      const double d_m = (FrictionMaterial(model, fp, st.x_W).point_W - smp.point_W).norm();
       if (d_m < best_m) {
         best_m = d_m;
         best = f;

@@ -106,8 +106,9 @@ void WriteOutput(const Model& model, Data& data) {
   // Curvature: each node's turn over an element's length; the grip's over half of one.
   double turn = 0.0;
   for (int i = 0; i < model.rod.elements; ++i) {
-    const Vec3 a = i == 0 ? data.input.tangent_held_W
-                          : Vec3((st.x_W[std::size_t(i)] - st.x_W[std::size_t(i - 1)]).normalized());
+    const Vec3 a = i == 0
+                       ? data.input.tangent_held_W
+                       : Vec3((st.x_W[std::size_t(i)] - st.x_W[std::size_t(i - 1)]).normalized());
     const Vec3 b = (st.x_W[std::size_t(i + 1)] - st.x_W[std::size_t(i)]).normalized();
     turn = std::max(turn, (i == 0 ? 2.0 : 1.0) * std::atan2(a.cross(b).norm(), a.dot(b)));
   }

@@ -931,7 +931,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     for (std::size_t e = 0; e < probe.elements().size(); ++e)
       if (in_goal.contains(probe.elements()[e].name)) unseen.push_back(static_cast<int>(e));
     for (std::size_t e = 0; e < probe.elements().size(); ++e)
-      if (!reached.contains(probe.elements()[e].name) && !in_goal.contains(probe.elements()[e].name))
+      if (!reached.contains(probe.elements()[e].name) &&
+          !in_goal.contains(probe.elements()[e].name))
         unseen.push_back(static_cast<int>(e));
     phase = "aims";
     run(Aims(scene, probe, unseen, o), {});

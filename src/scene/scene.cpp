@@ -2,9 +2,7 @@
 
 namespace tubeplan::scene {
 
-const char* ToString(TubeModel model) {
-  return model == TubeModel::kLinear ? "linear" : "rod";
-}
+const char* ToString(TubeModel model) { return model == TubeModel::kLinear ? "linear" : "rod"; }
 
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index) {
   const auto& own = scene.parts.at(part_index).friction;

@@ -73,8 +73,8 @@ void TipLoadRows(const scene::Scene& base, const AccuracyOptions& options, Accur
       row.scenario = scenario;
       row.time_us = time_us;
       // The rod's limit, as elements are added, is the elastica.
-      row.is_default = (m == model::BeamModel::kLinear) ==
-                       (base.model.tube == scene::TubeModel::kLinear);
+      row.is_default =
+          (m == model::BeamModel::kLinear) == (base.model.tube == scene::TubeModel::kLinear);
       if (m == model::BeamModel::kLinear) {
         // Against the exact elastica (closed form).
         const TipError e =
@@ -380,7 +380,8 @@ struct Setting {
 };
 
 std::string SettingName(const Setting& s, const scene::Scene& base, int elements) {
-  std::string name = Fmt("%s N=%d", scene::ToString(s.tube), s.elements > 0 ? s.elements : elements);
+  std::string name =
+      Fmt("%s N=%d", scene::ToString(s.tube), s.elements > 0 ? s.elements : elements);
   if (s.dt_s != base.model.time_step_s) name += Fmt(" dt=%gms", s.dt_s * 1e3);
   if (s.K != base.contact.stiffness_N_per_m || s.vs_rigid) name += Fmt(" K=%gN/m", s.K);
   if (s.eps != base.contact.threshold_m || s.vs_rigid) name += Fmt(" eps=%gmm", s.eps * 1e3);
@@ -450,13 +451,12 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
     if (n != report.elements && core::ElementCount(asked) == n)
       settings.push_back({"", scene::TubeModel::kRod, n, dt0, K0, eps0});
   }
-  settings.push_back({"", own == scene::TubeModel::kRod ? scene::TubeModel::kLinear
-                                                        : scene::TubeModel::kRod,
-                      0, dt0, K0, eps0});
+  settings.push_back(
+      {"", own == scene::TubeModel::kRod ? scene::TubeModel::kLinear : scene::TubeModel::kRod, 0,
+       dt0, K0, eps0});
   settings.push_back({"", own, 0, dt0 / 4, K0, eps0});
   for (const double k : {0.1, 1.0, 10.0})
-    for (const double e : {0.1, 1.0})
-      settings.push_back({"", own, 0, dt0, k * K0, e * eps0, true});
+    for (const double e : {0.1, 1.0}) settings.push_back({"", own, 0, dt0, k * K0, e * eps0, true});
   for (Setting& s : settings) s.name = SettingName(s, base, report.elements);
 
   for (const Scenario& sc : scenarios) {

@@ -143,7 +143,7 @@ struct Run {
   // First failing tick of each check (-1: never) and what it saw there.
   int fail_finite = -1, fail_force = -1, fail_law = -1, fail_friction = -1, fail_passive = -1,
       fail_tunnel = -1, fail_fault = -1;
-  int beyond_linear = -1;         // first tick the linear shape was beyond its range (not a check)
+  int beyond_linear = -1;  // first tick the linear shape was beyond its range (not a check)
   int unconverged = 0, first_unconverged = -1;  // ticks the solve stopped short (not a check)
   std::string why_force, why_law, why_friction, why_passive, why_tunnel;
   double work_J = 0.0, stored_J = 0.0, initial_J = 0.0;
@@ -215,7 +215,8 @@ Run Drive(const StabilityCase& c, bool check) {
              Fmt("friction %.4g N beyond its limit %.4g N", pc.friction_W_N.norm(),
                  pc.friction_limit_N));
       // Lower bound of the penalty energy: n springs sharing N hold at least N^2 / (2 n K).
-      contact_energy_J += pc.normal_force_N * pc.normal_force_N / (2.0 * std::max(1, pc.points) * K);
+      contact_energy_J +=
+          pc.normal_force_N * pc.normal_force_N / (2.0 * std::max(1, pc.points) * K);
     }
     // Passivity: what tube, proxy, contacts and coupling hold (a lower bound) never exceeds the
     // work the hand did on them. The hand pushes with -F; the work over the tick is integrated by
@@ -377,9 +378,10 @@ std::vector<StabilityCase> StabilityCases(bool quick) {
       const double hold_N =
           c.scene.contact.stiffness_N_per_m * (c.scene.contact.threshold_m + 0.5 * thinnest_m);
       if (std::isfinite(thinnest_m) && hold_N < c.scene.device.max_force_N)
-        why += Fmt("penalty too soft for a %.3g m part: K (eps + half its thickness) = %.3g N, "
-                   "below the device's %.3g N; ",
-                   thinnest_m, hold_N, c.scene.device.max_force_N);
+        why +=
+            Fmt("penalty too soft for a %.3g m part: K (eps + half its thickness) = %.3g N, "
+                "below the device's %.3g N; ",
+                thinnest_m, hold_N, c.scene.device.max_force_N);
       if (c.scene.contact.threshold_m >= t.outer_radius_m)
         why += "eps >= r1: the contact band is wider than the tube; ";
       if (t.inner_radius_m > 0.95 * t.outer_radius_m)

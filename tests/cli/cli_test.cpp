@@ -146,7 +146,8 @@ TEST_CASE("simulate: a strain beyond the material's elastic range gets evaluate'
   double strain = 0.0;
   REQUIRE(std::sscanf(at.c_str(), "%lf", &strain) == 1);
   CHECK(strain > 0.5);
-  CHECK(r.out.find("\nwarning: strain " + at + " is beyond the tube material's elastic range "
+  CHECK(r.out.find("\nwarning: strain " + at +
+                   " is beyond the tube material's elastic range "
                    "(0.5 for E < 10 GPa)") != std::string::npos);
   const Outcome j = RunTool({"simulate", scene("10 kPa"), trajectory, "--json"});
   REQUIRE(j.exit_code == 0);

@@ -225,8 +225,8 @@ TEST_CASE("No hand motion takes the tube through a part", "[core][through]") {
         }
       }
       INFO("lowest " << lowest_m << " m, x from " << leftmost_m << " to " << rightmost_m
-                     << " m; settled: " << settled_lowest_m << ", " << settled_leftmost_m
-                     << " to " << settled_rightmost_m << " m");
+                     << " m; settled: " << settled_lowest_m << ", " << settled_leftmost_m << " to "
+                     << settled_rightmost_m << " m");
       // In every tick the tube's surface presses into a part by less than a millimetre (the
       // device's 8.5 N on K = 10 N/mm is 0.85 mm), settled or not.
       CHECK(lowest_m > s.tube.outer_radius_m - 1e-3);

@@ -49,7 +49,8 @@ scene::BoxPart Box(const std::string& name, Eigen::Vector3d size, Eigen::Vector3
 // The held end at p with the tube pointing along `axis` (a unit vector).
 Eigen::Isometry3d Held(Eigen::Vector3d p, Eigen::Vector3d axis) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-  X.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
+  X.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix();
   X.translation() = p;
   return X;
 }
@@ -142,8 +143,8 @@ TEST_CASE("A frictionless side wall at the tip: 3EI/l^3 in series, a small-defle
   scene::BoxPart wall = Box("wall", {0.02, 0.1, 0.1}, {0.0, 0.0, 0.0});
   wall.X_WP.linear() = Eigen::AngleAxisd(-lean, Eigen::Vector3d::UnitY()).toRotationMatrix();
   // Its face (x = -0.01 in its frame) through (r1 + eps / 2, 0, l).
-  wall.X_WP.translation() =
-      Eigen::Vector3d(r1 + 0.5 * eps, 0.0, l) - wall.X_WP.linear() * Eigen::Vector3d(-0.01, 0.0, 0.0);
+  wall.X_WP.translation() = Eigen::Vector3d(r1 + 0.5 * eps, 0.0, l) -
+                            wall.X_WP.linear() * Eigen::Vector3d(-0.01, 0.0, 0.0);
   s.parts.push_back(wall);
   core::Core c(s);
   const double k_tip = 3.0 * EI(s) / (l * l * l);

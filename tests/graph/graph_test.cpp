@@ -300,7 +300,8 @@ const ContactGraph& DefaultGraph(int jobs) {
   return graphs[jobs];
 }
 
-TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit", "[graph][explore]") {
+TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit",
+          "[graph][explore]") {
   const scene::Scene s = Groove();
   const graph::ExploreOptions o;
   core::Core core(s), again(s);
@@ -332,7 +333,8 @@ TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit"
   }
 }
 
-TEST_CASE("Every node's witness, replayed through the core, gives that node's CF", "[graph][explore]") {
+TEST_CASE("Every node's witness, replayed through the core, gives that node's CF",
+          "[graph][explore]") {
   const scene::Scene s = ExploredScene();
   const ContactGraph& g = SmallGraph(2);
   REQUIRE(g.nodes.size() > 20);
@@ -356,7 +358,8 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
   for (const Arc& a : g.arcs) CHECK(a.witness.tick >= 1);
 }
 
-TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them", "[graph][explore]") {
+TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them",
+          "[graph][explore]") {
   // Probes of the second round start from stays found by probes of the first, whose runs were
   // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
   // prefix and every refinement from the motion's start (an independent path to the same bits).
@@ -402,7 +405,8 @@ TEST_CASE("Resuming runs from snapshots explores the same graph as replaying the
   CHECK(resumed.ticks < replayed.ticks);
 }
 
-TEST_CASE("The default exploration saturates, the same from one thread and from two", "[graph][explore]") {
+TEST_CASE("The default exploration saturates, the same from one thread and from two",
+          "[graph][explore]") {
   const ContactGraph& one = DefaultGraph(1);
   const ContactGraph& two = DefaultGraph(2);
   // Saturated within the default budget: every node probed, the last round found no new one.
@@ -551,7 +555,8 @@ void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
 
 }  // namespace
 
-TEST_CASE("The budget bounds the motions exactly, the same on any number of threads", "[graph][explore]") {
+TEST_CASE("The budget bounds the motions exactly, the same on any number of threads",
+          "[graph][explore]") {
   // The groove's sweeps are 14 motions: a budget of 1 cuts them, one of 20 cuts the aims.
   for (const int budget : {1, 20}) {
     graph::ExploreOptions o;
@@ -585,7 +590,8 @@ TEST_CASE("A tiny tube's exploration ends within its budget", "[graph][explore]"
   CHECK(g.seconds < 20.0);
 }
 
-TEST_CASE("The time limit stops exploring; the graph is the one of the motions kept", "[graph][explore]") {
+TEST_CASE("The time limit stops exploring; the graph is the one of the motions kept",
+          "[graph][explore]") {
   graph::ExploreOptions o;
   o.jobs = 2;
   o.time_limit_s = 0.5;

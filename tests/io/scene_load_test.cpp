@@ -10,7 +10,6 @@
 #include <catch2/catch.hpp>
 
 #include <tubeplan/core/core.hpp>
-
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/scene/scene.hpp>
 
@@ -104,11 +103,13 @@ TEST_CASE("An element count beyond the tube's length over its radius is said", "
 TEST_CASE("A part too thin for the contact to hold the device's force is said", "[scene]") {
   // The wall 2 mm thick at the default contact (K = 10 N/mm, eps = 1 mm): 10 N/mm x 2 mm = 20 N
   // holds the device's 8.5 N; at eps = 0.1 mm and K = 5 N/mm, 5 x 1.1 = 5.5 N does not.
-  const std::string thin = WithLine(9, "    box: {size: [2 mm, 200 mm, 20 mm], position: [15 mm, 0, 10 mm]}");
+  const std::string thin =
+      WithLine(9, "    box: {size: [2 mm, 200 mm, 20 mm], position: [15 mm, 0, 10 mm]}");
   const auto held = LoadSceneText(thin, "t.yaml");
   REQUIRE(held.scene);
   CHECK(held.diagnostics.FormatAll() == "");
-  const auto soft = LoadSceneText(thin + "contact: {stiffness: 5 N/mm, threshold: 0.1 mm}\n", "t.yaml");
+  const auto soft =
+      LoadSceneText(thin + "contact: {stiffness: 5 N/mm, threshold: 0.1 mm}\n", "t.yaml");
   REQUIRE(soft.scene);
   CHECK(soft.diagnostics.FormatAll() ==
         "t.yaml:12:10: warning: part wall is 2 mm thin: the contact holds K (eps + half of it) = "

@@ -41,8 +41,8 @@ TEST_CASE("An output's missing directories are made; one that cannot be made is 
   // nothing was asked to be written yet, speaks of no room ("room for 0 bytes").
   std::ofstream(dir / "plain") << "a file\n";
   const std::string error = tubeplan::io::WriteTextFileAtomically(dir / "plain" / "x.txt", "");
-  CHECK_THAT(error, Catch::StartsWith("cannot create " + (dir / "plain" / "x.txt").string() +
-                                      ".tmp."));
+  CHECK_THAT(error,
+             Catch::StartsWith("cannot create " + (dir / "plain" / "x.txt").string() + ".tmp."));
   CHECK_THAT(error, Catch::EndsWith(": Not a directory; nothing was written (" +
                                     (dir / "plain" / "x.txt").string() +
                                     " is as it was), expected a writable directory"));

@@ -28,8 +28,9 @@ std::vector<std::pair<std::size_t, std::size_t>> OverlappingParts(std::span<cons
 /// `radius_m` along the held frame's +z from its origin (the held end) to `length_m` (the tip).
 /// The depth is the radius less the distance from the tube's axis to the part's piece between
 /// the ends' planes (the radius itself when the part crosses the axis); nullopt when the part
-/// does not reach into the tube by more than `tolerance_m`, sideways or past an end's plane. Exact: the piece is a convex
-/// polygon when seen along the axis, and its distance to the axis is a point-polygon distance.
+/// does not reach into the tube by more than `tolerance_m`, sideways or past an end's plane. Exact:
+/// the piece is a convex polygon when seen along the axis, and its distance to the axis is a
+/// point-polygon distance.
 std::optional<double> StraightTubeOverlap(const Eigen::Isometry3d& X_WH, double radius_m,
                                           double length_m, const BoxPart& part, double tolerance_m);
 
