@@ -509,6 +509,15 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
                      " (at most length / outer_radius, so that a side's contact stays off the "
                      "end face)");
   }
+  // A contact band as wide as the tube makes every element near a part a PC of it.
+  if (s.tube.outer_radius_m > 0.0 && s.contact.threshold_m >= s.tube.outer_radius_m) {
+    std::ostringstream m;
+    m << "contact.threshold " << s.contact.threshold_m * 1e3
+      << " mm is not below the tube's outer radius (" << s.tube.outer_radius_m * 1e3
+      << " mm): the contact band is wider than the tube, so PCs and forces reach parts the tube "
+         "does not touch; expected a threshold well below the radius (the paper's 1 mm)";
+    r.Warning(r.Get(root, "contact", "scene", false), m.str());
+  }
   // The penalty's force at a part's middle, K (eps + half its thickness): below the device's
   // force, a full push can carry the tube out the part's far side.
   for (const scene::BoxPart& part : s.parts) {

@@ -117,6 +117,15 @@ TEST_CASE("A part too thin for the contact to hold the device's force is said", 
         "through it; expected a thicker part or a stiffer contact\n");
 }
 
+TEST_CASE("A contact band as wide as the tube is said", "[scene]") {
+  const auto loaded = LoadSceneText(kMinimal + "contact: {threshold: 6 mm}\n", "t.yaml");
+  REQUIRE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:12:10: warning: contact.threshold 6 mm is not below the tube's outer radius (5 "
+        "mm): the contact band is wider than the tube, so PCs and forces reach parts the tube "
+        "does not touch; expected a threshold well below the radius (the paper's 1 mm)\n");
+}
+
 TEST_CASE("A good scene gives exactly its SI values", "[scene]") {
   const auto loaded = LoadSceneFile(SourcePath("tests/data/scenes/good.yaml"));
   REQUIRE(loaded.diagnostics.FormatAll() == "");
