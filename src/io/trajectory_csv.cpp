@@ -62,6 +62,9 @@ class Collector {
     ++count_;
     if (count_ <= kMaxErrors) d_.Error(file_, line, column, message);
   }
+  void Warning(int line, int column, const std::string& message) {
+    d_.Warning(file_, line, column, message);
+  }
   void Finish() {
     if (count_ > kMaxErrors)
       d_.ErrorAfterAll(file_, "... and " + std::to_string(count_ - kMaxErrors) +
@@ -129,6 +132,8 @@ class RowParser {
   std::size_t column_count_ = 0;
   bool have_previous_ = false;
   double previous_t_ = 0.0;
+  Eigen::Vector3d previous_p_ = Eigen::Vector3d::Zero();
+  bool speed_warned_ = false;
   bool rows_ok_ = true;
   bool stopped_ = false;
   std::size_t sample_count_ = 0;
@@ -305,6 +310,19 @@ bool RowParser::Line(std::string_view line, int line_number, plan::HandSample& s
                       Number(options_.max_gap_s) + " s (a dropped recording?)");
     rows_ok_ = false;
   }
+  // A hand faster than a haptic device follows: said once, at its first sample (the core keeps
+  // the tube out of parts whatever the hand does, but such a recording is not a hand's).
+  if (have_previous_ && rows_ok_ && !speed_warned_ && s.t_s > previous_t_) {
+    const double speed = (s.p_WH_m - previous_p_).norm() / (s.t_s - previous_t_);
+    if (speed > options_.max_hand_speed_m_per_s) {
+      errors_.Warning(line_number, fields_[pose_index_[1]].column,
+                      "the hand moves at " + Number(speed) + " m/s before this sample, faster " +
+                          "than the " + Number(options_.max_hand_speed_m_per_s) +
+                          " m/s a hand moves a haptic device (a jump in the recording?)");
+      speed_warned_ = true;
+    }
+  }
+  previous_p_ = s.p_WH_m;
   const double norm = q.norm();
   if (!(std::abs(norm - 1.0) <= options_.quaternion_norm_tolerance)) {
     errors_.Error(line_number, fields_[pose_index_[4]].column,

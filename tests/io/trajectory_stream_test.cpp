@@ -269,3 +269,23 @@ TEST_CASE("A line reader hands out every line, across chunks, whatever their len
   CHECK(in.FinishCheck(path, "text", d));
   std::filesystem::remove_all(Scratch());
 }
+
+TEST_CASE("A hand faster than a haptic device is warned about once, at its sample", "[io]") {
+  // 1 kHz; the hand still, then 10 mm in one sample (10 m/s) at line 5, then 6 mm (6 m/s).
+  const std::string csv =
+      "t,px,py,pz,qw,qx,qy,qz\n"
+      "0.000,0,0,0.05,1,0,0,0\n"
+      "0.001,0,0,0.05,1,0,0,0\n"
+      "0.002,0,0.0019,0.05,1,0,0,0\n"
+      "0.003,0,0.0119,0.05,1,0,0,0\n"
+      "0.004,0,0.0179,0.05,1,0,0,0\n";
+  const tubeplan::io::TrajectoryLoadResult loaded =
+      tubeplan::io::LoadTrajectoryText(csv, "jump.csv");
+  REQUIRE(loaded.trajectory);  // a warning, not an error: the replay still runs
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "jump.csv:5:7: warning: the hand moves at 10 m/s before this sample, faster than the 2 "
+        "m/s a hand moves a haptic device (a jump in the recording?)\n");
+  // 1.9 m/s (the third row) is within what a hand does.
+  const std::string slow = csv.substr(0, csv.find("0.003"));
+  CHECK(tubeplan::io::LoadTrajectoryText(slow, "slow.csv").diagnostics.FormatAll() == "");
+}

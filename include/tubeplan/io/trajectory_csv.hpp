@@ -22,6 +22,9 @@ struct TrajectoryLoadOptions {
   /// six significant digits is off by ~1e-6, so 1e-3 catches real mistakes (a column swapped,
   /// degrees written for a quaternion) and never a rounding.
   double quaternion_norm_tolerance = 1e-3;
+  /// A faster hand between two samples is warned about: 2 m/s is about the fastest a hand
+  /// moves a desktop haptic device's stylus (a PHANToM's end tracks a few m/s at most).
+  double max_hand_speed_m_per_s = 2.0;
 };
 
 struct TrajectoryLoadResult {
