@@ -437,6 +437,10 @@ int RunPlans(const PlansOptions& o, Streams io) {
     << " asked) through the pruned graph of " << b.scene.name << " (" << g.nodes.size() << " CFs, "
     << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
     << " kept arcs), written to " << out_dir.string() << ":\n";
+  // Fewer than asked: the pruned graph holds no more loopless paths to the goal.
+  if (static_cast<int>(paths.size()) < o.k)
+    t << "  (the pruned graph has no other loopless path from the start to the goal: a larger "
+         "--tolerance keeps more arcs, a larger --budget explores more states)\n";
   for (std::size_t i = 0; i < paths.size(); ++i) {
     const graph::Path& path = paths[i];
     const std::string name = b.scene.name + "-candidate-" + std::to_string(i + 1);
