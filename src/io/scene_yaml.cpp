@@ -521,8 +521,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   // The penalty's force at a part's middle, K (eps + half its thickness): below the device's
   // force, a full push can carry the tube out the part's far side.
   for (const scene::BoxPart& part : s.parts) {
-    const double hold_N =
-        s.contact.stiffness_N_per_m * (s.contact.threshold_m + 0.5 * part.size_m.minCoeff());
+    const double hold_N = scene::ContactHoldAtMiddle_N(s, part);
     if (!(hold_N < s.device.max_force_N) || part.size_m.minCoeff() <= 0.0) continue;
     std::ostringstream m;
     m << "part " << part.name << " is " << part.size_m.minCoeff() * 1e3

@@ -370,18 +370,17 @@ std::vector<StabilityCase> StabilityCases(bool quick) {
         why += Fmt("penalty too soft: the device's %.3g N presses %.3g m in, more than r1; ",
                    c.scene.device.max_force_N,
                    c.scene.device.max_force_N / c.scene.contact.stiffness_N_per_m);
-      // The penalty's force at a part's middle, K (eps + half its thickness): below the
-      // device's force, a full push carries the tube past the middle and out the far side.
-      double thinnest_m = std::numeric_limits<double>::infinity();
+      // The contact's force at the thinnest part's middle: below the device's force, a full
+      // push carries the tube out the far side (scene::ContactHoldAtMiddle_N).
+      const scene::BoxPart* thinnest = nullptr;
       for (const scene::BoxPart& part : c.scene.parts)
-        thinnest_m = std::min(thinnest_m, part.size_m.minCoeff());
-      const double hold_N =
-          c.scene.contact.stiffness_N_per_m * (c.scene.contact.threshold_m + 0.5 * thinnest_m);
-      if (std::isfinite(thinnest_m) && hold_N < c.scene.device.max_force_N)
+        if (!thinnest || part.size_m.minCoeff() < thinnest->size_m.minCoeff()) thinnest = &part;
+      if (thinnest && scene::ContactHoldAtMiddle_N(c.scene, *thinnest) < c.scene.device.max_force_N)
         why +=
             Fmt("penalty too soft for a %.3g m part: K (eps + half its thickness) = %.3g N, "
                 "below the device's %.3g N; ",
-                thinnest_m, hold_N, c.scene.device.max_force_N);
+                thinnest->size_m.minCoeff(), scene::ContactHoldAtMiddle_N(c.scene, *thinnest),
+                c.scene.device.max_force_N);
       if (c.scene.contact.threshold_m >= t.outer_radius_m)
         why += "eps >= r1: the contact band is wider than the tube; ";
       if (t.inner_radius_m > 0.95 * t.outer_radius_m)

@@ -105,6 +105,11 @@ struct Scene {
 /// Friction that applies at a part: its own if set, the scene's otherwise.
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index);
 
+/// The force the contact law pushes back with when a point reaches a part's middle,
+/// K (eps + half the part's thinnest size) [N]: below the device's force, a full push can carry
+/// the tube through the part.
+double ContactHoldAtMiddle_N(const Scene& scene, const BoxPart& part);
+
 /// Rotation from roll-pitch-yaw [rad], applied as R = Rz(yaw) Ry(pitch) Rx(roll) (extrinsic
 /// x-y-z, the ROS/URDF convention).
 Eigen::Matrix3d RotationFromRpy(const Eigen::Vector3d& rpy_rad);
