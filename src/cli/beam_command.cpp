@@ -26,8 +26,8 @@ struct BeamOptions {
   bool json = false;
 };
 
-// The linear model's tip deflection is 0.7 % too large at alpha = 0.25 (physics.md): beyond that
-// a user asking the linear model deserves a word.
+// The linear model's tip deflection is 0.7 % too large at alpha = 0.25 (docs/models.md, "The load
+// parameter"): beyond that a user asking the linear model deserves a word.
 constexpr double kLinearAlphaLimit = 0.25;
 
 std::string Vec(const Eigen::Vector3d& v) {

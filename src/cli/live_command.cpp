@@ -308,8 +308,8 @@ int RunLive(const LiveOptions& o, Streams io) {
       break;
   }
   core::Core core(scene);
-  // The coupling must be passive on this device (physics.md): refuse a stiffer one. A device
-  // that reports its limits at Open (openhaptics) is checked again after it.
+  // The coupling must be stable on this device (docs/scene-format.md, "Device"): refuse a stiffer
+  // one. A device that reports its limits at Open (openhaptics) is checked again after it.
   auto too_stiff = [&] {
     if (core.coupling_stiffness_N_per_m() <= dev->spec().max_stiffness_N_per_m) return false;
     io.err << o.plan << ": error: the scene's coupling stiffness "

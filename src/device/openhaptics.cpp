@@ -64,7 +64,7 @@ std::string OpenHapticsDevice::Open() {
   s.device = hdInitDevice(configuration_.empty() ? HD_DEFAULT_DEVICE : configuration_.c_str());
   if (std::string e = ErrorText("hdInitDevice"); !e.empty()) return e;
   hdMakeCurrentDevice(s.device);
-  // The device's own nominal limits (physics.md: prefer them to any table).
+  // The device's own nominal limits, not a table's (docs/live.md, "openhaptics (a real PHANToM)").
   HDdouble max_force_N = 0, max_torque_mNm = 0, stiffness_N_per_mm = 0, damping_Ns_per_mm = 0;
   HDdouble workspace_mm[6] = {};
   HDint output_dof = 3, input_dof = 3;

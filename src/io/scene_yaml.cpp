@@ -63,8 +63,9 @@ std::optional<Eigen::Vector3d> ReadRpy(Reader& r, const YAML::Node& node, const 
   return ok ? rpy : std::nullopt;
 }
 
-// The exponent of the friction law is physics.md's [2/3, 1]; files write 2/3 as 0.6667 or 0.667,
-// so values down to 2/3 - 1e-3 are accepted (and kept as written: the law is smooth in beta).
+// The friction law's exponent is in [2/3, 1] (docs/models.md, "Friction's load exponent"); files
+// write 2/3 as 0.6667 or 0.667, so values down to 2/3 - 1e-3 are accepted (and kept as written:
+// the law is smooth in beta).
 constexpr double kExponentMin = 2.0 / 3.0 - 1e-3;
 
 std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
@@ -534,8 +535,8 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   }
   if (const YAML::Node h = r.Get(root, "heuristics", "scene", false); h.IsDefined())
     ReadHeuristics(r, h, s.heuristics);
-  // The coupling a scene asks for must be passive on its device at its step (physics.md): an
-  // active coupling makes the device oscillate in the operator's hand.
+  // The coupling a scene asks for must be passive on its device at its step (docs/scene-format.md,
+  // "Device"): an active coupling makes the device oscillate in the operator's hand.
   if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsMap()) {
     const YAML::Node coupling = r.Get(d, "coupling", "device", false);
     const core::Coupling c = core::ResolveCoupling(s.device, s.model.time_step_s);

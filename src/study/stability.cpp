@@ -359,9 +359,9 @@ std::vector<StabilityCase> StabilityCases(bool quick) {
       v.apply(c.scene, c.speed_m_per_s, c.off_plane_m);
       AddParts(motion, c.scene);
       c.name = std::string(ToString(motion)) + " " + v.parameter;
-      // Validity of the model (physics.md, docs/core.md): slender beam, the penalty stiff
-      // enough that the device cannot push the tube through more than a radius, epsilon below
-      // the radius, a wall not so thin that the section would ovalise.
+      // Validity of the model (docs/accuracy.md, "tubeplan stability"): slender beam, the penalty
+      // stiff enough that the device cannot push the tube through more than a radius, epsilon
+      // below the radius, a wall not so thin that the section would ovalise.
       const model::TubeSpec& t = c.scene.tube;
       std::string why;
       if (t.length_m / t.outer_radius_m < 10.0)

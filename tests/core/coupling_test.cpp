@@ -1,4 +1,4 @@
-// The virtual coupling: passive defaults for the device, as physics.md requires.
+// The virtual coupling: passive defaults for the device (docs/scene-format.md, "Device").
 #include <catch2/catch.hpp>
 
 #include <tubeplan/core/coupling.hpp>

@@ -1,8 +1,8 @@
-// Tests of the elastica solver (physics.md, "The large-deflection model").
+// Tests of the elastica solver (docs/models.md, "The elastica under a tip load").
 //
 // The reference values come from outside the solver: Mattiasson's published table, a test-only
 // shooting solver (RK4 on the ODE itself plus bisection on the root curvature), finite
-// differences of the returned centreline, and the small-alpha expansions quoted in physics.md.
+// differences of the returned centreline, and the small-alpha expansions in docs/models.md.
 
 #include <algorithm>
 #include <array>
@@ -176,7 +176,7 @@ TEST_CASE("Elastica matches Mattiasson's table for a lateral tip load", "[elasti
   struct Row {
     double alpha, deflection, shortening;
   };
-  // Mattiasson 1981, Table 1 (physics.md).
+  // Mattiasson 1981, Table 1 (docs/models.md, "Mattiasson's table").
   const Row rows[] = {{1.0, 0.30172, 0.05643},
                       {2.0, 0.49346, 0.16064},
                       {5.0, 0.71379, 0.38763},
@@ -393,7 +393,7 @@ TEST_CASE("An elastica solved from a nearby solution is the one solved from scra
           "[elastica]") {
   // The residual has one root in the tip angle, so Newton from a nearby solution must land on
   // the root the bracketed search finds, to rounding: the tip figures agree to 1e-13 (the
-  // solver's own accuracy, physics.md), the shape's modulus k' to 1e-13 relative. Near loads
+  // solver's own accuracy, docs/models.md), the shape's modulus k' to 1e-13 relative. Near loads
   // (1 % and 0.01 rad away, as tick to tick or a finite difference) must take fewer iterations
   // than the search from scratch; far ones (alpha 100 times off, psi across its range) may
   // take more, never another answer.
@@ -511,7 +511,7 @@ TEST_CASE("Elastica series and elliptic branches agree across the switch", "[ela
   }
 }
 
-TEST_CASE("Elastica series reproduces the physics.md expansions for a lateral load", "[elastica]") {
+TEST_CASE("Elastica series reproduces the small-load expansions for a lateral load", "[elastica]") {
   const double alpha = 1e-3;
   const ElasticaSolution solution = SolveElastica(alpha, 0.0);
   REQUIRE(solution.series);

@@ -1,4 +1,4 @@
-// Physics tests of the linear cantilever (physics.md, "Tube and beam model", corrected eq. 1).
+// Physics tests of the linear cantilever (docs/models.md, "The linear cantilever", eq. 1).
 //
 // The displacement field is judged as a field of linear elasticity rather than against its own
 // formula: strains and stresses come from finite differences of LinearBeam's displacements, and
@@ -89,9 +89,10 @@ long double SecondMomentLongDouble(double r1, double r2) {
 // Which warping term of eq. (1) a local transcription uses.
 enum class Warping { kCorrected, kPrinted };
 
-// physics.md eq. (1), transcribed here independently of src/model/linear_beam.cpp, in the bending
-// frame under a tip force F along +x. kPrinted swaps in the paper's printed warping term
-// -1/4 (x^3 - x y^2) for the corrected -1/4 x (x^2 + y^2); everything else is identical.
+// The corrected eq. (1) of docs/models.md, transcribed here independently of
+// src/model/linear_beam.cpp, in the bending frame under a tip force F along +x. kPrinted swaps in
+// the paper's printed warping term -1/4 (x^3 - x y^2) for the corrected -1/4 x (x^2 + y^2);
+// everything else is identical.
 Eigen::Vector3d Eq1(const TubeSpec& spec, double force_N, const Eigen::Vector3d& p,
                     Warping warping) {
   const double r1 = spec.outer_radius_m;
@@ -578,7 +579,7 @@ TEST_CASE("Shear-sum check has teeth: the printed term carries F (1 + 1/(4 (1 + 
     const double printed_shear =
         SectionResultants(spec, LocalField(spec, F, Warping::kPrinted), z, false)[2];
     // By hand: the printed term adds G c y^2 / 2 to sigma_xz, whose integral is G c I / 2 =
-    // F / (4 (1 + nu)). At nu = 0.2 that is the "about 1.21 F" of physics.md; at nu = 0.5, 7/6 F.
+    // F / (4 (1 + nu)). At nu = 0.2 that is the "about 1.21 F" of docs/models.md; at 0.5, 7/6 F.
     const double printed_expected = F * (1.0 + 1.0 / (4.0 * (1.0 + nu)));
     CHECK(std::abs(code_shear - F) <= 1e-7 * F);  // FD budget as in the resultant test
     CHECK(std::abs(corrected_shear - F) <= 1e-7 * F);

@@ -1,5 +1,5 @@
 // The accuracy study's reference rod (reference/planar_rod.hpp) judged from outside: Mattiasson's
-// published table (physics.md), the closed-form elastica of model/ (elliptic integrals, a
+// published table (docs/models.md), the closed-form elastica of model/ (elliptic integrals, a
 // different method), its own order of convergence, and the penalty contact law at equilibrium.
 #include <cmath>
 #include <vector>
@@ -27,7 +27,7 @@ TEST_CASE("Reference rod reproduces Mattiasson's table", "[reference]") {
   struct Row {
     double alpha, v, h;
   };
-  // Mattiasson 1981, Table 1 (physics.md), printed to 5 digits.
+  // Mattiasson 1981, Table 1 (docs/models.md, "Mattiasson's table"), printed to 5 digits.
   for (const Row row : {Row{1, 0.30172, 0.05643}, Row{2, 0.49346, 0.16064},
                         Row{5, 0.71379, 0.38763}, Row{10, 0.81061, 0.55500}}) {
     const reference::RodSolution coarse = TipLoaded(row.alpha, 128);

@@ -113,7 +113,7 @@ TEST_CASE("Shooting reference reproduces Mattiasson's table and the closed form"
   struct Row {
     double alpha, v, h;
   };
-  // Mattiasson 1981, Table 1 (physics.md), printed to 5 digits.
+  // Mattiasson 1981, Table 1 (docs/models.md, "Mattiasson's table"), printed to 5 digits.
   for (const Row row : {Row{1, 0.30172, 0.05643}, Row{2, 0.49346, 0.16064},
                         Row{5, 0.71379, 0.38763}, Row{10, 0.81061, 0.55500}}) {
     const sh::Solution s = TipLoaded(row.alpha);

@@ -1,6 +1,6 @@
 #pragma once
-// The virtual coupling of the hand to the held end (physics.md, "The operator, the proxy and
-// stability"): which spring and damper a scene gets, and whether they are passive on its device.
+// The virtual coupling of the hand to the held end (docs/scene-format.md, "Device"): which spring
+// and damper a scene gets, and whether they are passive on its device.
 
 #include <tubeplan/scene/scene.hpp>
 

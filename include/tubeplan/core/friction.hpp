@@ -1,7 +1,7 @@
 #pragma once
-// The friction law of one principal contact (physics.md, "Contact force", steps 3-4): the load-
-// dependent limit of static friction and the stick/slip decision with a return mapping. Part of
-// the core: no I/O, no allocation, never NaN for finite inputs.
+// The friction law of one principal contact (docs/core.md, "Friction"): the load-dependent limit
+// of static friction and the stick/slip decision with a return mapping. Part of the core: no I/O,
+// no allocation, never NaN for finite inputs.
 
 #include <Eigen/Core>
 
@@ -15,7 +15,7 @@ namespace tubeplan::core {
 /// case is needed beyond N <= 0, and denormal loads give denormal limits, never NaN.
 double FrictionLimit(const scene::Friction& friction, double coefficient, double normal_N);
 
-/// The limit is the PC's (physics.md: friction per PC): a PC carried by several load points (a
+/// The limit is the PC's (docs/core.md, "Friction"): a PC carried by several load points (a
 /// line contact's two ends) holds f_max at their total normal force pc_normal_N, and a load point
 /// pressed with normal_N holds the share normal_N / pc_normal_N of it. The shares add up to the
 /// PC's limit, so the PC's friction, the sum of its points', stays within it; a limit taken per

@@ -21,15 +21,15 @@ struct DeviceSpec {
   double max_force_N = 0.0;
   double max_torque_Nm = 0.0;
   double max_stiffness_N_per_m = 0.0;  ///< largest stiffness it renders stably at 1 kHz
-  double damping_Ns_per_m = 0.0;       ///< its own physical damping b (passivity, physics.md)
+  double damping_Ns_per_m = 0.0;       ///< its own physical damping b (for passivity)
   Eigen::Vector3d workspace_half_extents_m = Eigen::Vector3d::Zero();  ///< box about its centre
   int button_count = 0;
   bool senses_rotation = false;  ///< 6-DOF pose in (gimbal encoders)
   bool actuates_torque = false;  ///< 6-DOF wrench out
 };
 
-/// The PHANToM Premium 1.5/6DOF's nominal data (physics.md, from CHAI3D's device tables; the
-/// workspace 381 x 267 x 191 mm from SensAble's data sheet).
+/// The PHANToM Premium 1.5/6DOF's nominal data (docs/scene-format.md, "Device": from CHAI3D's
+/// device tables; the workspace 381 x 267 x 191 mm from SensAble's data sheet).
 DeviceSpec PhantomPremium15Spec();
 
 /// The safety limits for a device: the smaller of its own maxima and the scene's, a 10 ms ramp

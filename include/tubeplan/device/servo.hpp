@@ -4,10 +4,10 @@
 // the hand's pose, pass the wrench through the WrenchLimiter, send it, measure the tick, and hand
 // what happened to the other threads without a lock or an allocation (handoff.hpp).
 //
-// Safety (physics.md): the wrench sent is zero from the tick on which any of these is seen, and
-// stays zero: a non-finite number anywhere (device reading, core output), a streak of missed
-// deadlines, stale device data, a device error, SIGINT or SIGTERM, a stop request, and the end of
-// the loop. The loop ends after such a fault has been sent, and the device is disabled.
+// Safety (docs/live.md, "Safety"): the wrench sent is zero from the tick on which any of these is
+// seen, and stays zero: a non-finite number anywhere (device reading, core output), a streak of
+// missed deadlines, stale device data, a device error, SIGINT or SIGTERM, a stop request, and the
+// end of the loop. The loop ends after such a fault has been sent, and the device is disabled.
 
 #include <atomic>
 #include <cstdint>

@@ -1,7 +1,7 @@
 #pragma once
-// The last thing between a computed wrench and a haptic device (physics.md, "Safety, always"):
-// clamps, rate-limits, and zeroes on NaN, on a streak of missed deadlines and on stop. Used by
-// every path that sends a wrench to a device, live or recorded.
+// The last thing between a computed wrench and a haptic device (docs/live.md, "Safety"): clamps,
+// rate-limits, and zeroes on NaN, on a streak of missed deadlines and on stop. Used by every path
+// that sends a wrench to a device, live or recorded.
 
 #include <Eigen/Core>
 

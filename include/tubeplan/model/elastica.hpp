@@ -1,7 +1,8 @@
 #pragma once
-// The inextensible elastica of a cantilever under a dead tip load (large deflection; physics.md,
-// "The large-deflection model"). Everything here is dimensionless: arc length s in [0, 1] is
-// measured in units of l, positions in units of l, and the load by alpha = |F| l^2 / (E I).
+// The inextensible elastica of a cantilever under a dead tip load (large deflection;
+// docs/models.md, "The elastica under a tip load"). Everything here is dimensionless: arc length s
+// in [0, 1] is measured in units of l, positions in units of l, and the load by
+// alpha = |F| l^2 / (E I).
 //
 // The cantilever is clamped at s = 0 along +z (the tube frame O-xyz of linear_beam.hpp); theta(s)
 // is the angle of the tangent from +z towards +x. The tip load is

@@ -1,6 +1,6 @@
 #pragma once
-// The paper's linear (Euler-Bernoulli / Saint-Venant flexure) cantilever model, with the
-// corrections to eq. (1) given in physics.md.
+// The paper's linear (Euler-Bernoulli / Saint-Venant flexure) cantilever model, with eq. (1)
+// corrected (docs/models.md, "The linear cantilever").
 //
 // Frame O-xyz ("the tube frame"): origin at the centre of the held end, z along the undeformed
 // axis towards the free end at z = l. The *bending frame* is the tube frame turned about z so that

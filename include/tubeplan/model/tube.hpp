@@ -7,8 +7,8 @@
 
 namespace tubeplan::model {
 
-/// A homogeneous, isotropic, linear elastic hollow circular tube (physics.md, "Tube and beam
-/// model"). inner_radius_m == 0 is a solid rod.
+/// A homogeneous, isotropic, linear elastic hollow circular tube (docs/models.md, "The tube").
+/// inner_radius_m == 0 is a solid rod.
 struct TubeSpec {
   double outer_radius_m = 0.0;     ///< r1 [m], > 0
   double inner_radius_m = 0.0;     ///< r2 [m], 0 <= r2 < r1

@@ -15,9 +15,10 @@
 // the first term being the half segment between the clamp (angle phi0) and the first midpoint.
 // Tip figures extrapolate the last half segment with the last curvature.
 //
-// Contacts use the core's constitutive law (physics.md): one force K (eps - d)_+ per obstacle
-// along the normal of the nearest pair, d the distance from the tube's surface (the centreline
-// offset by r1) to the obstacle; sliding friction mu_k N opposite a given sliding direction.
+// Contacts use the core's constitutive law (docs/core.md, "The contact law"): one force
+// K (eps - d)_+ per obstacle along the normal of the nearest pair, d the distance from the tube's
+// surface (the centreline offset by r1) to the obstacle; sliding friction mu_k N opposite a given
+// sliding direction.
 // What differs from the core is everything else: the exact (converged) large-deflection rod
 // under any number of loads, the exact geometry of the deformed tube, all contacts at once.
 

@@ -65,7 +65,7 @@ enum class RimCorners {
   kEach,     ///< two contacts, one per corner, each with its own penalty and friction
 };
 
-/// Friction of a contact (physics.md): static limit f_max = mu_s N0 (N / N0)^beta.
+/// Friction of a contact (docs/core.md, "Friction"): static limit f_max = mu_s N0 (N / N0)^beta.
 struct Friction {
   double static_coefficient = 0.0;   ///< mu_s [-]
   double kinetic_coefficient = 0.0;  ///< mu_k [-]

@@ -16,7 +16,7 @@
 
 namespace tubeplan::scene {
 
-/// Coulomb friction with the load exponent of physics.md:
+/// Coulomb friction with a load exponent (docs/models.md, "Friction's load exponent"):
 /// f_max = static_coefficient * reference_load_N * (N / reference_load_N)^exponent.
 struct Friction {
   double static_coefficient = 0.0;   ///< mu_s [-], >= 0
@@ -64,7 +64,8 @@ struct ModelOptions {
   int elements = 0;
 };
 
-/// The haptic device and the virtual coupling of the hand to the held end (physics.md).
+/// The haptic device and the virtual coupling of the hand to the held end (docs/scene-format.md,
+/// "Device").
 struct Device {
   double max_force_N = 8.5;  ///< PHANToM Premium 1.5/6DOF
   double max_torque_Nm = 0.188;
