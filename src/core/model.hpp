@@ -12,13 +12,6 @@
 
 namespace tubeplan::core {
 
-/// Points on the free end's rim that carry a contact with one part: the nearest and the others
-/// equally spaced around it, so that a flat end on a face bears on its whole rim.
-inline constexpr int kRimSamples = 8;
-/// The softness of the rim's smooth minimum, as a fraction of epsilon: a flat end's points share
-/// its load until their distances differ by a few of these.
-inline constexpr double kRimSoftness = 2e-4;
-
 struct RodModel {
   int elements = 0;                    ///< N segments, N + 1 nodes
   double length_m = 0.0;               ///< l

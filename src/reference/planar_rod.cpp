@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include <Eigen/LU>
@@ -34,6 +35,38 @@ struct Evaluation {
   double bending_energy_J = 0.0;
 };
 
+// The end face on a plane under the rim law: the rim's points share K (eps - d)+, d the smooth
+// minimum of their distances, by the softmin's weights; each point's share acts at its offset.
+void RimForces(const PlanarRod& rod, const Loading& loading, const Obstacle& ob,
+               const Vector2d& tip, const Vector2d& g, Evaluation& ev) {
+  const int n = loading.law.rim_points;
+  const double tau = loading.law.rim_softness * loading.law.threshold_m;
+  const Vector2d tangent(ob.normal.y(), -ob.normal.x());
+  std::vector<double> offset(static_cast<std::size_t>(n)), dist(offset), w(offset);
+  double d_min = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < n; ++j) {
+    offset[std::size_t(j)] = rod.radius_m * std::cos(2.0 * std::numbers::pi * j / n);
+    dist[std::size_t(j)] = ob.normal.dot(tip + offset[std::size_t(j)] * g - ob.point_m);
+    d_min = std::min(d_min, dist[std::size_t(j)]);
+  }
+  double sum = 0.0;
+  for (int j = 0; j < n; ++j)
+    sum += (w[std::size_t(j)] = tau > 0.0 ? std::exp(-(dist[std::size_t(j)] - d_min) / tau)
+                                          : double(dist[std::size_t(j)] == d_min));
+  const double d = d_min - tau * std::log(sum);
+  const double lambda = loading.law.stiffness_N_per_m * std::max(0.0, loading.law.threshold_m - d);
+  Vector2d total = Vector2d::Zero();
+  for (int j = 0; j < n && lambda > 0.0; ++j) {
+    const double share = lambda * w[std::size_t(j)] / sum;
+    if (share <= 0.0) continue;
+    const Vector2d f = share * ob.normal - ob.slide_sign * ob.kinetic_friction * share * tangent;
+    ev.forces.push_back({rod.segments, 1.0, offset[std::size_t(j)], f});
+    total += f;
+  }
+  ev.obstacle_distance_m.push_back(d);
+  ev.obstacle_force_N.push_back(total);
+}
+
 // The penalty force of one obstacle at the current configuration, and where it acts.
 void ContactForce(const PlanarRod& rod, const Loading& loading, const Obstacle& ob,
                   const std::vector<Vector2d>& nodes, const Eigen::VectorXd& theta,
@@ -64,6 +97,10 @@ void ContactForce(const PlanarRod& rod, const Loading& loading, const Obstacle& 
         }
         ev.obstacle_distance_m.push_back(d);
         ev.obstacle_force_N.push_back(total);
+        return;
+      }
+      if (loading.law.rim_points > 0) {
+        RimForces(rod, loading, ob, nodes[std::size_t(N)], g, ev);
         return;
       }
       for (const double side : {-1.0, 1.0}) {

@@ -297,10 +297,36 @@ CoreRun RunCore(const scene::Scene& s, const Scenario& sc) {
   return run;
 }
 
+// Sliding sets in at the hand's first step along the wall: friction grows from 0 to mu_k there
+// while the rim's smooth minimum is widened, then the width narrows back to the law's. Under the
+// law's own width a flat end tipping onto its trailing corner is too sharp a turn for Newton's
+// method to follow; the widened law carries the rod across it.
+reference::RodSolution SlideOnset(const reference::PlanarRod& rod, reference::Loading load,
+                                  const std::vector<double>& kinetic,
+                                  std::optional<reference::RodState>& warm) {
+  constexpr int kFrictionSteps = 30;
+  constexpr double kWideSoftness = 0.1;  // of eps: 0.1 mm on the rubber scene
+  const double softness = load.law.rim_softness;
+  if (load.law.rim_points > 0) load.law.rim_softness = std::max(softness, kWideSoftness);
+  reference::RodSolution sol;
+  for (int k = 1; k <= kFrictionSteps; ++k) {
+    for (std::size_t j = 0; j < kinetic.size(); ++j)
+      load.obstacles[j].kinetic_friction = kinetic[j] * k / kFrictionSteps;
+    sol = reference::SolveRod(rod, load, warm);
+    warm = sol.state;
+  }
+  while (load.law.rim_softness > softness) {
+    load.law.rim_softness = std::max(softness, 0.7 * load.law.rim_softness);
+    sol = reference::SolveRod(rod, load, warm);
+    warm = sol.state;
+  }
+  return sol;
+}
+
 // The reference rod along the scenario's path: continuation in hand steps of at most min(r1 / 2,
-// 0.5 mm) (a
-// long jump could carry the rod past a thin obstacle to an equilibrium on its far side), each
-// solve warm-started from the last. Returns the solutions at the scenario's load steps.
+// 0.5 mm) (a long jump could carry the rod past a thin obstacle to an equilibrium on its far
+// side), each solve warm-started from the last. Returns the solutions at the scenario's load
+// steps.
 std::vector<reference::RodSolution> FollowPath(const reference::PlanarRod& rod, double coupling,
                                                const Scenario& sc, const reference::ContactLaw& law,
                                                double* solve_ms) {
@@ -315,9 +341,15 @@ std::vector<reference::RodSolution> FollowPath(const reference::PlanarRod& rod, 
     load.coupling_N_per_m = coupling;
     load.law = law;
     load.obstacles = sc.obstacles;
-    // The press before sliding: no sliding yet.
-    if (sc.sliding && i == 0)
-      for (reference::Obstacle& o : load.obstacles) o.slide_sign = 0.0;
+    // The press before sliding: no sliding yet. The first step along the wall: the hand moves
+    // without friction, which then sets in (SlideOnset).
+    const bool onset = sc.sliding && i == 1;
+    std::vector<double> kinetic;
+    for (reference::Obstacle& o : load.obstacles) {
+      kinetic.push_back(o.kinetic_friction);
+      if (sc.sliding && i == 0) o.slide_sign = 0.0;
+      if (onset) o.kinetic_friction = 0.0;
+    }
     const int substeps =
         std::max(1, int(std::ceil((path[i] - last).norm() / std::min(0.5 * rod.radius_m, 0.5e-3))));
     for (int k = 1; k <= substeps; ++k) {
@@ -326,8 +358,10 @@ std::vector<reference::RodSolution> FollowPath(const reference::PlanarRod& rod, 
       const reference::RodSolution sol = reference::SolveRod(rod, load, warm);
       if (solve_ms && k == substeps) *solve_ms += Micros(Clock::now() - t0) / 1000.0;
       warm = sol.state;
-      if (k == substeps && !(sc.sliding && i == 0)) out.push_back(sol);
+      if (k == substeps && !sc.sliding) out.push_back(sol);
+      if (k == substeps && sc.sliding && i > 1) out.push_back(sol);
     }
+    if (onset) out.push_back(SlideOnset(rod, load, kinetic, warm));
     last = path[i];
   }
   return out;
@@ -460,7 +494,8 @@ AccuracyReport RunAccuracy(const scene::Scene& base_in, const AccuracyOptions& o
   for (Setting& s : settings) s.name = SettingName(s, base, report.elements);
 
   for (const Scenario& sc : scenarios) {
-    const ScenarioReference same = SolveReference(base, Kc, sc, {K0, eps0}, N, "same law");
+    const ScenarioReference same = SolveReference(
+        base, Kc, sc, {K0, eps0, core::kRimSamples, core::kRimSoftness}, N, "same law");
     const ScenarioReference rigid = SolveReference(base, Kc, sc, {10.0 * K0, 0.0}, N, "hard");
     report.references.push_back(same);
     report.references.push_back(rigid);

@@ -119,6 +119,13 @@ inline FormationKey KeyOf(const StepOutput& out) {
   return key;
 }
 
+/// The free end's rim against one part (docs/core.md, "The contact law"): kRimSamples points
+/// round the rim, the nearest and the others equally spaced, press as one contact whose distance
+/// is the smooth minimum of theirs, of width kRimSoftness times epsilon, so that a flat end bears
+/// on its whole rim until its points' distances differ by a few widths.
+inline constexpr int kRimSamples = 8;
+inline constexpr double kRimSoftness = 2e-4;
+
 /// Fewest and most rod elements a scene may ask for (model.elements).
 inline constexpr int kMinElementCount = 4;
 inline constexpr int kMaxElementCount = 96;

@@ -17,8 +17,8 @@
 //
 // Contacts use the core's constitutive law (docs/core.md, "The contact law"): one force
 // K (eps - d)_+ per obstacle along the normal of the nearest pair, d the distance from the tube's
-// surface (the centreline offset by r1) to the obstacle; sliding friction mu_k N opposite a given
-// sliding direction.
+// surface (the centreline offset by r1) to the obstacle, an end face's shared among its rim's
+// points (ContactLaw); sliding friction mu_k N opposite a given sliding direction.
 // What differs from the core is everything else: the exact (converged) large-deflection rod
 // under any number of loads, the exact geometry of the deformed tube, all contacts at once.
 
@@ -57,6 +57,12 @@ struct Obstacle {
 struct ContactLaw {
   double stiffness_N_per_m = 1.0e4;  ///< K
   double threshold_m = 1.0e-3;       ///< eps
+  /// The end face on a plane with eps > 0: 0 puts the force at the nearer corner; n > 0 shares
+  /// it among n points round the rim (in-plane offsets r1 cos(2 pi j / n)) by the weights of a
+  /// smooth minimum of their distances of width rim_softness * eps: the core's rim law, under
+  /// which a flat end carries a moment until it tips onto a corner.
+  int rim_points = 0;
+  double rim_softness = 0.0;
 };
 
 struct Loading {
