@@ -184,6 +184,27 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   return 0.5 * K * depth * depth;
 }
 
+// The terms of a contact point's share w that fades with the nodes: E = (K/2) w depth^2 gives
+// (K/2) depth^2 grad w, and -K depth (grad w grad d^T + grad d grad w^T) in the Hessian, both on
+// the three-node window that holds the share's nodes and the point's.
+void AddFadingShare(const MaterialPoint& mp, const Sample& smp, double K, double depth,
+                    Assembler& a) {
+  StencilTerm t;
+  t.first = std::min(mp.first, smp.weight_first);
+  t.nodes = std::max(mp.first + mp.nodes, smp.weight_first + smp.weight_nodes) - t.first;
+  Eigen::Matrix<double, 9, 1> grad_w = Eigen::Matrix<double, 9, 1>::Zero();
+  const int w0 = 3 * (smp.weight_first - t.first);
+  grad_w.segment(w0, 9 - w0) = smp.weight_gradient.head(9 - w0);
+  t.gradient = 0.5 * K * depth * depth * grad_w;
+  if (a.hessian()) {
+    Eigen::Matrix<double, 9, 1> grad_d = Eigen::Matrix<double, 9, 1>::Zero();
+    const int d0 = 3 * (mp.first - t.first);
+    grad_d.segment(d0, 9 - d0) = (mp.jacobian.transpose() * smp.normal_W).head(9 - d0);
+    t.hessian = -K * depth * (grad_w * grad_d.transpose() + grad_d * grad_w.transpose());
+  }
+  a.AddStencil(t);
+}
+
 }  // namespace
 
 double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
@@ -238,14 +259,9 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
-    // A share that fades: its change moves the energy too (its curvature is left out).
-    if (smp.weight_nodes > 0) {
-      StencilTerm t;
-      t.first = smp.weight_first;
-      t.nodes = smp.weight_nodes;
-      t.gradient = 0.5 * K * depth * depth * smp.weight_gradient;
-      a.AddStencil(t);
-    }
+    // A share that fades: its change moves the energy too, with the cross terms of its change
+    // and the distance's in the Hessian (the share's own curvature is left out).
+    if (smp.weight_nodes > 0) AddFadingShare(mp, smp, K, depth, a);
   }
 
   // Friction: a spring from each friction point to its anchor in the tangent plane, stiffness
