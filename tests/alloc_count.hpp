@@ -1,6 +1,7 @@
 #pragma once
-// Heap allocations counted for the tests that prove a tick allocates nothing (style.md, 3):
-// tests/alloc_count.cpp replaces every form of operator new for the whole test program.
+// Heap allocations counted for the tests that prove a tick allocates nothing (docs/core.md,
+// "Determinism and no allocation per tick"): tests/alloc_count.cpp replaces every form of
+// operator new for the whole test program.
 
 #include <cstdint>
 

@@ -1,6 +1,6 @@
-// The servo's tick allocates nothing (style.md, 3; docs/live.md): the whole per-tick path, from
-// the device's reading through the core, the limiter, the send and both hand-offs, counted with
-// every operator new of the test program replaced (tests/alloc_count.cpp).
+// The servo's tick allocates nothing (docs/live.md, "The servo loop"): the whole per-tick path,
+// from the device's reading through the core, the limiter, the send and both hand-offs, counted
+// with every operator new of the test program replaced (tests/alloc_count.cpp).
 #include <algorithm>
 
 #include <catch2/catch.hpp>

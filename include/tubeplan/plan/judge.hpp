@@ -1,7 +1,7 @@
 #pragma once
 // The feasibility judge: replays a plan's trajectory through the core and gives each planned
-// transition a verdict (architecture.md, docs/evaluate.md). A state counts once the core has
-// kept it for the plan's dwell; the counted sequence is matched against the plan.
+// transition a verdict (docs/evaluate.md). A state counts once the core has kept it for the
+// plan's dwell; the counted sequence is matched against the plan.
 
 #include <array>
 #include <cstdint>
