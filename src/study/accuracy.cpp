@@ -358,8 +358,7 @@ std::vector<reference::RodSolution> FollowPath(const reference::PlanarRod& rod, 
       const reference::RodSolution sol = reference::SolveRod(rod, load, warm);
       if (solve_ms && k == substeps) *solve_ms += Micros(Clock::now() - t0) / 1000.0;
       warm = sol.state;
-      if (k == substeps && !sc.sliding) out.push_back(sol);
-      if (k == substeps && sc.sliding && i > 1) out.push_back(sol);
+      if (k == substeps && (!sc.sliding || i > 1)) out.push_back(sol);
     }
     if (onset) out.push_back(SlideOnset(rod, load, kinetic, warm));
     last = path[i];
