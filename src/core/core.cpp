@@ -162,7 +162,7 @@ Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<M
   // A tick's Newton iterations at most, over its friction passes: a snap through spreads over
   // ticks (each moving every point at most this many step caps) instead of stalling one.
   m.solver.max_iterations = 24;
-  m.solver.tolerance_N = 1e-6;
+  m.solver.tolerance_N = 1e-5;
   data_ = std::make_unique<Data>();
   InitData(m, scene_.X_WH_start, *data_);
 }
