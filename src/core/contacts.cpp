@@ -176,6 +176,12 @@ class Finder {
     const double weight = 1.0 - SmoothStep(x);
     if (weight <= 0.0) return;
     at.distance_m -= r1;
+    // The sphere is the capsule chain's surface at the node: sliding along the tube moves the
+    // contact onto the next element's side at the same distance, so the distance is taken not
+    // to curve along the tube (a point rolling off an edge would see it curve there).
+    const Eigen::Matrix3d across =
+        Eigen::Matrix3d::Identity() - mp.tangent_W * mp.tangent_W.transpose();
+    at.curvature_per_m = across * at.curvature_per_m * across;
     mp.offset_W = -r1 * at.normal_W;
     mp.point_W += mp.offset_W;
     Sample* smp = Record(SampleKind::kNode, p, i, 0, 0.0, weight, at, mp, Vec3::Zero());
@@ -293,7 +299,16 @@ class Finder {
       at.point_W = q;
       // The edge, or the vertex it ends in.
       at.face_mask = u == 0.0 ? edge.a_mask : u == 1.0 ? edge.b_mask : edge.face_mask;
-      at.curvature_per_m = (P - at.normal_W * at.normal_W.transpose()) / lw;
+      // The distance is between the element's axis and the edge (or its vertex): it does not
+      // change as the element slides along its axis, or along the edge, so it curves only across
+      // both (past a vertex), not as a point's distance from the edge would. Its change as the
+      // element turns is left out.
+      if (on_line) {
+        at.curvature_per_m.setZero();
+      } else {
+        const Vec3 m = v.normalized().cross(at.normal_W);
+        at.curvature_per_m = m * m.transpose() / lw;
+      }
       // The distance moves with the axis point alone (the nearest point's own motion along the
       // axis and the edge changes it only to second order); the surface point is r1 from it.
       MaterialPoint mp = Material(Carrier::kElement, x_, i, theta, Vec3::Zero(), false);
