@@ -94,20 +94,20 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.out.X_WH = X_WH;
 }
 
-Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<Model>()) {
-  Model& m = *model_;
-  const model::TubeSpec& tube = scene_.tube;
+void BuildModel(const scene::Scene& scene, Model& m, std::vector<scene::PartElement>& elements,
+                std::vector<std::uint32_t>& reachable_parts) {
+  const model::TubeSpec& tube = scene.tube;
   const model::TubeSection section = model::ComputeSection(tube);
-  m.rod.elements = ElementCount(scene_);
+  m.rod.elements = ElementCount(scene);
   m.rod.length_m = tube.length_m;
   m.rod.segment_m = tube.length_m / m.rod.elements;
   m.rod.outer_radius_m = tube.outer_radius_m;
   m.rod.inner_radius_m = tube.inner_radius_m;
   m.rod.bending_stiffness_Nm2 = section.bending_stiffness_Nm2;
-  m.rod.linear = scene_.model.tube == scene::TubeModel::kLinear;
-  m.contact.stiffness_N_per_m = scene_.contact.stiffness_N_per_m;
-  m.contact.threshold_m = scene_.contact.threshold_m;
-  m.contact.bend_threshold_m = scene_.contact.bend_threshold_m;
+  m.rod.linear = scene.model.tube == scene::TubeModel::kLinear;
+  m.contact.stiffness_N_per_m = scene.contact.stiffness_N_per_m;
+  m.contact.threshold_m = scene.contact.threshold_m;
+  m.contact.bend_threshold_m = scene.contact.bend_threshold_m;
   // Inextensible, as the paper's tube and Kirchhoff's rod: the axial stiffness is the tube's own
   // or, when that is softer, a hundred times the contact's over the tube's length, so that the
   // rod's stretch under any load is a hundredth of the contact's give (docs/core.md).
@@ -115,43 +115,43 @@ Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<M
                                  tube.inner_radius_m * tube.inner_radius_m);
   m.rod.stretch_stiffness_N = std::max(tube.youngs_modulus_Pa * area_m2,
                                        100.0 * m.contact.stiffness_N_per_m * tube.length_m);
-  const Coupling coupling = ResolveCoupling(scene_.device, scene_.model.time_step_s);
+  const Coupling coupling = ResolveCoupling(scene.device, scene.model.time_step_s);
   m.coupling.stiffness_N_per_m = coupling.stiffness_N_per_m;
   m.coupling.damping_Ns_per_m = coupling.damping_Ns_per_m;
-  m.coupling.max_force_N = scene_.device.max_force_N;
-  m.coupling.max_torque_Nm = scene_.device.max_torque_Nm;
-  m.coupling.time_step_s = scene_.model.time_step_s;
+  m.coupling.max_force_N = scene.device.max_force_N;
+  m.coupling.max_torque_Nm = scene.device.max_torque_Nm;
+  m.coupling.time_step_s = scene.model.time_step_s;
 
   // Reachable parts: those whose box meets the hand's workspace grown by everything the tube can
   // reach from it (its length, its radius and epsilon). Others are left out of the core entirely.
   Eigen::Vector3d lo, hi;
-  const double reach = tube.length_m + tube.outer_radius_m + scene_.contact.threshold_m;
-  if (scene_.workspace) {
-    lo = scene_.workspace->min_W_m.array() - reach;
-    hi = scene_.workspace->max_W_m.array() + reach;
+  const double reach = tube.length_m + tube.outer_radius_m + scene.contact.threshold_m;
+  if (scene.workspace) {
+    lo = scene.workspace->min_W_m.array() - reach;
+    hi = scene.workspace->max_W_m.array() + reach;
   } else {
     lo.setConstant(-std::numeric_limits<double>::infinity());
     hi.setConstant(std::numeric_limits<double>::infinity());
   }
-  const std::vector<scene::PartElement> all = scene::EnumerateElements(scene_);
+  const std::vector<scene::PartElement> all = scene::EnumerateElements(scene);
   double thinnest = tube.outer_radius_m;
   std::size_t next_element = 0;
-  for (std::uint32_t p = 0; p < scene_.parts.size(); ++p) {
+  for (std::uint32_t p = 0; p < scene.parts.size(); ++p) {
     PartModel part;
-    part.geometry = BoxGeometry(scene_.parts[p]);
+    part.geometry = BoxGeometry(scene.parts[p]);
     const BoxGeometry& g = part.geometry;
     // All elements of a part are consecutive in `all`, in part order.
     while (next_element < all.size() && all[next_element].part_index < p) ++next_element;
     if ((g.min_W().array() > hi.array()).any() || (g.max_W().array() < lo.array()).any()) continue;
     part.scene_index = p;
-    part.friction = scene::FrictionAt(scene_, p);
+    part.friction = scene::FrictionAt(scene, p);
     part.element_of.fill(-1);
     for (std::size_t e = next_element; e < all.size() && all[e].part_index == p; ++e) {
-      part.element_of[all[e].face_mask] = static_cast<int>(elements_.size());
-      elements_.push_back(all[e]);
+      part.element_of[all[e].face_mask] = static_cast<int>(elements.size());
+      elements.push_back(all[e]);
     }
     thinnest = std::min(thinnest, g.thinnest_m());
-    reachable_parts_.push_back(p);
+    reachable_parts.push_back(p);
     m.parts.push_back(std::move(part));
   }
   m.frictionless = std::all_of(m.parts.begin(), m.parts.end(),
@@ -163,8 +163,12 @@ Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<M
   // ticks (each moving every point at most this many step caps) instead of stalling one.
   m.solver.max_iterations = 24;
   m.solver.tolerance_N = 1e-5;
+}
+
+Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<Model>()) {
+  BuildModel(scene_, *model_, elements_, reachable_parts_);
   data_ = std::make_unique<Data>();
-  InitData(m, scene_.X_WH_start, *data_);
+  InitData(*model_, scene_.X_WH_start, *data_);
 }
 
 Core::~Core() = default;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <tubeplan/scene/elements.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 #include "core/part_geometry.hpp"
@@ -59,5 +60,10 @@ struct Model {
   std::vector<PartModel> parts;  ///< the parts the tube can reach, in scene order
   bool frictionless = true;      ///< no part has friction: no friction state at all
 };
+
+/// The model of `scene`, with the part elements of the parts the tube can reach (their indices
+/// are PartModel::element_of's) and those parts' indices in the scene.
+void BuildModel(const scene::Scene& scene, Model& model, std::vector<scene::PartElement>& elements,
+                std::vector<std::uint32_t>& reachable_parts);
 
 }  // namespace tubeplan::core
