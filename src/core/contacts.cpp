@@ -176,12 +176,13 @@ class Finder {
     const double weight = 1.0 - SmoothStep(x);
     if (weight <= 0.0) return;
     at.distance_m -= r1;
+    const Eigen::Matrix3d curvature_per_m = at.curvature_per_m;
     // The sphere is the capsule chain's surface at the node: sliding along the tube moves the
     // contact onto the next element's side at the same distance, so the distance is taken not
     // to curve along the tube (a point rolling off an edge would see it curve there).
     const Eigen::Matrix3d across =
         Eigen::Matrix3d::Identity() - mp.tangent_W * mp.tangent_W.transpose();
-    at.curvature_per_m = across * at.curvature_per_m * across;
+    at.curvature_per_m = across * curvature_per_m * across;
     mp.offset_W = -r1 * at.normal_W;
     mp.point_W += mp.offset_W;
     Sample* smp = Record(SampleKind::kNode, p, i, 0, 0.0, weight, at, mp, Vec3::Zero());
@@ -189,7 +190,7 @@ class Finder {
       // d |n.t| = sign (t^T C dx_i + n^T dt), C the distance's curvature at the node.
       const double slope = -6.0 * x * (1.0 - x) / kCapFade * (along < 0.0 ? -1.0 : 1.0);
       smp->weight_gradient = slope * (mp.tangent_jacobian.transpose() * at.normal_W);
-      smp->weight_gradient.segment<3>(3) += slope * (at.curvature_per_m * mp.tangent_W);
+      smp->weight_gradient.segment<3>(3) += slope * (curvature_per_m * mp.tangent_W);
       smp->weight_first = i - 1;
       smp->weight_nodes = 3;
     }
@@ -243,7 +244,9 @@ class Finder {
     const Vec3& b = x_[std::size_t(i + 1)];
     const Vec3 lo = a.cwiseMin(b).array() - (r1 + eps), hi = a.cwiseMax(b).array() + (r1 + eps);
     const Vec3 v = b - a;
-    const double ramp = std::min(0.25 * r1, 0.5 * m_.rod.segment_m) / v.norm();  // in theta
+    // The length over which the share fades towards a node.
+    const double ramp_m = std::min(0.25 * r1, 0.5 * m_.rod.segment_m);
+    const double lv = v.norm();
     const auto& edges = part.geometry.edges();
     for (int e = 0; e < int(edges.size()); ++e) {
       const PartEdge& edge = edges[std::size_t(e)];
@@ -265,7 +268,7 @@ class Finder {
       // The share: s(theta) towards the nodes, times s(sin^2 phi / sin^2 20 deg) for the angle
       // phi between the element and the edge (1 against a vertex, a point).
       const bool on_line = u > 0.0 && u < 1.0;
-      const double near_node = std::min(theta, 1.0 - theta) / ramp;
+      const double near_node = std::min(theta, 1.0 - theta) * lv / ramp_m;
       const double along = SmoothStep(near_node);
       double across = 1.0;
       Vec3 d_across_dv = Vec3::Zero();
@@ -290,9 +293,11 @@ class Finder {
       const double num = -v.dot(Pw0), den = v.dot(Pv);
       const Vec3 d_theta_a = ((Pw0 - Pv) * den + 2.0 * num * Pv) / (den * den);
       const Vec3 d_theta_b = (-Pw0 * den - 2.0 * num * Pv) / (den * den);
-      const double d_along =
-          near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) / ramp * (theta < 0.5 ? 1.0 : -1.0)
-                          : 0.0;
+      // d along / d (a, b): near_node changes with theta and with the element's length.
+      const double side_sign = theta < 0.5 ? 1.0 : -1.0;
+      const double d_along = near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) / ramp_m : 0.0;
+      const Vec3 d_near_a = side_sign * lv * d_theta_a - std::min(theta, 1.0 - theta) * v / lv;
+      const Vec3 d_near_b = side_sign * lv * d_theta_b + std::min(theta, 1.0 - theta) * v / lv;
       PartDistance at;
       at.distance_m = lw - r1;
       at.normal_W = w / lw;
@@ -316,8 +321,8 @@ class Finder {
       mp.point_W += mp.offset_W;
       Sample* smp = Record(SampleKind::kSide, p, i, e, theta, weight, at, mp, Vec3::Zero());
       if (smp != nullptr) {
-        smp->weight_gradient.segment<3>(0) = across * d_along * d_theta_a - along * d_across_dv;
-        smp->weight_gradient.segment<3>(3) = across * d_along * d_theta_b + along * d_across_dv;
+        smp->weight_gradient.segment<3>(0) = across * d_along * d_near_a - along * d_across_dv;
+        smp->weight_gradient.segment<3>(3) = across * d_along * d_near_b + along * d_across_dv;
         smp->weight_first = i;
         smp->weight_nodes = 2;
       }

@@ -1,0 +1,121 @@
+// The solve's gradient against central differences of its own energy, on random bent tubes
+// near an edge and a wall: every contact term (a node's sphere and its fading share, an
+// element's side on the edge, the end's rim) and the rod's and the coupling's.
+#include "core/assemble.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "core/contacts.hpp"
+#include "core/data.hpp"
+#include "core/model.hpp"
+
+using namespace tubeplan;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+scene::BoxPart Cube(const std::string& name, double size_m, const Eigen::Vector3d& centre,
+                    double turn_y_rad) {
+  scene::BoxPart b;
+  b.name = name;
+  b.size_m = Eigen::Vector3d::Constant(size_m);
+  b.X_WP.linear() = Eigen::AngleAxisd(turn_y_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  b.X_WP.translation() = centre;
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core][gradient]") {
+  // The rubber tube of scenes/groove.yaml (18 elements), held at the origin along +z and bent
+  // in the x-z plane; an edge along y beside it (a cube turned 45 deg), a wall across its end.
+  scene::Scene s;
+  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
+  s.contact = {1e4, 1e-3, 1e-4};
+  s.device.coupling_stiffness_N_per_m = 400.0;
+  s.device.coupling_damping_Ns_per_m = 0.0;
+  const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  int nodes_fading = 0, sides = 0, rims = 0, checked = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    // The centreline: an arc of curvature kappa, each node moved up to 0.2 mm at random.
+    const double kappa = 6.0 * u01(rng);
+    const auto arc = [&](double s_m) {
+      return kappa < 1e-9 ? Eigen::Vector3d(0.0, 0.0, s_m)
+                          : Eigen::Vector3d((1.0 - std::cos(kappa * s_m)) / kappa, 0.0,
+                                            std::sin(kappa * s_m) / kappa);
+    };
+    const auto tangent = [&](double s_m) {
+      return Eigen::Vector3d(std::sin(kappa * s_m), 0.0, std::cos(kappa * s_m));
+    };
+    // The edge beside the arc at 0.3-0.8 l, on its convex side, from 0.5 mm inside to 1 mm
+    // beyond the band; the wall facing the end, from 0.5 mm inside to 1 mm beyond.
+    const double s_edge = (0.3 + 0.5 * u01(rng)) * l;
+    const Eigen::Vector3d t_e = tangent(s_edge), n_e(t_e.z(), 0.0, -t_e.x());
+    const Eigen::Vector3d edge_W = arc(s_edge) + (r1 + eps * (1.5 * u01(rng) - 0.5)) * n_e;
+    const double half_diagonal = 0.02 * std::sqrt(2.0);
+    s.parts = {
+        Cube("edge", 0.04, edge_W + half_diagonal * n_e, std::atan2(n_e.x(), n_e.z()) + kPi / 4.0),
+        Cube("wall", 0.04, arc(l) + (eps * (1.5 * u01(rng) - 0.5) + 0.02) * tangent(l),
+             std::atan2(tangent(l).x(), tangent(l).z()))};
+    s.X_WH_start = Eigen::Isometry3d::Identity();
+    core::Model model;
+    std::vector<scene::PartElement> elements;
+    std::vector<std::uint32_t> reachable;
+    core::BuildModel(s, model, elements, reachable);
+    core::Data data;
+    core::InitData(model, s.X_WH_start, data);
+    const int n = model.rod.elements;
+    std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector3d jiggle(u01(rng) - 0.5, u01(rng) - 0.5, u01(rng) - 0.5);
+      x[std::size_t(k)] = arc(k * model.rod.segment_m) + (k == 0 ? 0.0 : 0.4e-3) * jiggle;
+    }
+    data.input.p_hand_W = Eigen::Vector3d(0.3e-3, -0.2e-3, 0.1e-3);
+
+    core::FindContacts(model, x, data, core::Choices::kKeep);
+    core::Assemble(model, data, x, core::Derivatives::kGradient);
+    const Eigen::VectorXd gradient = data.scratch.gradient;
+    bool fading = false, side = false, rim = false;
+    for (int k = 0; k < data.scratch.sample_count; ++k) {
+      const core::Sample& smp = data.scratch.samples[std::size_t(k)];
+      if (!(smp.distance_m < eps)) continue;
+      fading = fading || (smp.kind == core::SampleKind::kNode && smp.weight_nodes > 0);
+      side = side || (smp.kind == core::SampleKind::kSide && smp.node > 0);
+      rim = rim || smp.kind == core::SampleKind::kRim;
+    }
+    nodes_fading += fading;
+    sides += side;
+    rims += rim;
+
+    // Central differences of the energy, the contact points found again at each point (the
+    // sections' nearest directions kept, as within a tick).
+    const double h = 1e-8;
+    const auto energy = [&](int unknown, double by) {
+      std::vector<Eigen::Vector3d> y = x;
+      y[std::size_t(unknown / 3)][unknown % 3] += by;
+      core::FindContacts(model, y, data, core::Choices::kPending);
+      return core::Assemble(model, data, y, core::Derivatives::kNone);
+    };
+    const double scale = gradient.lpNorm<Eigen::Infinity>();
+    for (int k = 0; k < gradient.size(); ++k) {
+      const double fd = (energy(k, h) - energy(k, -h)) / (2.0 * h);
+      INFO("trial " << trial << ", unknown " << k << " (node " << k / 3 << ")");
+      // Truncation h^2 E''' and the energy's rounding over 2h leave ~1e-7 of the largest force.
+      CHECK(gradient[k] == Approx(fd).margin(1e-6 * scale + 1e-9));
+      ++checked;
+    }
+  }
+  // Every kind of term was in contact in some of the trials.
+  CHECK(nodes_fading > 0);
+  CHECK(sides > 0);
+  CHECK(rims > 0);
+  CHECK(checked == 60 * 3 * 19);
+}
