@@ -265,6 +265,38 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
   return s;
 }
 
+// The hand's poses of the contact scenarios, for a groove along world y with its floor's top at
+// z = 0 (the shipped scenes' layout), sized by the tube and by the gap between the tube and the
+// wall named `left` (the groove taken as symmetric), so that each scenario reaches the same
+// contact formation on a soft short tube and a stiff long one.
+struct CorePoses {
+  Eigen::Isometry3d end, two_pcs, three_pcs, side_on_floor;
+};
+
+CorePoses PosesFor(const scene::Scene& scene) {
+  const double l = scene.tube.length_m, r1 = scene.tube.outer_radius_m;
+  const double y = scene.X_WH_start.translation().y();
+  // The gap between the tube and the left wall when the tube lies along the groove's middle.
+  double gap_m = 0.25 * r1;
+  for (const scene::BoxPart& part : scene.parts)
+    if (part.name == "left") gap_m = -(part.X_WP.translation().x() + 0.5 * part.size_m.x()) - r1;
+  constexpr double kTipDownDeg = 15.0;
+  const double tip_down = kTipDownDeg * std::numbers::pi / 180.0;
+  // Tipped down 15 deg, the rim's lowest point 0.13 r1 below the floor's top.
+  const double z_end = l * std::sin(tip_down) + r1 * std::cos(tip_down) - 0.1313 * r1;
+  CorePoses p;
+  p.end = HandPose(0.0, y, z_end, kTipDownDeg, 0.0);
+  // As the end, 1/16 r1 past touching the left wall.
+  p.two_pcs = HandPose(-(gap_m + r1 / 16.0), y, z_end, kTipDownDeg, 0.0);
+  // Lying on the floor, the held end 0.15 of the gap from the left wall, turned so that the free
+  // end, were the tube straight, would come within half the contact band of the right wall.
+  const double eps = scene.contact.threshold_m;
+  const double turn = std::atan((0.85 * gap_m + gap_m - 0.5 * eps) / l) * 180.0 / std::numbers::pi;
+  p.three_pcs = HandPose(-0.85 * gap_m, y, 1.025 * r1, 0.0, -turn);
+  p.side_on_floor = HandPose(0.0, y, 0.95 * r1, 0.0, 0.0);
+  return p;
+}
+
 std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   std::vector<Scenario> out;
   // A small dither keeps every tick doing real work without changing the state.
@@ -280,8 +312,9 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
     Y.translation().y() += phase < 20e-3 ? phase - 10e-3 : 30e-3 - phase;
     return Y;
   };
+  const CorePoses poses = PosesFor(scene);
   const Eigen::Isometry3d free_pose = scene.X_WH_start;
-  const Eigen::Isometry3d end_pose = HandPose(0.0, -0.090, 0.0455, 15.0, 0.0);
+  const Eigen::Isometry3d& end_pose = poses.end;
   out.push_back(CoreScenario(scene, "core.free", "free motion above the groove", free_pose,
                              [](const Eigen::Isometry3d& X, long k) {
                                Eigen::Isometry3d Y = X;
@@ -293,16 +326,16 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   out.push_back(
       CoreScenario(scene, "core.end_sliding", "the tip sliding along the floor", end_pose, slide));
   out.push_back(CoreScenario(scene, "core.two_pcs",
-                             "the tip on the floor and the side along the left wall",
-                             HandPose(-2.5e-3, -0.090, 0.0455, 15.0, 0.0), dither));
+                             "the tip on the floor and the side along the left wall", poses.two_pcs,
+                             dither));
   out.push_back(
       CoreScenario(scene, "core.three_pcs",
                    "lying in the groove, turned to touch both walls: floor, left wall, right wall",
-                   HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
+                   poses.three_pcs, dither));
   // A line contact: the side lying along the floor, carried by every section on it.
   out.push_back(CoreScenario(scene, "core.side_on_floor",
                              "lying along the floor, pressed onto it (a line contact)",
-                             HandPose(0.0, -0.090, 0.0076, 0.0, 0.0), dither));
+                             poses.side_on_floor, dither));
   // The same stuck tip without friction, and with the shape asked for every tick.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
@@ -317,8 +350,7 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   out.push_back(CoreScenario(linear, "core.end_stuck.linear",
                              "core.end_stuck with the linear beam model", end_pose, dither));
   out.push_back(CoreScenario(linear, "core.three_pcs.linear",
-                             "core.three_pcs with the linear beam model",
-                             HandPose(-1.7e-3, -0.090, 0.0082, 0.0, -0.85), dither));
+                             "core.three_pcs with the linear beam model", poses.three_pcs, dither));
   return out;
 }
 
