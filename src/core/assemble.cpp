@@ -201,6 +201,11 @@ void AddFadingShare(const MaterialPoint& mp, const Sample& smp, double K, double
     const int d0 = 3 * (mp.first - t.first);
     grad_d.segment(d0, 9 - d0) = (mp.jacobian.transpose() * smp.normal_W).head(9 - d0);
     t.hessian = -K * depth * (grad_w * grad_d.transpose() + grad_d * grad_w.transpose());
+    if (smp.weight_curve > 0.0) {
+      Eigen::Matrix<double, 9, 1> g = Eigen::Matrix<double, 9, 1>::Zero();
+      g.segment(w0, 9 - w0) = smp.weight_curve_gradient.head(9 - w0);
+      t.hessian += 0.5 * K * depth * depth * smp.weight_curve * g * g.transpose();
+    }
   }
   a.AddStencil(t);
 }

@@ -325,6 +325,11 @@ class Finder {
         smp->weight_gradient.segment<3>(3) = across * d_along * d_near_b + along * d_across_dv;
         smp->weight_first = i;
         smp->weight_nodes = 2;
+        if (near_node < 1.0) {
+          smp->weight_curve = across * std::max(0.0, 6.0 - 12.0 * near_node);
+          smp->weight_curve_gradient.segment<3>(0) = d_near_a / ramp_m;
+          smp->weight_curve_gradient.segment<3>(3) = d_near_b / ramp_m;
+        }
       }
     }
   }

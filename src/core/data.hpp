@@ -41,6 +41,10 @@ struct Sample {
   Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
   int weight_first = 0;
   int weight_nodes = 0;
+  /// The leading part of the share's curvature, c g g^T (g over the same nodes): the bend of the
+  /// smooth step it fades by along the coordinate it fades with, where that bend is convex.
+  double weight_curve = 0.0;
+  Eigen::Matrix<double, 9, 1> weight_curve_gradient = Eigen::Matrix<double, 9, 1>::Zero();
   double distance_m = 0.0;  ///< signed distance d of the point to the part
   /// The distance its contact presses by: its own, or for the rim's points on one part their
   /// smooth minimum (Assemble), so that every contact's force is K (eps - this).
