@@ -293,11 +293,13 @@ class Finder {
       const double num = -v.dot(Pw0), den = v.dot(Pv);
       const Vec3 d_theta_a = ((Pw0 - Pv) * den + 2.0 * num * Pv) / (den * den);
       const Vec3 d_theta_b = (-Pw0 * den - 2.0 * num * Pv) / (den * den);
-      // d along / d (a, b): near_node changes with theta and with the element's length.
+      // d near_node / d (a, b): it changes with theta and with the element's length; and
+      // d along / d near_node.
       const double side_sign = theta < 0.5 ? 1.0 : -1.0;
-      const double d_along = near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) / ramp_m : 0.0;
-      const Vec3 d_near_a = side_sign * lv * d_theta_a - std::min(theta, 1.0 - theta) * v / lv;
-      const Vec3 d_near_b = side_sign * lv * d_theta_b + std::min(theta, 1.0 - theta) * v / lv;
+      const double nearer = std::min(theta, 1.0 - theta);
+      const Vec3 d_near_a = (side_sign * lv * d_theta_a - nearer * v / lv) / ramp_m;
+      const Vec3 d_near_b = (side_sign * lv * d_theta_b + nearer * v / lv) / ramp_m;
+      const double d_along = near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) : 0.0;
       PartDistance at;
       at.distance_m = lw - r1;
       at.normal_W = w / lw;
@@ -327,8 +329,8 @@ class Finder {
         smp->weight_nodes = 2;
         if (near_node < 1.0) {
           smp->weight_curve = across * std::max(0.0, 6.0 - 12.0 * near_node);
-          smp->weight_curve_gradient.segment<3>(0) = d_near_a / ramp_m;
-          smp->weight_curve_gradient.segment<3>(3) = d_near_b / ramp_m;
+          smp->weight_curve_gradient.segment<3>(0) = d_near_a;
+          smp->weight_curve_gradient.segment<3>(3) = d_near_b;
         }
       }
     }
