@@ -219,8 +219,8 @@ TEST_CASE("A stiff tube pivoting on one edge onto another converges in every tic
   // The steel tube along +z, its side on an edge at l/2 (-x) and its tip swinging onto a second
   // edge near the end (+x) as the hand moves towards -x: about 0.5 N, then 1.5 N at the hand,
   // each reached in 0.2 s and held 0.2 s. A distance taken to curve along the tube there (as a
-  // point's rolling off an edge) made the Hessian indefinite along the tube's axis, where only
-  // the coupling holds it, and 288 of the 800 ticks stopped short of the tolerance.
+  // point's rolling off an edge) would make the Hessian indefinite along the tube's axis, where
+  // only the coupling holds it, and about a third of the ticks would stop short of the tolerance.
   // As scenes/groove-steel.yaml: the linear beam and a 0.2 mm contact band.
   scene::Scene s = SteelScene();
   s.model.tube = scene::TubeModel::kLinear;
@@ -303,8 +303,8 @@ TEST_CASE("A tip dragged along a floor slides in one Newton iteration a tick", "
   // The rubber tube leaning 15 deg from the vertical, its tip pressed about 2 N onto a floor
   // with the rubber's friction, then dragged away from the lean 30 mm at 20 mm/s: the tip
   // sticks, then slides. A sliding point starts each tick at its limit; if the solve held it
-  // there with the friction spring's stiffness, every sliding tick would need two or three
-  // iterations (about half of them did).
+  // there with the friction spring's stiffness, about half the sliding ticks would need two or
+  // three iterations.
   scene::Scene s = RubberScene();
   s.friction = scene::Friction{0.7, 0.08, 2.0 / 3.0, 1.0};
   s.parts.push_back(Box("floor", {0.4, 0.4, 0.02}, {0.0, 0.0, -0.01}));
@@ -326,7 +326,7 @@ TEST_CASE("A tip dragged along a floor slides in one Newton iteration a tick", "
     ++sliding;
     if (out.iterations > 1) ++more;
   }
-  // It slides for the last part of the drag (427 ticks when this was written).
+  // It slides for the last part of the drag (427 ticks, measured).
   CHECK(sliding > 300);
   // A few ticks where the tip starts sliding or its load changes fast may take two.
   CHECK(more <= sliding / 20);
@@ -335,9 +335,9 @@ TEST_CASE("A tip dragged along a floor slides in one Newton iteration a tick", "
 TEST_CASE("A stiff tube jammed over a part's end at the device's force converges", "[core]") {
   // The steel tube tipped 15 deg down, its hand driven so low that its end passes a floor's end
   // and dips below the floor's top, the coupling at the device's force. The last element's side
-  // lies on the floor's end edge with the share that fades towards the end node nearly gone: the
-  // bend of that share, left out of the Hessian, made every tick run its 24 iterations without
-  // converging (1 ms a tick).
+  // lies on the floor's end edge with the share that fades towards the end node nearly gone: with
+  // the bend of that share left out of the Hessian, every tick would run its 24 iterations
+  // without converging (1 ms a tick).
   scene::Scene s = SteelScene();
   s.model.tube = scene::TubeModel::kLinear;
   s.contact.threshold_m = 0.2e-3;
