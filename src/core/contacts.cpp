@@ -57,10 +57,8 @@ class Finder {
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
-      // How far the held end's surface is from the part, for the solve's step (Node and Rim
-      // note the other nodes').
-      Clear(0, part.geometry.Distance(x_[0], Entry(p, 0)).distance_m);
-      // The side at the inner nodes and between them, the free end's rim and end face.
+      // The held end's section, the side at the inner nodes and between them, the free end's
+      // rim and end face; each notes its node's clearance for the solve's step.
       HeldNode(p, part);
       for (int i = 1; i < n_; ++i) Node(p, part, i);
       for (int i = 0; i < n_; ++i) Side(p, part, i);
