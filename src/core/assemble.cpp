@@ -49,7 +49,7 @@ class Assembler {
     t.gradient.noalias() = J.transpose() * g_p;
     if (hessian_) {
       const Eigen::Matrix<double, 3, 9> HJ = H_p * J;
-      t.hessian.noalias() = J.transpose() * HJ;
+      t.hessian.noalias() = J.transpose().lazyProduct(HJ);
     }
     AddStencil(t);
   }

@@ -168,7 +168,7 @@ class Finder {
     PartDistance at = part.geometry.Distance(c, Entry(p, i));
     Clear(i, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
-    MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), true);
+    MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), false);
     const double along = at.normal_W.dot(mp.tangent_W);
     const double x = (std::abs(along) - kCapStart) / kCapFade;
     const double weight = 1.0 - SmoothStep(x);
@@ -187,7 +187,8 @@ class Finder {
     if (smp != nullptr && x > 0.0 && x < 1.0) {
       // d |n.t| = sign (t^T C dx_i + n^T dt), C the distance's curvature at the node.
       const double slope = -6.0 * x * (1.0 - x) / kCapFade * (along < 0.0 ? -1.0 : 1.0);
-      smp->weight_gradient = slope * (mp.tangent_jacobian.transpose() * at.normal_W);
+      smp->weight_gradient =
+          slope * (TangentJacobian(Carrier::kInnerNode, x_, i).transpose() * at.normal_W);
       smp->weight_gradient.segment<3>(3) += slope * (curvature_per_m * mp.tangent_W);
       smp->weight_first = i - 1;
       smp->weight_nodes = 3;
@@ -202,7 +203,7 @@ class Finder {
     PartDistance at = part.geometry.Distance(x_[0], Entry(p, 0));
     Clear(0, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
-    MaterialPoint mp = Material(Carrier::kElement, x_, 0, 0.0, Vec3::Zero(), true);
+    MaterialPoint mp = Material(Carrier::kElement, x_, 0, 0.0, Vec3::Zero(), false);
     at.distance_m -= r1;
     mp.offset_W = -r1 * at.normal_W;
     mp.point_W += mp.offset_W;

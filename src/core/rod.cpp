@@ -190,22 +190,8 @@ Vec3 CarrierCentre(Carrier carrier, std::span<const Vec3> x_W, int i, double the
   return x_W[std::size_t(i)];
 }
 
-MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double theta,
-                       const Vec3& offset0_W, bool jacobian) {
-  MaterialPoint mp;
-  if (!jacobian) {
-    const Vec3 t = CarrierTangent(carrier, x_W, i);
-    const Vec3 v = offset0_W - offset0_W.dot(t) * t;
-    const double lv = v.norm();
-    mp.tangent_W = t;
-    mp.offset_W = lv > 0.0 ? Vec3(v * (offset0_W.norm() / lv)) : Vec3::Zero();
-    mp.point_W = CarrierCentre(carrier, x_W, i, theta) + mp.offset_W;
-    return mp;
-  }
-  // d t / d x_k for the stencil's nodes, and d centre / d x_k.
-  std::array<Mat3, 3> dt{Mat3::Zero(), Mat3::Zero(), Mat3::Zero()};
-  std::array<double, 3> dc{0.0, 0.0, 0.0};
-  Vec3 t;
+Eigen::Matrix<double, 3, 9> TangentJacobian(Carrier carrier, std::span<const Vec3> x_W, int i) {
+  Eigen::Matrix<double, 3, 9> dt = Eigen::Matrix<double, 3, 9>::Zero();
   switch (carrier) {
     case Carrier::kInnerNode: {
       const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
@@ -214,61 +200,64 @@ MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double
       const Vec3 a = e / le, b = f / lf;
       const Vec3 s = a + b;
       const double ls = s.norm();
-      t = s / ls;
-      const Mat3 Pt = UnitDerivative(t, ls);
+      const Mat3 Pt = UnitDerivative(s / ls, ls);
       const Mat3 Ea = UnitDerivative(a, le), Eb = UnitDerivative(b, lf);
-      dt[0] = -Pt * Ea;
-      dt[1] = Pt * (Ea - Eb);
-      dt[2] = Pt * Eb;
-      dc[1] = 1.0;
-      mp.first = i - 1;
-      mp.nodes = 3;
+      dt.block<3, 3>(0, 0) = -Pt * Ea;
+      dt.block<3, 3>(0, 3) = Pt * (Ea - Eb);
+      dt.block<3, 3>(0, 6) = Pt * Eb;
       break;
     }
-    case Carrier::kEndNode: {
-      const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
-      const double le = e.norm();
-      t = e / le;
-      const Mat3 E = UnitDerivative(t, le);
-      dt[0] = -E;
-      dt[1] = E;
-      dc[1] = 1.0;
-      mp.first = i - 1;
-      mp.nodes = 2;
-      break;
-    }
+    case Carrier::kEndNode:
     case Carrier::kElement: {
-      const Vec3 e = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
+      const int a = carrier == Carrier::kEndNode ? i - 1 : i;
+      const Vec3 e = x_W[std::size_t(a + 1)] - x_W[std::size_t(a)];
       const double le = e.norm();
-      t = e / le;
-      const Mat3 E = UnitDerivative(t, le);
-      dt[0] = -E;
-      dt[1] = E;
-      dc[0] = 1.0 - theta;
-      dc[1] = theta;
-      mp.first = i;
-      mp.nodes = 2;
+      const Mat3 E = UnitDerivative(e / le, le);
+      dt.block<3, 3>(0, 0) = -E;
+      dt.block<3, 3>(0, 3) = E;
       break;
     }
   }
+  return dt;
+}
+
+MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double theta,
+                       const Vec3& offset0_W, bool jacobian) {
   // The offset turned with the section: its part along the new tangent removed, length kept,
-  // o = |o0| v / |v| with v = (I - t t^T) o0, and its exact derivative through t.
+  // o = |o0| v / |v| with v = (I - t t^T) o0.
+  MaterialPoint mp;
+  const Vec3 t = CarrierTangent(carrier, x_W, i);
   const Vec3 v = offset0_W - offset0_W.dot(t) * t;
   const double lv = v.norm(), l0 = offset0_W.norm();
   mp.tangent_W = t;
   mp.offset_W = lv > 0.0 ? Vec3(v * (l0 / lv)) : Vec3::Zero();
   mp.point_W = CarrierCentre(carrier, x_W, i, theta) + mp.offset_W;
-  const Vec3 vh = lv > 0.0 ? Vec3(v / lv) : Vec3::Zero();
-  const Mat3 across = Mat3::Identity() - vh * vh.transpose();
-  const double scale = lv > 0.0 ? l0 / lv : 0.0;
-  const double along = t.dot(offset0_W);
-  for (int k = 0; k < mp.nodes; ++k) {
-    const Mat3& T = dt[std::size_t(k)];
-    mp.tangent_jacobian.block<3, 3>(0, 3 * k) = T;
-    mp.jacobian.block<3, 3>(0, 3 * k) =
-        dc[std::size_t(k)] * Mat3::Identity() -
-        scale * (along * across * T + t * (T.transpose() * offset0_W).transpose());
+  if (!jacobian) return mp;
+  // d point / d x_k: a point on the centre line moves with the centre's nodes alone; an offset
+  // also turns with the tangent, whose stencil starts one node before a node's.
+  const bool turns = lv > 0.0;
+  std::array<double, 3> dc{0.0, 1.0, 0.0};
+  if (carrier == Carrier::kElement) {
+    mp.first = i;
+    mp.nodes = 2;
+    dc = {1.0 - theta, theta, 0.0};
+  } else if (!turns) {
+    mp.first = i;
+    mp.nodes = 1;
+    dc = {1.0, 0.0, 0.0};
+  } else {
+    mp.first = i - 1;
+    mp.nodes = carrier == Carrier::kInnerNode ? 3 : 2;
   }
+  for (int k = 0; k < mp.nodes; ++k)
+    mp.jacobian.block<3, 3>(0, 3 * k) = dc[std::size_t(k)] * Mat3::Identity();
+  if (!turns) return mp;
+  // The offset's exact derivative through the tangent's: d o / d t = -(|o0| / |v|) (I - vh vh^T)
+  // ((t . o0) I + t o0^T), vh = v / |v|, of which (I - vh vh^T) t = t.
+  const Vec3 vh = v / lv;
+  const Mat3 across = Mat3::Identity() - vh * vh.transpose();
+  const Mat3 do_dt = -(l0 / lv) * (t.dot(offset0_W) * across + t * offset0_W.transpose());
+  mp.jacobian.noalias() += do_dt * TangentJacobian(carrier, x_W, i);
   return mp;
 }
 

@@ -60,12 +60,14 @@ struct MaterialPoint {
   int first = 0;                                       ///< first node of the stencil
   int nodes = 0;
   Eigen::Matrix<double, 3, 9> jacobian = Eigen::Matrix<double, 3, 9>::Zero();
-  /// d tangent / d nodes of the stencil.
-  Eigen::Matrix<double, 3, 9> tangent_jacobian = Eigen::Matrix<double, 3, 9>::Zero();
 };
 
 /// The tangent at a carrier (unit).
 Eigen::Vector3d CarrierTangent(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i);
+/// d tangent / d nodes of the carrier's stencil (the nodes from i - 1 at a node, from i on an
+/// element).
+Eigen::Matrix<double, 3, 9> TangentJacobian(Carrier carrier, std::span<const Eigen::Vector3d> x_W,
+                                            int i);
 Eigen::Vector3d CarrierCentre(Carrier carrier, std::span<const Eigen::Vector3d> x_W, int i,
                               double theta);
 
