@@ -35,6 +35,9 @@ void ClosestSegmentPoints(const Vec3& p0, const Vec3& p1, const Vec3& q0, const 
 
 // Where a node's sphere stops standing for the side: |n.t| from kCapStart, over kCapFade.
 constexpr double kCapStart = 0.3, kCapFade = 0.2;
+// A section's nearest direction is kept while it is within this fraction of epsilon of the
+// nearest point's distance.
+constexpr double kKeepDirection = 0.01;
 // The feature of the held end's sphere, apart from the element sides' edges (0 and up).
 constexpr int kHeldFeature = -1;
 
@@ -146,6 +149,16 @@ class Finder {
       return;
     }
     rho = NearestOnCircle(part, c, t, r1, kept, entry);
+    // A section nearly square to the part keeps last tick's direction: its points are then as
+    // near within a hundredth of epsilon, and a direction chosen afresh would swing with every
+    // small tilt (carrying the friction anchors of the rim's points with it).
+    Vec3 last = kept - kept.dot(t) * t;
+    if (last.norm() > 1e-12) {
+      last.normalize();
+      const double gain_m = part.geometry.Distance(c + r1 * last, entry).distance_m -
+                            part.geometry.Distance(c + r1 * rho, entry).distance_m;
+      if (gain_m < kKeepDirection * m_.contact.threshold_m) rho = last;
+    }
     side = t.cross(rho);
     if (keep_) {
       kept = rho;
