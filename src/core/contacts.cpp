@@ -1,7 +1,6 @@
 #include "core/contacts.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -273,10 +272,20 @@ class Finder {
       const Vec3 w = c - q;
       const double lw = w.norm();
       if (!(lw - r1 < eps) || lw == 0.0) continue;
-      const PartDistance axis = part.geometry.Distance(c, Entry(p, i));
-      if (axis.distance_m > 0.0 && ((axis.face_mask & edge.face_mask) != edge.face_mask ||
-                                    std::popcount(unsigned(axis.face_mask)) < 2))
-        continue;
+      // The edge bears where the axis point lies above both its faces' planes: its share fades
+      // in across each plane, a half where the axis point is on it (beside a face, the nodes'
+      // spheres bear).
+      double above = 1.0;
+      Vec3 d_above_dc = Vec3::Zero();
+      for (int k = 0; k < 2; ++k) {
+        const Vec3& n = edge.face_normals_W[std::size_t(k)];
+        const Vec3& n_other = edge.face_normals_W[std::size_t(1 - k)];
+        const double x = 1.0 + (c - edge.a_W).dot(n) / ramp_m;
+        const double x_other = 1.0 + (c - edge.a_W).dot(n_other) / ramp_m;
+        above *= SmoothStep(x);
+        if (x > 0.0 && x < 1.0)
+          d_above_dc += SmoothStep(x_other) * 6.0 * x * (1.0 - x) / ramp_m * n;
+      }
       // The share: s(theta) towards the nodes, times s(sin^2 phi / sin^2 20 deg) for the angle
       // phi between the element and the edge (1 against a vertex, a point).
       const bool on_line = u > 0.0 && u < 1.0;
@@ -295,7 +304,7 @@ class Finder {
                                2.0 * cross.squaredNorm() * v / (v.squaredNorm() * v.squaredNorm());
         d_across_dv = 6.0 * x * (1.0 - x) / kSin2Fade * d_sin2_dv;
       }
-      const double weight = along * across;
+      const double weight = along * across * above;
       if (weight <= 0.0) continue;
       // d theta / d (a, b): theta = -(v^T P w0) / (v^T P v), w0 = a - q, P the projector across
       // the edge's line (the identity for a vertex).
@@ -335,12 +344,20 @@ class Finder {
       mp.point_W += mp.offset_W;
       Sample* smp = Record(SampleKind::kSide, p, i, e, theta, weight, at, mp, Vec3::Zero());
       if (smp != nullptr) {
-        smp->weight_gradient.segment<3>(0) = across * d_along * d_near_a - along * d_across_dv;
-        smp->weight_gradient.segment<3>(3) = across * d_along * d_near_b + along * d_across_dv;
+        // d above / d (a, b) through c = a + theta (b - a).
+        const double v_dot = v.dot(d_above_dc);
+        const Vec3 d_above_a = (1.0 - theta) * d_above_dc + v_dot * d_theta_a;
+        const Vec3 d_above_b = theta * d_above_dc + v_dot * d_theta_b;
+        smp->weight_gradient.segment<3>(0) =
+            above * (across * d_along * d_near_a - along * d_across_dv) +
+            along * across * d_above_a;
+        smp->weight_gradient.segment<3>(3) =
+            above * (across * d_along * d_near_b + along * d_across_dv) +
+            along * across * d_above_b;
         smp->weight_first = i;
         smp->weight_nodes = 2;
         if (near_node < 1.0) {
-          smp->weight_curve = across * std::max(0.0, 6.0 - 12.0 * near_node);
+          smp->weight_curve = above * across * std::max(0.0, 6.0 - 12.0 * near_node);
           smp->weight_curve_gradient.segment<3>(0) = d_near_a;
           smp->weight_curve_gradient.segment<3>(3) = d_near_b;
         }

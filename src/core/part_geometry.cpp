@@ -47,6 +47,11 @@ BoxGeometry::BoxGeometry(const scene::BoxPart& box)
       edge.face_mask = edge.a_mask & edge.b_mask;
       edge.min_W = edge.a_W.cwiseMin(edge.b_W);
       edge.max_W = edge.a_W.cwiseMax(edge.b_W);
+      for (int k = 1; k <= 2; ++k) {
+        const int other = (axis + k) % 3;
+        edge.face_normals_W[std::size_t(k - 1)] =
+            (corner & (1 << other) ? 1.0 : -1.0) * R_WP_.col(other);
+      }
     }
   }
 }

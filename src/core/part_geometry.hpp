@@ -31,6 +31,8 @@ struct PartEdge {
   Eigen::Vector3d min_W = Eigen::Vector3d::Zero(), max_W = Eigen::Vector3d::Zero();  ///< its box
   std::uint8_t face_mask = 0;
   std::uint8_t a_mask = 0, b_mask = 0;  ///< the vertices it ends in
+  /// The outward unit normals of the two faces that meet at it.
+  std::array<Eigen::Vector3d, 2> face_normals_W{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
 
 class BoxGeometry {
