@@ -79,6 +79,7 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   for (int k = 0; k <= n; ++k)
     d.state.x_W[std::size_t(k)] =
         X_WH.translation() + (k * model.rod.segment_m) * X_WH.linear().col(2);
+  d.state.x_prev_W = d.state.x_W;
   d.state.R_WH = X_WH.linear();
   d.state.p_hand_prev_W = d.state.p_held_prev_W = X_WH.translation();
   d.state.friction_count = 0;

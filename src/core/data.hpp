@@ -99,6 +99,7 @@ inline constexpr int kMaxFrictionPoints = 256;
 /// What a tick carries to the next: the rod, the held end, the hand, friction.
 struct CarriedState {
   std::vector<Eigen::Vector3d> x_W;                    ///< nodes 0..N [m]
+  std::vector<Eigen::Vector3d> x_prev_W;               ///< the nodes a tick before [m]
   Eigen::Matrix3d R_WH = Eigen::Matrix3d::Identity();  ///< the held end's orientation
   Eigen::Vector3d p_hand_prev_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d p_held_prev_W = Eigen::Vector3d::Zero();

@@ -17,6 +17,16 @@ bool Finite(const Eigen::Isometry3d& X) {
   return X.translation().allFinite() && X.linear().allFinite();
 }
 
+// In contact, the solve starts where the tube would be if it went on moving as it did the tick
+// before, if it moved steadily then: no node by more than a quarter of the contact threshold (a
+// snap's jump, carried on, would land deep in a part).
+void PredictFromLastMotion(const Model& model, CarriedState& st) {
+  const double most_m = 0.25 * model.contact.threshold_m;
+  for (std::size_t k = 0; k < st.x_W.size(); ++k)
+    if ((st.x_W[k] - st.x_prev_W[k]).norm() > most_m) return;
+  for (std::size_t k = 0; k < st.x_W.size(); ++k) st.x_W[k] += st.x_W[k] - st.x_prev_W[k];
+}
+
 }  // namespace
 
 bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand, Data& data) {
@@ -42,6 +52,8 @@ bool StartTick(const Model& model, double t_s, const Eigen::Isometry3d& X_W_hand
     const Vec3 p_H = st.x_W[0];
     const Mat3 turn = R_new * st.R_WH.transpose();
     for (Vec3& x : st.x_W) x = p_H + hand_move + turn * (x - p_H);
+  } else if (!free) {
+    PredictFromLastMotion(model, st);
   }
   st.R_WH = R_new;
   data.input.tangent_held_W = R_new.col(2);
@@ -126,6 +138,7 @@ void EndTick(const Model& model, Data& data) {
   CarriedState& st = data.state;
   st.p_hand_prev_W = data.input.p_hand_W;
   st.p_held_prev_W = st.x_W[0];
+  std::copy(data.scratch.x_start_W.begin(), data.scratch.x_start_W.end(), st.x_prev_W.begin());
   // Where each point pressing on a part came in: kept while it is inside, so that it is pushed
   // back out that way; forgotten once it is out of contact.
   const int stride = model.rod.elements + 1;
