@@ -272,9 +272,8 @@ class Finder {
       const Vec3 w = c - q;
       const double lw = w.norm();
       if (!(lw - r1 < eps) || lw == 0.0) continue;
-      // The edge bears where the axis point lies above both its faces' planes: its share fades
-      // in across each plane, a half where the axis point is on it (beside a face, the nodes'
-      // spheres bear).
+      // The edge bears where the axis point lies in front of both its faces' planes; its share
+      // fades out over the ramp behind either plane, beside the face whose nodes' spheres bear.
       double above = 1.0;
       Vec3 d_above_dc = Vec3::Zero();
       for (int k = 0; k < 2; ++k) {
