@@ -29,6 +29,8 @@
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/synthesize.hpp>
 
 #include "commands.hpp"
@@ -343,11 +345,21 @@ int RunGraph(const GraphOptions& o, Streams io) {
 struct PlansOptions {
   GraphOptions graph;
   int k = 3;
+  bool all = false;
   std::string out_dir;
   std::string tremor = "0";
   std::string quantum = "0";
   std::string speed = "80 mm/s";
 };
+
+// Why a replay was judged infeasible: its first infeasible transition and the reason.
+std::string FirstFailure(const plan::Judgement& j) {
+  for (const plan::TransitionVerdict& v : j.transitions)
+    if (v.verdict == plan::Verdict::kInfeasible) return v.from + " -> " + v.to + ": " + v.reason;
+  if (j.after_goal.started && j.after_goal.verdict == plan::Verdict::kInfeasible)
+    return j.after_goal.reason;
+  return j.transitions.empty() ? "the trajectory did not load" : "no transition judged";
+}
 
 int RunPlans(const PlansOptions& o, Streams io) {
   // Quantities first: a typo should not cost an exploration.
@@ -431,56 +443,94 @@ int RunPlans(const PlansOptions& o, Streams io) {
   synthesis.peak_speed_m_per_s = speed_m_per_s;
   synthesis.tremor_m = tremor_m;
   synthesis.quantum_m = quantum_m;
+  // Each path's plan and trajectory, replayed through evaluate's judge as its file will read.
+  struct Candidate {
+    const graph::Path* path = nullptr;
+    plan::Plan plan;
+    std::string csv;
+    double duration_s = 0.0;
+    plan::Judgement judgement;
+  };
+  std::vector<Candidate> candidates;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    Candidate c;
+    c.path = &paths[i];
+    // Waypoints: the scene's start pose, then the hand at each later state's witness.
+    std::vector<Eigen::Isometry3d> waypoints = {b.scene.X_WH_start};
+    for (std::size_t j = 0; j < c.path->nodes.size(); ++j) {
+      const graph::Node& n = g.nodes[std::size_t(c.path->nodes[j])];
+      c.plan.states.push_back(n.cf);
+      if (j > 0) waypoints.push_back(n.X_W_hand);
+    }
+    c.plan.scene = scene_rel;
+    c.plan.limits.max_force_N = b.scene.device.max_force_N;
+    c.plan.limits.dwell_s = b.explore.dwell_s;
+    synthesis.seed = o.graph.seed + i;
+    const plan::Trajectory trajectory = plan::SynthesizeTrajectory(waypoints, synthesis);
+    c.duration_s = trajectory.samples.back().t_s;
+    c.csv = io::FormatTrajectoryCsv(trajectory);
+    const io::TrajectoryLoadResult as_read = io::LoadTrajectoryText(c.csv, "candidate");
+    if (as_read.trajectory)
+      c.judgement = plan::Judge(b.scene, *as_read.trajectory, c.plan.states, c.plan.limits);
+    candidates.push_back(std::move(c));
+  }
+  // The feasible first, each kind in order of cost.
+  std::stable_partition(candidates.begin(), candidates.end(),
+                        [](const Candidate& c) { return c.judgement.feasible; });
+  const auto feasible = std::count_if(candidates.begin(), candidates.end(),
+                                      [](const Candidate& c) { return c.judgement.feasible; });
+
   std::ostringstream t;
   t << std::setprecision(3);
   t << paths.size() << " candidate plan" << (paths.size() == 1 ? "" : "s") << " (of " << o.k
     << " asked) through the pruned graph of " << b.scene.name << " (" << g.nodes.size() << " CFs, "
     << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
-    << " kept arcs), written to " << out_dir.string() << ":\n";
+    << " kept arcs), each replayed as `evaluate` would: " << feasible << " feasible"
+    << (o.all || feasible == 0 || feasible == long(candidates.size())
+            ? ""
+            : " (the others are not written; --all writes them, marked)")
+    << "; written to " << out_dir.string() << ":\n";
   // Fewer than asked: the pruned graph holds no more loopless paths to the goal.
   if (static_cast<int>(paths.size()) < o.k)
     t << "  (the pruned graph has no other loopless path from the start to the goal: a larger "
          "--tolerance keeps more arcs, a larger --budget explores more states)\n";
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    const graph::Path& path = paths[i];
-    const std::string name = b.scene.name + "-candidate-" + std::to_string(i + 1);
-    // Waypoints: the scene's start pose, then the hand at each later state's witness.
-    std::vector<Eigen::Isometry3d> waypoints = {b.scene.X_WH_start};
-    plan::Plan p;
-    p.name = name;
-    p.scene = scene_rel;
-    p.trajectory = name + ".csv";
-    for (std::size_t j = 0; j < path.nodes.size(); ++j) {
-      const graph::Node& n = g.nodes[std::size_t(path.nodes[j])];
-      p.states.push_back(n.cf);
-      if (j > 0) waypoints.push_back(n.X_W_hand);
-    }
-    p.limits.max_force_N = b.scene.device.max_force_N;
-    p.limits.dwell_s = b.explore.dwell_s;
-    synthesis.seed = o.graph.seed + i;
-    const plan::Trajectory trajectory = plan::SynthesizeTrajectory(waypoints, synthesis);
-    std::ostringstream comment;
-    comment << "Candidate " << i + 1 << " of " << paths.size() << " made by `tubeplan plans "
-            << o.graph.scene_path << "` (seed " << o.graph.seed << "), cost " << path.cost
-            << ": the hand moves by minimum jerk through the witnesses of its states.";
-    p.comment = comment.str();
-    for (const auto& [file, text] :
-         {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(p)},
-          std::pair{out_dir / p.trajectory, io::FormatTrajectoryCsv(trajectory)}}) {
-      if (const std::string e = io::WriteTextFileAtomically(file, text); !e.empty()) {
-        io.err << file.string() << ": error: " << e << "\n";
-        return kExitBadInput;
+  int written = 0;
+  for (Candidate& c : candidates) {
+    const bool write = c.judgement.feasible || o.all;
+    const std::string verdict =
+        c.judgement.feasible ? std::string("feasible") : "infeasible: " + FirstFailure(c.judgement);
+    std::string name = "(not written)";
+    if (write) {
+      name = b.scene.name + "-candidate-" + std::to_string(++written);
+      c.plan.name = name;
+      c.plan.trajectory = name + ".csv";
+      std::ostringstream comment;
+      comment << "Candidate " << written << " made by `tubeplan plans " << o.graph.scene_path
+              << "` (seed " << o.graph.seed << "), cost " << c.path->cost
+              << ": the hand moves by minimum jerk through the witnesses of its states. Replayed "
+                 "when made: "
+              << verdict << ".";
+      c.plan.comment = comment.str();
+      for (const auto& [file, text] :
+           {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(c.plan)},
+            std::pair{out_dir / c.plan.trajectory, c.csv}}) {
+        if (const std::string e = io::WriteTextFileAtomically(file, text); !e.empty()) {
+          io.err << file.string() << ": error: " << e << "\n";
+          return kExitBadInput;
+        }
       }
     }
-    t << "  " << name << ": cost " << path.cost << ", " << path.nodes.size() - 1
-      << (path.nodes.size() == 2 ? " transition, " : " transitions, ")
-      << trajectory.samples.back().t_s << " s:";
-    for (const std::string& state : p.states)
-      t << " " << state << (&state == &p.states.back() ? "" : " ->");
-    t << "\n";
+    t << "  " << name << ": cost " << c.path->cost << ", " << c.path->nodes.size() - 1
+      << (c.path->nodes.size() == 2 ? " transition, " : " transitions, ") << c.duration_s << " s:";
+    for (const std::string& state : c.plan.states)
+      t << " " << state << (&state == &c.plan.states.back() ? "" : " ->");
+    t << "; " << verdict << "\n";
   }
+  if (feasible == 0)
+    t << "  no candidate replays feasible: a slower --speed, a larger --budget or a larger "
+         "--tolerance may give one; --all writes them for inspection\n";
   io.out << t.str();
-  return kExitOk;
+  return feasible > 0 ? kExitOk : kExitNegative;
 }
 
 }  // namespace
@@ -514,14 +564,18 @@ Command AddPlansCommand(CLI::App& app, Streams streams) {
   auto options = std::make_shared<PlansOptions>();
   CLI::App* sub = app.add_subcommand(
       "plans",
-      "Build and prune the scene's contact-state graph, then write the k best start -> goal paths "
-      "as plan files, each with a synthesized (minimum-jerk) operator trajectory.");
+      "Build and prune the scene's contact-state graph, then take the k best start -> goal paths, "
+      "each with a synthesized (minimum-jerk) operator trajectory, replay each as `evaluate` "
+      "would, and write the feasible ones as plan files.");
   sub->add_option("scene", options->graph.scene_path, "scene file (.yaml)")->required();
   sub->add_option("--k", options->k, "how many plans")
       ->check(CLI::Range(1, 100))
       ->capture_default_str();
   sub->add_option("--out-dir", options->out_dir,
                   "where to write NAME-candidate-I.yaml and .csv (default: SCENE_NAME-plans)");
+  sub->add_flag("--all", options->all,
+                "also write the candidates whose replay is infeasible (after the feasible ones, "
+                "their comment saying why)");
   sub->add_option("--speed", options->speed, "peak hand speed, e.g. \"80 mm/s\"")
       ->capture_default_str();
   sub->add_option("--tremor", options->tremor,

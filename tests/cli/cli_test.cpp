@@ -57,12 +57,18 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
                              "100", "--jobs", "2", "--out-dir", dir});
   INFO(r.err);
   REQUIRE(r.exit_code == 0);
-  // Up to k: a small exploration's pruned graph may hold fewer ways to the goal.
+  // Up to k: a small exploration's pruned graph may hold fewer ways to the goal; the written
+  // ones are those whose replay was feasible, and evaluate judges their files the same.
   REQUIRE(r.out.find("groove-candidate-1: cost") != std::string::npos);
+  const Outcome judged = RunTool({"evaluate", dir});
+  INFO(judged.out);
+  CHECK(judged.exit_code == 0);
   for (const std::string name : {"groove-candidate-1", "groove-candidate-2"}) {
     if (r.out.find(name + ": cost") == std::string::npos) continue;
     const std::string yaml = dir + "/" + name + ".yaml";
     REQUIRE(std::filesystem::exists(yaml));
+    const std::size_t line = r.out.find(name + ": cost");
+    CHECK(r.out.substr(line, r.out.find('\n', line) - line).ends_with("; feasible"));
     const Outcome check = RunTool({"check", dir + "/" + name + ".csv"});
     CHECK(check.exit_code == 0);
     std::ifstream in(yaml);
