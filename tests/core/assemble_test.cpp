@@ -30,6 +30,14 @@ scene::BoxPart Cube(const std::string& name, double size_m, const Eigen::Vector3
   return b;
 }
 
+// The scene's model and its data at the start pose, as a Core builds them, without a tick.
+void Build(const scene::Scene& s, core::Model& model, core::Data& data) {
+  std::vector<scene::PartElement> elements;
+  std::vector<std::uint32_t> reachable;
+  core::BuildModel(s, model, elements, reachable);
+  core::InitData(model, s.X_WH_start, data);
+}
+
 }  // namespace
 
 TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core][gradient]") {
@@ -67,11 +75,8 @@ TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core]
              std::atan2(tangent(l).x(), tangent(l).z()))};
     s.X_WH_start = Eigen::Isometry3d::Identity();
     core::Model model;
-    std::vector<scene::PartElement> elements;
-    std::vector<std::uint32_t> reachable;
-    core::BuildModel(s, model, elements, reachable);
     core::Data data;
-    core::InitData(model, s.X_WH_start, data);
+    Build(s, model, data);
     const int n = model.rod.elements;
     std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
     for (int k = 0; k <= n; ++k) {
@@ -138,11 +143,8 @@ TEST_CASE("An element's side on an edge bears continuously across the edge's fac
   wall.X_WP.translation() = Eigen::Vector3d(-half - 0.05, 0.0, 0.045 + height / 2);
   s.parts = {wall};
   core::Model model;
-  std::vector<scene::PartElement> elements;
-  std::vector<std::uint32_t> reachable;
-  core::BuildModel(s, model, elements, reachable);
   core::Data data;
-  core::InitData(model, s.X_WH_start, data);
+  Build(s, model, data);
   const int n = model.rod.elements;
   std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
   std::vector<double> energy_J;
