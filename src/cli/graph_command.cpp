@@ -30,8 +30,7 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/judge.hpp>
-#include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/plan/candidates.hpp>
 
 #include "commands.hpp"
 #include "graph_json.hpp"
@@ -353,14 +352,6 @@ struct PlansOptions {
 };
 
 // Why a replay was judged infeasible: its first infeasible transition and the reason.
-std::string FirstFailure(const plan::Judgement& j) {
-  for (const plan::TransitionVerdict& v : j.transitions)
-    if (v.verdict == plan::Verdict::kInfeasible) return v.from + " -> " + v.to + ": " + v.reason;
-  if (j.after_goal.started && j.after_goal.verdict == plan::Verdict::kInfeasible)
-    return j.after_goal.reason;
-  return j.transitions.empty() ? "the trajectory did not load" : "no transition judged";
-}
-
 int RunPlans(const PlansOptions& o, Streams io) {
   // Quantities first: a typo should not cost an exploration.
   double tremor_m = 0.0, quantum_m = 0.0, speed_m_per_s = 0.0;
@@ -439,46 +430,24 @@ int RunPlans(const PlansOptions& o, Streams io) {
   }
   const std::string scene_rel =
       fs::relative(fs::absolute(o.graph.scene_path), fs::absolute(out_dir), ec).generic_string();
-  plan::SynthesisOptions synthesis;
-  synthesis.peak_speed_m_per_s = speed_m_per_s;
-  synthesis.tremor_m = tremor_m;
-  synthesis.quantum_m = quantum_m;
-  // Each path's plan and trajectory, replayed through evaluate's judge as its file will read.
-  struct Candidate {
-    const graph::Path* path = nullptr;
-    plan::Plan plan;
-    std::string csv;
-    double duration_s = 0.0;
-    plan::Judgement judgement;
-  };
-  std::vector<Candidate> candidates;
-  for (std::size_t i = 0; i < paths.size(); ++i) {
-    Candidate c;
-    c.path = &paths[i];
-    // Waypoints: the scene's start pose, then the hand at each later state's witness.
-    std::vector<Eigen::Isometry3d> waypoints = {b.scene.X_WH_start};
-    for (std::size_t j = 0; j < c.path->nodes.size(); ++j) {
-      const graph::Node& n = g.nodes[std::size_t(c.path->nodes[j])];
-      c.plan.states.push_back(n.cf);
-      if (j > 0) waypoints.push_back(n.X_W_hand);
-    }
-    c.plan.scene = scene_rel;
-    c.plan.limits.max_force_N = b.scene.device.max_force_N;
-    c.plan.limits.dwell_s = b.explore.dwell_s;
-    synthesis.seed = o.graph.seed + i;
-    const plan::Trajectory trajectory = plan::SynthesizeTrajectory(waypoints, synthesis);
-    c.duration_s = trajectory.samples.back().t_s;
-    c.csv = io::FormatTrajectoryCsv(trajectory);
-    const io::TrajectoryLoadResult as_read = io::LoadTrajectoryText(c.csv, "candidate");
-    if (as_read.trajectory)
-      c.judgement = plan::Judge(b.scene, *as_read.trajectory, c.plan.states, c.plan.limits);
-    candidates.push_back(std::move(c));
-  }
-  // The feasible first, each kind in order of cost.
-  std::stable_partition(candidates.begin(), candidates.end(),
-                        [](const Candidate& c) { return c.judgement.feasible; });
-  const auto feasible = std::count_if(candidates.begin(), candidates.end(),
-                                      [](const Candidate& c) { return c.judgement.feasible; });
+  plan::CandidateOptions candidate_options;
+  candidate_options.synthesis.peak_speed_m_per_s = speed_m_per_s;
+  candidate_options.synthesis.tremor_m = tremor_m;
+  candidate_options.synthesis.quantum_m = quantum_m;
+  candidate_options.synthesis.seed = o.graph.seed;
+  candidate_options.dwell_s = b.explore.dwell_s;
+  candidate_options.scene_ref = scene_rel;
+  // Each replayed as its file will read: what `evaluate` on the written plan sees.
+  std::vector<plan::Candidate> candidates =
+      plan::MakeCandidates(b.scene, g, paths, candidate_options,
+                           [](const plan::Trajectory& t) -> std::optional<plan::Trajectory> {
+                             io::TrajectoryLoadResult read =
+                                 io::LoadTrajectoryText(io::FormatTrajectoryCsv(t), "candidate");
+                             return std::move(read.trajectory);
+                           });
+  const auto feasible =
+      std::count_if(candidates.begin(), candidates.end(),
+                    [](const plan::Candidate& c) { return c.judgement.feasible; });
 
   std::ostringstream t;
   t << std::setprecision(3);
@@ -495,10 +464,17 @@ int RunPlans(const PlansOptions& o, Streams io) {
     t << "  (the pruned graph has no other loopless path from the start to the goal: a larger "
          "--tolerance keeps more arcs, a larger --budget explores more states)\n";
   int written = 0;
-  for (Candidate& c : candidates) {
+  for (plan::Candidate& c : candidates) {
     const bool write = c.judgement.feasible || o.all;
-    const std::string verdict =
-        c.judgement.feasible ? std::string("feasible") : "infeasible: " + FirstFailure(c.judgement);
+    std::ostringstream verdict_text;
+    verdict_text << std::setprecision(3)
+                 << (c.judgement.feasible ? "feasible"
+                                          : "infeasible: " + plan::FirstFailure(c.judgement));
+    if (c.tries > 1)
+      verdict_text << " (at " << c.peak_speed_m_per_s * 1e3 << " mm/s after " << c.tries - 1
+                   << (c.tries == 2 ? " slower try" : " slower tries") << ")";
+    verdict_text << "; peak operator force " << c.judgement.peak_force_N << " N";
+    const std::string verdict = verdict_text.str();
     std::string name = "(not written)";
     if (write) {
       name = b.scene.name + "-candidate-" + std::to_string(++written);
@@ -513,7 +489,7 @@ int RunPlans(const PlansOptions& o, Streams io) {
       c.plan.comment = comment.str();
       for (const auto& [file, text] :
            {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(c.plan)},
-            std::pair{out_dir / c.plan.trajectory, c.csv}}) {
+            std::pair{out_dir / c.plan.trajectory, io::FormatTrajectoryCsv(c.trajectory)}}) {
         if (const std::string e = io::WriteTextFileAtomically(file, text); !e.empty()) {
           io.err << file.string() << ": error: " << e << "\n";
           return kExitBadInput;
@@ -527,8 +503,8 @@ int RunPlans(const PlansOptions& o, Streams io) {
     t << "; " << verdict << "\n";
   }
   if (feasible == 0)
-    t << "  no candidate replays feasible: a slower --speed, a larger --budget or a larger "
-         "--tolerance may give one; --all writes them for inspection\n";
+    t << "  no candidate replays feasible, each also tried at 1/2 and 1/4 of --speed: a larger "
+         "--budget or a larger --tolerance may give one; --all writes them for inspection\n";
   io.out << t.str();
   return feasible > 0 ? kExitOk : kExitNegative;
 }

@@ -68,7 +68,13 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
     const std::string yaml = dir + "/" + name + ".yaml";
     REQUIRE(std::filesystem::exists(yaml));
     const std::size_t line = r.out.find(name + ": cost");
-    CHECK(r.out.substr(line, r.out.find('\n', line) - line).ends_with("; feasible"));
+    const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
+    // Feasible at the asked speed, with the peak force that evaluate finds on its files.
+    const std::string peak = "; feasible; peak operator force ";
+    REQUIRE(said.find(peak) != std::string::npos);
+    const std::string newtons = said.substr(said.find(peak) + peak.size());
+    CHECK(newtons.ends_with(" N"));
+    CHECK(judged.out.find("peak force " + newtons) != std::string::npos);
     const Outcome check = RunTool({"check", dir + "/" + name + ".csv"});
     CHECK(check.exit_code == 0);
     std::ifstream in(yaml);

@@ -1,0 +1,55 @@
+#pragma once
+// Candidate plans from paths through the contact-state graph: the hand moves by minimum jerk
+// through the witnesses of each path's states, and every candidate is replayed through the same
+// judge as `evaluate`. A candidate that replays infeasible is tried again at slower speeds before
+// it is given up (docs/graph.md, "Plans").
+
+#include <functional>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <tubeplan/graph/contact_graph.hpp>
+#include <tubeplan/graph/paths.hpp>
+#include <tubeplan/plan/judge.hpp>
+#include <tubeplan/plan/plan.hpp>
+#include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/scene/scene.hpp>
+
+namespace tubeplan::plan {
+
+struct CandidateOptions {
+  SynthesisOptions synthesis;  ///< the first try's; its seed is offset by the path's rank
+  double dwell_s = 0.0;        ///< the plans' dwell (the explorer's)
+  std::string scene_ref;       ///< the scene as the plan files name it
+  /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
+  /// less): the first try is at the asked speed.
+  std::vector<double> slower = {2.0, 4.0};
+};
+
+struct Candidate {
+  const graph::Path* path = nullptr;
+  Plan plan;  ///< name, trajectory and comment left to the writer
+  Trajectory trajectory;
+  double duration_s = 0.0;
+  double peak_speed_m_per_s = 0.0;  ///< of the try kept
+  int tries = 0;                    ///< 1 when the first was kept
+  Judgement judgement;
+};
+
+/// The trajectory as its file will read it back (rounded as written), or nothing if it would
+/// not load: what the verdict is taken on, so that `evaluate` on the written files agrees.
+using AsWritten = std::function<std::optional<Trajectory>(const Trajectory&)>;
+
+/// One candidate for each path (in order), each the first try that replays feasible or else the
+/// last; the feasible come first, each kind in the paths' order.
+std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
+                                      std::span<const graph::Path> paths,
+                                      const CandidateOptions& options, const AsWritten& as_written);
+
+/// "FROM -> TO: reason" of the first infeasible transition, or what stopped the judgement.
+std::string FirstFailure(const Judgement& judgement);
+
+}  // namespace tubeplan::plan

@@ -1,0 +1,63 @@
+#include <algorithm>
+
+#include <tubeplan/plan/candidates.hpp>
+
+namespace tubeplan::plan {
+
+namespace {
+
+// The hand's poses: the scene's start, then the hand at each later state's witness.
+std::vector<Eigen::Isometry3d> Waypoints(const scene::Scene& scene,
+                                         const graph::ContactGraph& graph,
+                                         const graph::Path& path) {
+  std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
+  for (std::size_t j = 1; j < path.nodes.size(); ++j)
+    waypoints.push_back(graph.nodes[std::size_t(path.nodes[j])].X_W_hand);
+  return waypoints;
+}
+
+}  // namespace
+
+std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
+                                      std::span<const graph::Path> paths,
+                                      const CandidateOptions& options,
+                                      const AsWritten& as_written) {
+  std::vector<Candidate> candidates;
+  for (std::size_t i = 0; i < paths.size(); ++i) {
+    Candidate c;
+    c.path = &paths[i];
+    for (const int n : c.path->nodes) c.plan.states.push_back(graph.nodes[std::size_t(n)].cf);
+    c.plan.scene = options.scene_ref;
+    c.plan.limits.max_force_N = scene.device.max_force_N;
+    c.plan.limits.dwell_s = options.dwell_s;
+    const std::vector<Eigen::Isometry3d> waypoints = Waypoints(scene, graph, *c.path);
+    // The asked speed, then each slower one until a replay is feasible.
+    SynthesisOptions synthesis = options.synthesis;
+    synthesis.seed = options.synthesis.seed + i;
+    for (std::size_t k = 0; k <= options.slower.size(); ++k) {
+      if (k > 0)
+        synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s / options.slower[k - 1];
+      c.trajectory = SynthesizeTrajectory(waypoints, synthesis);
+      c.duration_s = c.trajectory.samples.back().t_s;
+      c.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
+      c.tries = int(k) + 1;
+      const std::optional<Trajectory> read = as_written(c.trajectory);
+      c.judgement = read ? Judge(scene, *read, c.plan.states, c.plan.limits) : Judgement{};
+      if (c.judgement.feasible) break;
+    }
+    candidates.push_back(std::move(c));
+  }
+  std::stable_partition(candidates.begin(), candidates.end(),
+                        [](const Candidate& c) { return c.judgement.feasible; });
+  return candidates;
+}
+
+std::string FirstFailure(const Judgement& j) {
+  for (const TransitionVerdict& v : j.transitions)
+    if (v.verdict == Verdict::kInfeasible) return v.from + " -> " + v.to + ": " + v.reason;
+  if (j.after_goal.started && j.after_goal.verdict == Verdict::kInfeasible)
+    return j.after_goal.reason;
+  return j.transitions.empty() ? "the trajectory did not load" : "no transition judged";
+}
+
+}  // namespace tubeplan::plan

@@ -1,0 +1,74 @@
+// Candidate plans made from graph paths: each is replayed through the judge, a candidate that
+// fails is tried again slower, and the feasible come first.
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/plan/candidates.hpp>
+
+namespace {
+
+using namespace tubeplan;
+
+// The groove's start and goal as a two-node graph whose goal witness has the hand at height z
+// over the floor with the tube turned as the shipped lay-flat plan ends.
+graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m) {
+  graph::ContactGraph g;
+  g.nodes.resize(2);
+  g.nodes[0].cf = "{}";
+  g.nodes[0].X_W_hand = scene.X_WH_start;
+  g.nodes[1].cf = "{Fs - floor.top}";
+  g.nodes[1].X_W_hand.linear() =
+      Eigen::Quaterniond(0.737277337, -0.675590208, 0.0, 0.0).toRotationMatrix();
+  g.nodes[1].X_W_hand.translation() = Eigen::Vector3d(0.0, -0.09, hand_z_m);
+  g.start = 0;
+  g.goal = 1;
+  return g;
+}
+
+}  // namespace
+
+TEST_CASE("Candidates: a failing one is retried slower and the feasible are put first", "[plan]") {
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  // One graph, two witnesses of the goal: the lay-flat plan's hand pose (8.16 mm over the floor)
+  // and the same 40 mm lower, which drives the hand through the floor to the device's limit.
+  graph::ContactGraph g = LayFlatGraph(scene, 0.00816);
+  g.nodes.push_back(LayFlatGraph(scene, 0.00816 - 0.040).nodes[1]);
+  const std::vector<graph::Path> paths = {{{0, 2}, 1.0}, {{0, 1}, 2.0}};
+  plan::CandidateOptions options;
+  options.synthesis.peak_speed_m_per_s = 0.08;
+  options.dwell_s = 0.02;
+  options.scene_ref = "groove.yaml";
+  int replays = 0;
+  const std::vector<plan::Candidate> c =
+      plan::MakeCandidates(scene, g, paths, options, [&](const plan::Trajectory& t) {
+        ++replays;
+        return std::optional<plan::Trajectory>(t);
+      });
+  REQUIRE(c.size() == 2);
+  // The reachable witness replays feasible at the asked speed, and comes first.
+  CHECK(c[0].path == &paths[1]);
+  CHECK(c[0].judgement.feasible);
+  CHECK(c[0].tries == 1);
+  CHECK(c[0].peak_speed_m_per_s == 0.08);
+  CHECK(c[0].judgement.peak_force_N < scene.device.max_force_N);
+  CHECK(c[0].plan.states == std::vector<std::string>{"{}", "{Fs - floor.top}"});
+  // The other is tried at 1/2 and 1/4 of the speed and kept infeasible, at the device's limit,
+  // with the slowest try's longer trajectory.
+  CHECK(c[1].path == &paths[0]);
+  CHECK_FALSE(c[1].judgement.feasible);
+  CHECK(c[1].tries == 3);
+  CHECK(c[1].peak_speed_m_per_s == Approx(0.02));
+  CHECK(c[1].duration_s > 2.0 * c[0].duration_s);
+  CHECK(c[1].judgement.peak_force_N == Approx(scene.device.max_force_N));
+  // Its reason is the judge's, not a load failure (pushed through the floor, the tube leaves
+  // the goal's lying-flat state).
+  const std::string failure = plan::FirstFailure(c[1].judgement);
+  CHECK(failure.find("after the goal") != std::string::npos);
+  CHECK(replays == 4);
+}
