@@ -31,6 +31,7 @@ TubeElement TubeElementOf(const Model& model, const Data& data, const Sample& s)
   switch (s.kind) {
     case SampleKind::kNode:
     case SampleKind::kSide:
+    case SampleKind::kCurve:
       return TubeElement::kSide;
     case SampleKind::kEndFace:
       return TubeElement::kEndFace;
@@ -44,6 +45,7 @@ TubeElement TubeElementOf(const Model& model, const Data& data, const Sample& s)
 
 double ArcOf(const Model& model, const Sample& s) {
   if (s.kind == SampleKind::kSide) return (s.node + s.theta) * model.rod.segment_m;
+  if (s.kind == SampleKind::kCurve) return (s.node - 0.5 + s.theta) * model.rod.segment_m;
   return s.node * model.rod.segment_m;
 }
 

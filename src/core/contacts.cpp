@@ -10,6 +10,7 @@ namespace tubeplan::core {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
 
 // Closest points of segments [p0, p1] and [q0, q1]: parameters (s, u) in [0, 1] (Ericson,
 // Real-Time Collision Detection, 5.1.9).
@@ -37,6 +38,9 @@ constexpr double kCapStart = 0.3, kCapFade = 0.2;
 // A section's nearest direction is kept while it is within this fraction of epsilon of the
 // nearest point's distance.
 constexpr double kKeepDirection = 0.01;
+// The fraction of a curve piece at either end over which its node's sphere takes back the share
+// it yields to the piece (YieldNode).
+constexpr double kPieceEnd = 0.1;
 // The feature of the held end's sphere, apart from the element sides' edges (0 and up).
 constexpr int kHeldFeature = -1;
 
@@ -44,6 +48,73 @@ constexpr int kHeldFeature = -1;
 double SmoothStep(double a) {
   a = std::clamp(a, 0.0, 1.0);
   return a * a * (3.0 - 2.0 * a);
+}
+
+// How far point c lies in front of both the edge's face planes (where the edge is the part's
+// nearest feature): 1 there, fading to 0 over ramp_m behind either plane; and its gradient.
+double InFrontOfFaces(const PartEdge& edge, const Vec3& c, double ramp_m, Vec3& gradient) {
+  double front = 1.0;
+  gradient.setZero();
+  for (int k = 0; k < 2; ++k) {
+    const Vec3& n = edge.face_normals_W[std::size_t(k)];
+    const Vec3& n_other = edge.face_normals_W[std::size_t(1 - k)];
+    const double x = 1.0 + (c - edge.a_W).dot(n) / ramp_m;
+    const double x_other = 1.0 + (c - edge.a_W).dot(n_other) / ramp_m;
+    front *= SmoothStep(x);
+    if (x > 0.0 && x < 1.0) gradient += SmoothStep(x_other) * 6.0 * x * (1.0 - x) / ramp_m * n;
+  }
+  return front;
+}
+
+// How square the tube's direction v (any length) crosses the edge's unit direction: s(sin^2 phi /
+// sin^2 20 deg), 1 from 20 degrees on; and its gradient in v. Below, the node spheres bear the
+// edge as a line along the tube.
+double Across(const Vec3& v, const Vec3& unit, Vec3& gradient) {
+  constexpr double kSin2Fade = 0.116977778440511;  // sin^2 20 deg
+  const Vec3 cross = v.cross(unit);
+  const double v2 = v.squaredNorm();
+  const double sin2 = cross.squaredNorm() / v2;
+  const double x = std::clamp(sin2 / kSin2Fade, 0.0, 1.0);
+  const Vec3 d_sin2_dv = 2.0 * unit.cross(cross) / v2 - 2.0 * cross.squaredNorm() * v / (v2 * v2);
+  gradient = 6.0 * x * (1.0 - x) / kSin2Fade * d_sin2_dv;
+  return SmoothStep(x);
+}
+
+// The parameter in [0, 1] of a curve piece's point (nodes x0, x1, x2; CurveWeights) nearest the
+// line through `from` along unit `dir` (zero: the point `from`), by Newton's method from `theta`
+// on the squared distance. Also its first and second derivatives there (halved): a minimum inside
+// the piece has slope 0 and curvature > 0; at an end, a slope that is not 0 says it was clamped.
+double NearestOnPiece(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& from,
+                      const Vec3& dir, double theta, double& slope, double& curvature) {
+  const Mat3 Q = Mat3::Identity() - dir * dir.transpose();
+  const Vec3 second = Q * (x0 - 2.0 * x1 + x2);
+  curvature = 0.0;
+  for (int k = 0; k < 16; ++k) {
+    const std::array<double, 3> w = CurveWeights(theta), dw = CurveSlopes(theta);
+    const Vec3 r = Q * (w[0] * x0 + w[1] * x1 + w[2] * x2 - from);
+    const Vec3 t = Q * (dw[0] * x0 + dw[1] * x1 + dw[2] * x2);
+    slope = r.dot(t);
+    curvature = t.squaredNorm() + r.dot(second);
+    if (std::abs(slope) <= 1e-12 * r.norm() * t.norm()) slope = 0.0;
+    // Where the distance curves the wrong way, a step towards the nearer end.
+    const double step =
+        curvature > 1e-12 * t.squaredNorm() ? -slope / curvature : (slope > 0.0 ? -0.25 : 0.25);
+    const double next = std::clamp(theta + step, 0.0, 1.0);
+    const bool done = std::abs(next - theta) < 1e-12;
+    theta = next;
+    if (done) break;
+  }
+  return theta;
+}
+
+// Whether the piece's point nearest the target (NearestOnPiece from `guess`) is a minimum that
+// belongs to the piece: inside it, or at its start where the piece before ends (so that a point
+// where two pieces meet is borne once); its parameter and the distance's curvature there.
+bool InsidePiece(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& from, const Vec3& dir,
+                 double guess, double& theta, double& curvature) {
+  double slope = 0.0;
+  theta = NearestOnPiece(x0, x1, x2, from, dir, guess, slope, curvature);
+  return theta >= 0.0 && theta < 1.0 && !(theta == 0.0 && slope != 0.0) && curvature > 0.0;
 }
 
 class Finder {
@@ -59,11 +130,14 @@ class Finder {
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
-      // The held end's section, the side at the inner nodes and between them, the free end's
-      // rim and end face; each notes its node's clearance for the solve's step.
+      // The held end's section, the spheres at the inner nodes, the end elements' outer halves
+      // and the smooth side between them against edges, the free end's rim and end face; each
+      // notes its node's clearance for the solve's step.
       HeldNode(p, part);
       for (int i = 1; i < n_; ++i) Node(p, part, i);
-      for (int i = 0; i < n_; ++i) Side(p, part, i);
+      Side(p, part, 0);
+      if (n_ > 1) Side(p, part, n_ - 1);
+      for (int i = 1; i < n_; ++i) Curve(p, part, i);
       Rim(p, part);
       EndFace(p, part);
     }
@@ -181,6 +255,7 @@ class Finder {
     Clear(i, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
     MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), false);
+    mp.tangent_W = CarrierTangent(Carrier::kInnerNode, x_, i);
     const double along = at.normal_W.dot(mp.tangent_W);
     const double x = (std::abs(along) - kCapStart) / kCapFade;
     const double weight = 1.0 - SmoothStep(x);
@@ -244,20 +319,27 @@ class Finder {
     }
   }
 
-  // The side surface between nodes i and i + 1, a cylinder, against the part's edges: where the
-  // element's axis comes nearest an edge (or a vertex it ends in) inside the element, and that
-  // edge is the part's nearest feature there. Its share of K fades out towards the nodes, whose
-  // spheres carry it there, and as the element turns parallel to the edge (the spheres then are
-  // as near): the share's derivatives go into the gradient with it.
+  // The length over which an edge's share fades towards the tube's ends and behind the edge's
+  // face planes.
+  double Ramp() const { return std::min(0.25 * m_.rod.outer_radius_m, 0.5 * m_.rod.segment_m); }
+
+  // The side surface of an end element's outer half (between the tube's end node and the middle
+  // of the element, where the smooth centreline's pieces take over: Curve), a cylinder, against
+  // the part's edges: where the element's axis comes nearest an edge (or a vertex it ends in)
+  // there, in front of the edge's face planes. Its share of K fades out towards the end node,
+  // whose sphere or rim bears there, and as the element turns parallel to the edge (the spheres
+  // then are as near): the share's derivatives go into the gradient with it.
   void Side(int p, const PartModel& part, int i) {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& a = x_[std::size_t(i)];
     const Vec3& b = x_[std::size_t(i + 1)];
     const Vec3 lo = a.cwiseMin(b).array() - (r1 + eps), hi = a.cwiseMax(b).array() + (r1 + eps);
     const Vec3 v = b - a;
-    // The length over which the share fades towards a node.
-    const double ramp_m = std::min(0.25 * r1, 0.5 * m_.rod.segment_m);
+    const double ramp_m = Ramp();
     const double lv = v.norm();
+    // The half at the held end (i = 0), the free end (i = N - 1), or both for a single element.
+    const double theta_lo = i == n_ - 1 && n_ > 1 ? 0.5 : 0.0;
+    const double theta_hi = i == 0 && n_ > 1 ? 0.5 : 1.0;
     const auto& edges = part.geometry.edges();
     for (int e = 0; e < int(edges.size()); ++e) {
       const PartEdge& edge = edges[std::size_t(e)];
@@ -265,7 +347,9 @@ class Finder {
         continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
-      if (!(theta > 0.0 && theta < 1.0)) continue;
+      // The free end's half starts where the last curve piece ends, and bears a point there.
+      if (!(theta > theta_lo || (theta == theta_lo && theta_lo > 0.0)) || !(theta < theta_hi))
+        continue;
       const Vec3 c = a + theta * v;
       const Vec3 ab = edge.b_W - edge.a_W;
       const Vec3 q = edge.a_W + u * ab;
@@ -274,35 +358,14 @@ class Finder {
       if (!(lw - r1 < eps) || lw == 0.0) continue;
       // The edge bears where the axis point lies in front of both its faces' planes; its share
       // fades out over the ramp behind either plane, beside the face whose nodes' spheres bear.
-      double above = 1.0;
-      Vec3 d_above_dc = Vec3::Zero();
-      for (int k = 0; k < 2; ++k) {
-        const Vec3& n = edge.face_normals_W[std::size_t(k)];
-        const Vec3& n_other = edge.face_normals_W[std::size_t(1 - k)];
-        const double x = 1.0 + (c - edge.a_W).dot(n) / ramp_m;
-        const double x_other = 1.0 + (c - edge.a_W).dot(n_other) / ramp_m;
-        above *= SmoothStep(x);
-        if (x > 0.0 && x < 1.0)
-          d_above_dc += SmoothStep(x_other) * 6.0 * x * (1.0 - x) / ramp_m * n;
-      }
-      // The share: s(theta) towards the nodes, times s(sin^2 phi / sin^2 20 deg) for the angle
-      // phi between the element and the edge (1 against a vertex, a point).
+      Vec3 d_above_dc;
+      const double above = InFrontOfFaces(edge, c, ramp_m, d_above_dc);
+      // The share: s(theta) towards the end node, times Across (1 against a vertex, a point).
       const bool on_line = u > 0.0 && u < 1.0;
       const double near_node = std::min(theta, 1.0 - theta) * lv / ramp_m;
       const double along = SmoothStep(near_node);
-      double across = 1.0;
       Vec3 d_across_dv = Vec3::Zero();
-      if (on_line) {
-        constexpr double kSin2Fade = 0.116977778440511;  // sin^2 20 deg
-        const Vec3 unit = ab.normalized();
-        const Vec3 cross = v.cross(unit);
-        const double sin2 = cross.squaredNorm() / v.squaredNorm();
-        across = SmoothStep(sin2 / kSin2Fade);
-        const double x = std::clamp(sin2 / kSin2Fade, 0.0, 1.0);
-        const Vec3 d_sin2_dv = 2.0 * unit.cross(cross) / v.squaredNorm() -
-                               2.0 * cross.squaredNorm() * v / (v.squaredNorm() * v.squaredNorm());
-        d_across_dv = 6.0 * x * (1.0 - x) / kSin2Fade * d_sin2_dv;
-      }
+      const double across = on_line ? Across(v, ab.normalized(), d_across_dv) : 1.0;
       const double weight = along * across * above;
       if (weight <= 0.0) continue;
       // d theta / d (a, b): theta = -(v^T P w0) / (v^T P v), w0 = a - q, P the projector across
@@ -362,6 +425,140 @@ class Finder {
         }
       }
     }
+  }
+
+  // The side surface about inner node i against the part's edges: the tube around its smooth
+  // centreline's piece there (CurveWeights), at the piece's point nearest an edge (or a vertex it
+  // ends in) where that lies inside the piece, in front of the edge's face planes. Neighbouring
+  // pieces meet with the same point and tangent, so a load passing a node moves on without a
+  // jump in its size or direction. Its share fades as the tube turns parallel to the edge
+  // (Across), where the node spheres bear, and behind the face planes; its derivatives go into
+  // the gradient with it.
+  void Curve(int p, const PartModel& part, int i) {
+    const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
+    const Vec3& x0 = x_[std::size_t(i - 1)];
+    const Vec3& x1 = x_[std::size_t(i)];
+    const Vec3& x2 = x_[std::size_t(i + 1)];
+    // The piece lies within the triangle of the elements' middles and the node.
+    const Vec3 m0 = 0.5 * (x0 + x1), m1 = 0.5 * (x1 + x2);
+    const Vec3 lo = m0.cwiseMin(m1).cwiseMin(x1).array() - (r1 + eps);
+    const Vec3 hi = m0.cwiseMax(m1).cwiseMax(x1).array() + (r1 + eps);
+    const double ramp_m = Ramp();
+    // How far the piece strays from the chord between the middles: at most half the node's
+    // distance from it (the piece's middle).
+    const double bulge = 0.5 * (x1 - 0.5 * (m0 + m1)).norm();
+    const auto& edges = part.geometry.edges();
+    for (int e = 0; e < int(edges.size()); ++e) {
+      const PartEdge& edge = edges[std::size_t(e)];
+      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
+        continue;
+      double theta = 0.0, u = 0.0;
+      ClosestSegmentPoints(m0, m1, edge.a_W, edge.b_W, theta, u);
+      const Vec3 ab = edge.b_W - edge.a_W;
+      if ((m0 + theta * (m1 - m0) - edge.a_W - u * ab).norm() - bulge >= r1 + eps) continue;
+      const Vec3 unit = ab.normalized();
+      // The piece's point nearest the edge: nearest its line where that projects inside the
+      // edge (u in [0, 1]), else nearest the vertex on the side it projects to.
+      Vec3 from = edge.a_W, dir = unit;
+      double curvature = 0.0;
+      const double guess = theta;
+      bool found = InsidePiece(x0, x1, x2, from, dir, guess, theta, curvature);
+      u = (CarrierCentre(Carrier::kCurve, x_, i, theta) - edge.a_W).dot(ab) / ab.squaredNorm();
+      if (!found || u < 0.0 || u > 1.0) {
+        dir = Vec3::Zero();
+        found = false;
+        for (const double end : {0.0, 1.0}) {
+          from = end == 0.0 ? edge.a_W : edge.b_W;
+          u = end;
+          if (InsidePiece(x0, x1, x2, from, dir, guess, theta, curvature) &&
+              (CarrierCentre(Carrier::kCurve, x_, i, theta) - from).dot(ab) * (end - 0.5) >= 0.0) {
+            found = true;
+            break;
+          }
+        }
+      }
+      if (!found) continue;
+      const std::array<double, 3> w = CurveWeights(theta), dw = CurveSlopes(theta);
+      const Vec3 c = w[0] * x0 + w[1] * x1 + w[2] * x2;
+      const Vec3 tangent = dw[0] * x0 + dw[1] * x1 + dw[2] * x2;
+      const Mat3 Q = Mat3::Identity() - dir * dir.transpose();
+      const Vec3 r = Q * (c - from);
+      const double lr = r.norm();
+      if (!(lr - r1 < eps) || lr == 0.0) continue;
+      Vec3 d_above_dc, d_across_dv = Vec3::Zero();
+      const double above = InFrontOfFaces(edge, c, ramp_m, d_above_dc);
+      const bool on_line = dir.squaredNorm() > 0.0;
+      const double across = on_line ? Across(tangent, unit, d_across_dv) : 1.0;
+      const double weight = across * above;
+      if (weight <= 0.0) continue;
+      PartDistance at;
+      at.distance_m = lr - r1;
+      at.normal_W = r / lr;
+      at.point_W = from + u * (on_line ? ab : Vec3::Zero());
+      at.face_mask = on_line ? edge.face_mask : u == 0.0 ? edge.a_mask : edge.b_mask;
+      // As for an element's side (Side): the distance curves only across the tube past a vertex.
+      if (on_line) {
+        at.curvature_per_m.setZero();
+      } else {
+        const Vec3 m = tangent.normalized().cross(at.normal_W);
+        at.curvature_per_m = m * m.transpose() / lr;
+      }
+      MaterialPoint mp = Material(Carrier::kCurve, x_, i, theta, Vec3::Zero(), false);
+      mp.offset_W = -r1 * at.normal_W;
+      mp.point_W += mp.offset_W;
+      Sample* smp = Record(SampleKind::kCurve, p, i, e, theta, weight, at, mp, Vec3::Zero());
+      if (smp == nullptr) continue;
+      // The share's gradient: the nearest point moves along the piece as the nodes move,
+      // d theta / d x_k = -(w_k Q c' + w'_k r) / curvature (its condition r . Q c' = 0), and
+      // with it the point (above) and the tangent (across).
+      const Vec3 Qt = Q * tangent, second = x0 - 2.0 * x1 + x2;
+      std::array<Vec3, 3> d_thetas;
+      for (int k = 0; k < 3; ++k) {
+        const Vec3 d_theta = -(w[std::size_t(k)] * Qt + dw[std::size_t(k)] * r) / curvature;
+        d_thetas[std::size_t(k)] = d_theta;
+        const Vec3 d_above = w[std::size_t(k)] * d_above_dc + tangent.dot(d_above_dc) * d_theta;
+        const Vec3 d_across = dw[std::size_t(k)] * d_across_dv + second.dot(d_across_dv) * d_theta;
+        smp->weight_gradient.segment<3>(3 * k) = above * d_across + across * d_above;
+      }
+      smp->weight_first = i - 1;
+      smp->weight_nodes = 3;
+      YieldNode(p, edge, i, *smp, theta, d_thetas);
+    }
+  }
+
+  // Node i's sphere yields to the curve sample `curve` on its piece (at theta, d theta / d x_k
+  // in d_thetas) the share that sample bears, where the node lies in the edge's region
+  // (InFrontOfFaces): the edge's load is then borne at the smooth surface, not also at the node.
+  // It yields y = rho w f(theta), f fading over the tenth of the piece at either end, where the
+  // load passes to the next piece and the sphere is half an element from it; its share becomes
+  // w_node (1 - y), with the gradient of that over nodes i - 1 .. i + 1.
+  void YieldNode(int p, const PartEdge& edge, int i, const Sample& curve, double theta,
+                 const std::array<Vec3, 3>& d_thetas) {
+    Scratch& s = d_.scratch;
+    Sample* node = nullptr;
+    for (int k = s.sample_count - 1; k >= 0 && node == nullptr; --k) {
+      Sample& q = s.samples[std::size_t(k)];
+      if (q.kind == SampleKind::kNode && q.part == p && q.node == i) node = &q;
+    }
+    if (node == nullptr) return;
+    Vec3 d_rho;
+    const double rho = InFrontOfFaces(edge, x_[std::size_t(i)], Ramp(), d_rho);
+    const double end = std::min(theta, 1.0 - theta) / kPieceEnd;
+    const double f = SmoothStep(end);
+    const double y = rho * curve.weight * f;
+    if (y <= 0.0) return;
+    Eigen::Matrix<double, 9, 1> dy = rho * f * curve.weight_gradient;
+    if (end < 1.0) {
+      const double df = 6.0 * end * (1.0 - end) / kPieceEnd * (theta < 0.5 ? 1.0 : -1.0);
+      for (int k = 0; k < 3; ++k)
+        dy.segment<3>(3 * k) += rho * curve.weight * df * d_thetas[std::size_t(k)];
+    }
+    dy.segment<3>(3) += curve.weight * f * d_rho;
+    if (node->weight_nodes == 0) node->weight_gradient.setZero();
+    node->weight_gradient = (1.0 - y) * node->weight_gradient - node->weight * dy;
+    node->weight *= 1.0 - y;
+    node->weight_first = i - 1;
+    node->weight_nodes = 3;
   }
 
   void EndFace(int p, const PartModel& part) {

@@ -21,12 +21,14 @@ namespace tubeplan::core {
 enum class SampleKind : std::uint8_t {
   kNode,     ///< the side surface at an inner node (the capsule chain's sphere there)
   kRim,      ///< the free end's rim
-  kSide,     ///< the side surface between two nodes, against a part's edge
+  kSide,     ///< the side surface of an end's half element, against a part's edge
+  kCurve,    ///< the side surface about an inner node (its smooth centreline), against an edge
   kEndFace,  ///< the free end's face, against a part's vertex
 };
 
 /// One contact point between the tube's surface and a part. The point is a material point of the
-/// section at `node` (kNode, kRim, kEndFace) or of the element from `node` (kSide), offset
+/// section at `node` (kNode, kRim, kEndFace), of the element from `node` (kSide) or of the
+/// smooth centreline's piece about `node` (kCurve), offset
 /// from the centreline by `offset_W`; its distance moves with the material point whose offset
 /// was `moving_offset_W` (Material), whose derivatives the assembly takes.
 struct Sample {
@@ -34,8 +36,8 @@ struct Sample {
   std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
   int part = 0;                ///< index into Model::parts
   int node = 0;                ///< the section's node, or the segment's first node
-  int feature = 0;             ///< ring position (kRim), edge (kSide) or vertex (kEndFace)
-  double theta = 0.0;          ///< position along the segment (kSide), 0..1
+  int feature = 0;     ///< ring position (kRim), edge (kSide, kCurve) or vertex (kEndFace)
+  double theta = 0.0;  ///< position along the segment (kSide) or the piece (kCurve), 0..1
   double weight = 1.0;         ///< share of K it carries
   /// d weight / d nodes from weight_first on (two or three): a share that fades moves with them.
   Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
@@ -70,6 +72,8 @@ inline Carrier CarrierOf(SampleKind kind) {
       return Carrier::kInnerNode;
     case SampleKind::kSide:
       return Carrier::kElement;
+    case SampleKind::kCurve:
+      return Carrier::kCurve;
     case SampleKind::kRim:
     case SampleKind::kEndFace:
       break;

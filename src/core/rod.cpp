@@ -169,9 +169,18 @@ double AxialHoldEnergy(const RodModel& rod, const Mat3& R_WH, std::span<const Ve
   return 0.5 * k * s * s;
 }
 
+std::array<double, 3> CurveWeights(double theta) {
+  return {0.5 * (1.0 - theta) * (1.0 - theta), 0.5 + theta - theta * theta, 0.5 * theta * theta};
+}
+
+std::array<double, 3> CurveSlopes(double theta) {
+  return {theta - 1.0, 1.0 - 2.0 * theta, theta};
+}
+
 Vec3 CarrierTangent(Carrier carrier, std::span<const Vec3> x_W, int i) {
   switch (carrier) {
-    case Carrier::kInnerNode: {
+    case Carrier::kInnerNode:
+    case Carrier::kCurve: {
       const Vec3 a = (x_W[std::size_t(i)] - x_W[std::size_t(i - 1)]).normalized();
       const Vec3 b = (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]).normalized();
       return (a + b).normalized();
@@ -187,13 +196,19 @@ Vec3 CarrierTangent(Carrier carrier, std::span<const Vec3> x_W, int i) {
 Vec3 CarrierCentre(Carrier carrier, std::span<const Vec3> x_W, int i, double theta) {
   if (carrier == Carrier::kElement)
     return x_W[std::size_t(i)] + theta * (x_W[std::size_t(i + 1)] - x_W[std::size_t(i)]);
+  if (carrier == Carrier::kCurve) {
+    const std::array<double, 3> w = CurveWeights(theta);
+    return w[0] * x_W[std::size_t(i - 1)] + w[1] * x_W[std::size_t(i)] +
+           w[2] * x_W[std::size_t(i + 1)];
+  }
   return x_W[std::size_t(i)];
 }
 
 Eigen::Matrix<double, 3, 9> TangentJacobian(Carrier carrier, std::span<const Vec3> x_W, int i) {
   Eigen::Matrix<double, 3, 9> dt = Eigen::Matrix<double, 3, 9>::Zero();
   switch (carrier) {
-    case Carrier::kInnerNode: {
+    case Carrier::kInnerNode:
+    case Carrier::kCurve: {
       const Vec3 e = x_W[std::size_t(i)] - x_W[std::size_t(i - 1)];
       const Vec3 f = x_W[std::size_t(i + 1)] - x_W[std::size_t(i)];
       const double le = e.norm(), lf = f.norm();
@@ -226,12 +241,15 @@ MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double
   // The offset turned with the section: its part along the new tangent removed, length kept,
   // o = |o0| v / |v| with v = (I - t t^T) o0.
   MaterialPoint mp;
-  const Vec3 t = CarrierTangent(carrier, x_W, i);
+  mp.point_W = CarrierCentre(carrier, x_W, i, theta);
+  const double l0 = offset0_W.norm();
+  // A point on the centre line has no offset to turn.
+  const Vec3 t = l0 > 0.0 ? CarrierTangent(carrier, x_W, i) : Vec3::Zero();
   const Vec3 v = offset0_W - offset0_W.dot(t) * t;
-  const double lv = v.norm(), l0 = offset0_W.norm();
+  const double lv = v.norm();
   mp.tangent_W = t;
   mp.offset_W = lv > 0.0 ? Vec3(v * (l0 / lv)) : Vec3::Zero();
-  mp.point_W = CarrierCentre(carrier, x_W, i, theta) + mp.offset_W;
+  mp.point_W += mp.offset_W;
   if (!jacobian) return mp;
   // d point / d x_k: a point on the centre line moves with the centre's nodes alone; an offset
   // also turns with the tangent, whose stencil starts one node before a node's.
@@ -241,6 +259,10 @@ MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double
     mp.first = i;
     mp.nodes = 2;
     dc = {1.0 - theta, theta, 0.0};
+  } else if (carrier == Carrier::kCurve) {
+    mp.first = i - 1;
+    mp.nodes = 3;
+    dc = CurveWeights(theta);
   } else if (!turns) {
     mp.first = i;
     mp.nodes = 1;

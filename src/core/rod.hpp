@@ -3,6 +3,7 @@
 // (docs/core.md, "The rod"). Nodes x_0 .. x_N; x_0 is the held end and x_1 = x_0 + l/N t_H, so
 // the grip holds the first element's direction.
 
+#include <array>
 #include <span>
 
 #include <Eigen/Core>
@@ -49,13 +50,25 @@ enum class Carrier : unsigned char {
   kInnerNode,  ///< node i, 1 <= i <= N-1, tangent bisecting its two elements
   kEndNode,    ///< node N, tangent of the last element
   kElement,    ///< the point theta of element i (nodes i, i+1), its tangent
+  kCurve,      ///< the point theta of the smooth centreline's piece about inner node i
+               ///< (CurveWeights); an offset turns with node i's tangent
 };
+
+/// The tube's smooth centreline about inner node i: the quadratic B-spline of nodes i - 1, i and
+/// i + 1, from the middle of element i - 1 (theta 0) to the middle of element i (theta 1),
+/// c(theta) = sum_k w_k x_{i-1+k}. Neighbouring pieces meet with the same point and tangent, so
+/// the surface around it has no edges at the nodes.
+std::array<double, 3> CurveWeights(double theta);
+/// d w_k / d theta: the tangent c'(theta) = sum_k w'_k x_{i-1+k}.
+std::array<double, 3> CurveSlopes(double theta);
 
 /// A material point: the centre plus an offset perpendicular to the tangent, carried with the
 /// section as the tangent turns (no twist).
 struct MaterialPoint {
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
-  Eigen::Vector3d tangent_W = Eigen::Vector3d::UnitZ();
+  /// The carrier's tangent that turns the offset; zero for a point without one (CarrierTangent
+  /// gives it).
+  Eigen::Vector3d tangent_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d offset_W = Eigen::Vector3d::Zero();  ///< perpendicular to the tangent
   int first = 0;                                       ///< first node of the stencil
   int nodes = 0;

@@ -1,6 +1,6 @@
 // The solve's gradient against central differences of its own energy, on random bent tubes
-// near an edge and a wall: every contact term (a node's sphere and its fading share, an
-// element's side on the edge, the end's rim) and the rod's and the coupling's.
+// near an edge and a wall: every contact term (a node's sphere and its fading share, the smooth
+// side about a node on the edge, the end's rim) and the rod's and the coupling's.
 #include "core/assemble.hpp"
 
 #include <algorithm>
@@ -21,11 +21,12 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 scene::BoxPart Cube(const std::string& name, double size_m, const Eigen::Vector3d& centre,
-                    double turn_y_rad) {
+                    double turn_y_rad, const Eigen::Matrix3d& then = Eigen::Matrix3d::Identity()) {
   scene::BoxPart b;
   b.name = name;
   b.size_m = Eigen::Vector3d::Constant(size_m);
-  b.X_WP.linear() = Eigen::AngleAxisd(turn_y_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  b.X_WP.linear() =
+      then * Eigen::AngleAxisd(turn_y_rad, Eigen::Vector3d::UnitY()).toRotationMatrix();
   b.X_WP.translation() = centre;
   return b;
 }
@@ -69,8 +70,12 @@ TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core]
     const Eigen::Vector3d t_e = tangent(s_edge), n_e(t_e.z(), 0.0, -t_e.x());
     const Eigen::Vector3d edge_W = arc(s_edge) + (r1 + eps * (1.5 * u01(rng) - 0.5)) * n_e;
     const double half_diagonal = 0.02 * std::sqrt(2.0);
+    // Every other trial turns the edge towards the tube's tangent (5-30 deg between them), where
+    // the smooth side's share and the node spheres' fade with the angle.
+    const double turn = trial % 2 == 0 ? 0.0 : (60.0 + 25.0 * u01(rng)) * kPi / 180.0;
     s.parts = {
-        Cube("edge", 0.04, edge_W + half_diagonal * n_e, std::atan2(n_e.x(), n_e.z()) + kPi / 4.0),
+        Cube("edge", 0.04, edge_W + half_diagonal * n_e, std::atan2(n_e.x(), n_e.z()) + kPi / 4.0,
+             Eigen::AngleAxisd(turn, n_e).toRotationMatrix()),
         Cube("wall", 0.04, arc(l) + (eps * (1.5 * u01(rng) - 0.5) + 0.02) * tangent(l),
              std::atan2(tangent(l).x(), tangent(l).z()))};
     s.X_WH_start = Eigen::Isometry3d::Identity();
@@ -93,7 +98,7 @@ TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core]
       const core::Sample& smp = data.scratch.samples[std::size_t(k)];
       if (!(smp.distance_m < eps)) continue;
       fading = fading || (smp.kind == core::SampleKind::kNode && smp.weight_nodes > 0);
-      side = side || (smp.kind == core::SampleKind::kSide && smp.node > 0);
+      side = side || smp.kind == core::SampleKind::kCurve;
       rim = rim || smp.kind == core::SampleKind::kRim;
     }
     nodes_fading += fading;
