@@ -251,6 +251,13 @@ class Finder {
   void Node(int p, const PartModel& part, int i) {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& c = x_[std::size_t(i)];
+    // Beyond reach of the part's bounding box, the gap to the box is the node's clearance.
+    const double gap_m =
+        (part.geometry.min_W() - c).cwiseMax(c - part.geometry.max_W()).cwiseMax(0.0).norm();
+    if (gap_m - r1 >= eps) {
+      Clear(i, gap_m);
+      return;
+    }
     PartDistance at = part.geometry.Distance(c, Entry(p, i));
     Clear(i, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
