@@ -92,6 +92,28 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[cli][explore]") {
+  // A task of another kind than the groove: the tube carried over a shelf's edge and laid on its
+  // top. Its default exploration saturates and reaches the goal; the best candidate replays
+  // feasible within the device's force, and evaluate agrees on the written files.
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-shelf") / "out";
+  const Outcome r =
+      RunTool({"plans", SourcePath("scenes/shelf.yaml"), "--jobs", "2", "--out-dir", dir.string()});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::size_t line = r.out.find("shelf-candidate-1: cost");
+  REQUIRE(line != std::string::npos);
+  const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
+  CHECK(said.find("-> {Fs - shelf.top}; feasible; peak operator force ") != std::string::npos);
+  const double peak_N = std::stod(said.substr(said.rfind("force ") + 6));
+  CHECK(peak_N > 0.0);
+  CHECK(peak_N < 8.5);
+  const Outcome judged = RunTool({"evaluate", dir.string()});
+  INFO(judged.out);
+  CHECK(judged.exit_code == 0);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-shelf"));
+}
+
 }  // namespace
 
 // The groove scene with one line changed (`from` replaced by `to`), written to the scratch
