@@ -114,6 +114,32 @@ TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-shelf"));
 }
 
+TEST_CASE("plans: the tilted groove's two-PC goal gives verified plans on a small budget",
+          "[cli][explore]") {
+  // Parts turned about a non-vertical axis and a goal of two PCs (the tube seated in the corner
+  // of the floor and the left wall). 250 motions (a twelfth of the default budget) reach the goal;
+  // every written candidate ends there and replays feasible within the device's force.
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-tilted") / "out";
+  const Outcome r = RunTool({"plans", SourcePath("scenes/groove-tilted.yaml"), "--jobs", "2",
+                             "--budget", "250", "--out-dir", dir.string()});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  int written = 0;
+  for (std::size_t at = r.out.find("groove-tilted-candidate-"); at != std::string::npos;
+       at = r.out.find("groove-tilted-candidate-", at + 1)) {
+    const std::string said = r.out.substr(at, r.out.find('\n', at) - at);
+    CHECK(said.find("-> {Fs n floor.top, Fs n left.inner}; feasible; peak operator force ") !=
+          std::string::npos);
+    CHECK(std::stod(said.substr(said.rfind("force ") + 6)) < 8.5);
+    ++written;
+  }
+  CHECK(written >= 1);
+  const Outcome judged = RunTool({"evaluate", dir.string()});
+  INFO(judged.out);
+  CHECK(judged.exit_code == 0);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-tilted"));
+}
+
 }  // namespace
 
 // The groove scene with one line changed (`from` replaced by `to`), written to the scratch
