@@ -464,6 +464,9 @@ int RunLive(const LiveOptions& o, Streams io) {
                      {"max_latency_us", stats.max_latency_us},
                      {"max_jitter_us", stats.max_jitter_us},
                      {"dropped", stats.dropped},
+                     {"stalls", stats.stalls},
+                     {"ticks_lost", stats.ticks_lost},
+                     {"longest_stall_ms", stats.longest_stall_ms},
                      {"stop", device::ToString(stats.stop)},
                      {"realtime", stats.realtime_note.empty()},
                      {"device", dev->spec().name},
@@ -478,13 +481,29 @@ int RunLive(const LiveOptions& o, Streams io) {
       << stats.overruns << " overruns; tick median " << stats.median_us << " us, p99.9 "
       << stats.p999_us << " us, worst " << stats.max_us
       << " us; ended: " << device::ToString(stats.stop) << "\n";
+    if (stats.stalls > 0)
+      t << "servo: " << stats.stalls << (stats.stalls == 1 ? " stall" : " stalls")
+        << " (the loop woke more than a tick late; first at t = " << stats.first_stall_s
+        << " s, longest " << stats.longest_stall_ms << " ms, " << stats.ticks_lost
+        << " periods lost): the force went to zero and ramped back in over 10 ms each time\n";
     if (!o.record.empty() && record_error.empty()) t << "recording written to " << o.record << "\n";
     io.out << t.str();
   }
+  if (stats.stop == device::StopReason::kSignal) {
+    io.err << "tubeplan live: interrupted at t = " << e.judgement.replayed_s
+           << " s; the force was zeroed; the verdicts above cover the run until then\n";
+    return kExitInterrupted;
+  }
   if (device::IsFault(stats.stop)) {
     io.err << "tubeplan live: error: the servo stopped on a fault (" << device::ToString(stats.stop)
+           << (stats.stop == device::StopReason::kMissedDeadlines
+                   ? ": a stall longer than " +
+                         std::to_string(std::lround(config.max_stall_s * 1e3)) +
+                         " ms or more than " + std::to_string(config.max_stalls_per_s) +
+                         " in a second; docs/live.md says what helps"
+                   : std::string())
            << "); the force was zeroed\n";
-    return kExitInternal;
+    return stats.stop == device::StopReason::kNonFinite ? kExitInternal : kExitDeviceFault;
   }
   if (stats.dropped > 0 || !record_error.empty()) return kExitInternal;
   return e.judgement.feasible ? kExitOk : kExitNegative;

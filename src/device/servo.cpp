@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -137,6 +138,8 @@ ServoStats ServoLoop::Run() {
   std::fill(histogram_.begin(), histogram_.end(), 0u);
 
   const std::int64_t start_ns = clock_.NowNs();
+  // Tick k is due at schedule_ns + k T; a stall moves the schedule on by the time it lost.
+  std::int64_t schedule_ns = start_ns;
   std::int64_t previous_wake_ns = 0, last_end_ns = start_ns;
   std::uint64_t last_sequence = 0;
   int stale_ticks = 0;
@@ -146,8 +149,12 @@ ServoStats ServoLoop::Run() {
   StopReason reason = StopReason::kNone;
   const double nan = std::numeric_limits<double>::quiet_NaN();
 
+  // The run times of the last stalls, oldest first overwritten (the rate of stalls).
+  std::array<std::int64_t, 64> stall_ns{};
+  const int stall_window = std::clamp(config_.max_stalls_per_s + 1, 1, int(stall_ns.size()));
+
   for (long k = 0; config_.max_ticks == 0 || k < config_.max_ticks; ++k) {
-    const std::int64_t deadline_ns = start_ns + k * T_ns;
+    std::int64_t deadline_ns = schedule_ns + k * T_ns;
     clock_.SleepUntilNs(deadline_ns);
     if (on_tick) on_tick(k);
     const std::int64_t wake_ns = clock_.NowNs();
@@ -157,11 +164,26 @@ ServoStats ServoLoop::Run() {
       stats.max_jitter_us =
           std::max(stats.max_jitter_us, std::abs(double(wake_ns - previous_wake_ns - T_ns)) * 1e-3);
     previous_wake_ns = wake_ns;
-    // Missed: this tick woke more than a period late, so its wrench goes out after the next
-    // tick's deadline. A stall of d ms makes about d ticks in a row late while the loop catches
-    // up on its absolute deadlines: the limiter's streak of 3 trips on stalls of 3 ms and more.
+    // A stall: this tick woke more than a period late. The schedule moves on by the whole
+    // periods it lost (the loop does not race to catch up; the core still steps every tick, so
+    // a replay of the recording steps it the same), its force is zero and ramps back in after;
+    // one stall too long or too many in a second end the run.
     const bool missed = latency_ns > T_ns;
-    stats.late_wakeups += latency_ns > T_ns;
+    stats.late_wakeups += missed;
+    if (missed) {
+      const long lost = long(latency_ns / T_ns);
+      schedule_ns += lost * T_ns;
+      deadline_ns = schedule_ns + k * T_ns;
+      stall_ns[std::size_t(stats.stalls % stall_window)] = wake_ns;
+      ++stats.stalls;
+      stats.ticks_lost += lost;
+      stats.longest_stall_ms = std::max(stats.longest_stall_ms, double(latency_ns) * 1e-6);
+      if (stats.first_stall_s < 0.0) stats.first_stall_s = double(wake_ns - start_ns) * 1e-9;
+      const std::int64_t oldest = stall_ns[std::size_t(stats.stalls % stall_window)];
+      if (double(latency_ns) * 1e-9 > config_.max_stall_s ||
+          (stats.stalls >= stall_window && wake_ns - oldest < 1'000'000'000))
+        reason = StopReason::kMissedDeadlines;
+    }
 
     if (ScopedStopSignals::received() != 0) reason = StopReason::kSignal;
     if (reason == StopReason::kNone && stop_requested_.load(std::memory_order_acquire))
@@ -176,11 +198,12 @@ ServoStats ServoLoop::Run() {
                         sample.w_W_rad_per_s.allFinite();
     record.tick = k;
     record.stepped = false;
+    record.stalled = missed;
     record.buttons = sample.buttons;
     LimitedWrench wrench;
     if (reason == StopReason::kNone && !finite) {
       // Through the limiter like every wrench: a NaN request latches it at zero.
-      wrench = limiter_.Command(Eigen::Vector3d::Constant(nan), Eigen::Vector3d::Zero(), missed);
+      wrench = limiter_.Command(Eigen::Vector3d::Constant(nan), Eigen::Vector3d::Zero());
       reason = StopReason::kNonFinite;
     } else if (reason == StopReason::kNone) {
       record.hand = AsRecorded(double(k) * T, sample.X_W_hand);
@@ -189,9 +212,10 @@ ServoStats ServoLoop::Run() {
       const core::StepOutput& out = core_.Step(record.hand.t_s, X_W_hand);
       record.out = out;
       record.stepped = true;
-      wrench = limiter_.Command(out.force_W_N, out.torque_W_Nm, missed);
+      // Stalls are this loop's to judge (above), not the limiter's streak.
+      wrench = limiter_.Command(out.force_W_N, out.torque_W_Nm);
       if (wrench.fault == Fault::kNonFinite) reason = StopReason::kNonFinite;
-      if (wrench.fault == Fault::kMissedDeadlines) reason = StopReason::kMissedDeadlines;
+      if (missed && wrench.fault == Fault::kNone) wrench = limiter_.Drop();
     } else {
       limiter_.Stop();
       wrench = limiter_.Command(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero());

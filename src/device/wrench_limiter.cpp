@@ -78,6 +78,8 @@ LimitedWrench WrenchLimiter::Command(const Eigen::Vector3d& force_N,
   return out;
 }
 
+LimitedWrench WrenchLimiter::Drop() { return Zero(); }
+
 void WrenchLimiter::Stop() {
   fault_ = Fault::kStopped;
   Zero();

@@ -13,6 +13,9 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitNegative = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitInternal = 3;
+/// A live run ended on a persistent fault of the device or the host (stalls too long or too
+/// frequent, stale device data, a device error); the message names it.
+inline constexpr int kExitDeviceFault = 4;
 inline constexpr int kExitInterrupted = 130;
 
 /// Runs the command with `args` (without the program name); output to `out`, logs to `err`.

@@ -31,7 +31,7 @@ enum class StopReason : unsigned char {
   kStopRequested,    ///< RequestStop() (the session's end, from another thread)
   kSignal,           ///< SIGINT or SIGTERM
   kNonFinite,        ///< NaN or Inf in the device's reading or the core's output
-  kMissedDeadlines,  ///< the limiter's streak of missed deadlines
+  kMissedDeadlines,  ///< stalls too long or too frequent (ServoConfig), or the limiter's streak
   kStaleData,        ///< the device's reading stopped changing
   kDeviceError,      ///< the device failed a read
 };
@@ -49,6 +49,14 @@ struct ServoConfig {
   int max_stale_ticks = 1;
   /// Try SCHED_FIFO for the servo thread (a note says when it is not permitted).
   bool realtime = true;
+  /// A tick that wakes more than a period late is a stall, which the run survives: its force is
+  /// zero, the schedule moves on by the periods it lost (the core still steps every tick: the
+  /// run's time falls behind the clock's by the stalls, and a replay of the recording steps the
+  /// core the same) and the force ramps back in at the limiter's rates (zero to the maximum in
+  /// 10 ms). A persistent fault ends the run: one stall longer than this, or more than
+  /// `max_stalls_per_s` stalls within a second.
+  double max_stall_s = 0.1;
+  int max_stalls_per_s = 20;  ///< at most 63
 };
 
 /// What one tick did, handed to the judge and the recorder (every tick, in order).
@@ -60,6 +68,7 @@ struct TickRecord {
   Eigen::Vector3d force_sent_N = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_sent_Nm = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;
+  bool stalled = false;          ///< this tick woke more than a period late: its force was zero
   std::int32_t response_ns = 0;  ///< from the tick's deadline to its wrench sent
 };
 
@@ -81,6 +90,10 @@ struct ServoStats {
   long ticks = 0;
   long overruns = 0;  ///< ticks whose wrench went out after the next tick's deadline
   long late_wakeups = 0;
+  long stalls = 0;      ///< late wake-ups survived (ServoConfig::max_stall_s)
+  long ticks_lost = 0;  ///< ticks the stalls skipped
+  double longest_stall_ms = 0.0;
+  double first_stall_s = -1.0;  ///< run time of the first stall, -1 for none
   double median_us = 0.0, p999_us = 0.0, max_us = 0.0;
   double max_latency_us = 0.0;  ///< worst wake-up latency (deadline to running)
   double max_jitter_us = 0.0;   ///< worst |period - T| between two wake-ups

@@ -45,6 +45,9 @@ class WrenchLimiter {
   LimitedWrench Command(const Eigen::Vector3d& force_N, const Eigen::Vector3d& torque_Nm,
                         bool deadline_missed = false);
 
+  /// Zero on this tick only (a stall: the loop woke late), not a fault: the commands after it
+  /// ramp back up from zero at the rate limits.
+  LimitedWrench Drop();
   /// Zero from now on (exit, device error), until Reset().
   void Stop();
   /// Clears a fault; the output then ramps up from zero.
