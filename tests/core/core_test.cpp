@@ -304,8 +304,8 @@ TEST_CASE("The force on an edge is smooth in where the edge meets the tube", "[c
   // its nodes: the force must change smoothly with the edge's place, whichever element it meets.
   // Its second difference over the steps is a few 1e-5 N where the load stays on one piece of
   // the smooth side and 1.3e-3 N at most, where a node's sphere takes back its share near a
-  // piece's end; with capsules (spheres at the nodes, straight cylinders between) it was 0.011 N.
-  // The bound lies between.
+  // piece's end; a tube of capsules (spheres at the nodes, straight cylinders between) gives
+  // 0.011 N here. The bound lies between.
   scene::Scene s = RubberScene();
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   const double d0 = 0.5e-3, EIs = EI(s);
