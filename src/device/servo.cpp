@@ -181,7 +181,8 @@ ServoStats ServoLoop::Run() {
       if (stats.first_stall_s < 0.0) stats.first_stall_s = double(wake_ns - start_ns) * 1e-9;
       const std::int64_t oldest = stall_ns[std::size_t(stats.stalls % stall_window)];
       if (double(latency_ns) * 1e-9 > config_.max_stall_s ||
-          (stats.stalls >= stall_window && wake_ns - oldest < 1'000'000'000))
+          (config_.max_stalls_per_s > 0 && stats.stalls >= stall_window &&
+           wake_ns - oldest < 1'000'000'000))
         reason = StopReason::kMissedDeadlines;
     }
 

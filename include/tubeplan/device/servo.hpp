@@ -56,7 +56,7 @@ struct ServoConfig {
   /// 10 ms). A persistent fault ends the run: one stall longer than this, or more than
   /// `max_stalls_per_s` stalls within a second.
   double max_stall_s = 0.1;
-  int max_stalls_per_s = 20;  ///< at most 63
+  int max_stalls_per_s = 20;  ///< at most 63; 0: no limit on the rate
 };
 
 /// What one tick did, handed to the judge and the recorder (every tick, in order).
