@@ -330,6 +330,34 @@ class Finder {
   // face planes.
   double Ramp() const { return std::min(0.25 * m_.rod.outer_radius_m, 0.5 * m_.rod.segment_m); }
 
+  // Records a side's contact (kSide, kCurve) with an edge (on_line) or the vertex it ends in (u 0
+  // or 1), q on it: the axis point at theta is at w (length lw) from q. The distance is the
+  // axis's from the edge less r1: it does not change as the tube slides along its axis or along
+  // the edge, so it curves only across both (past a vertex, about the tube's `tangent`), not as a
+  // point's distance from the edge would; its change as the tube turns is left out. It moves with
+  // the axis point alone (the nearest point's own motion changes it only to second order); the
+  // surface point is r1 from it.
+  Sample* RecordEdge(SampleKind kind, int p, int i, int e, double theta, double weight,
+                     const PartEdge& edge, bool on_line, const Vec3& q, double u, const Vec3& w,
+                     double lw, const Vec3& tangent) {
+    const double r1 = m_.rod.outer_radius_m;
+    PartDistance at;
+    at.distance_m = lw - r1;
+    at.normal_W = w / lw;
+    at.point_W = q;
+    at.face_mask = on_line ? edge.face_mask : u == 0.0 ? edge.a_mask : edge.b_mask;
+    if (on_line) {
+      at.curvature_per_m.setZero();
+    } else {
+      const Vec3 m = tangent.normalized().cross(at.normal_W);
+      at.curvature_per_m = m * m.transpose() / lw;
+    }
+    MaterialPoint mp = Material(CarrierOf(kind), x_, i, theta, Vec3::Zero(), false);
+    mp.offset_W = -r1 * at.normal_W;
+    mp.point_W += mp.offset_W;
+    return Record(kind, p, i, e, theta, weight, at, mp, Vec3::Zero());
+  }
+
   // The side surface of an end element's outer half (between the tube's end node and the middle
   // of the element, where the smooth centreline's pieces take over: Curve), a cylinder, against
   // the part's edges: where the element's axis comes nearest an edge (or a vertex it ends in)
@@ -390,28 +418,8 @@ class Finder {
       const Vec3 d_near_a = (side_sign * lv * d_theta_a - nearer * v / lv) / ramp_m;
       const Vec3 d_near_b = (side_sign * lv * d_theta_b + nearer * v / lv) / ramp_m;
       const double d_along = near_node < 1.0 ? 6.0 * near_node * (1.0 - near_node) : 0.0;
-      PartDistance at;
-      at.distance_m = lw - r1;
-      at.normal_W = w / lw;
-      at.point_W = q;
-      // The edge, or the vertex it ends in.
-      at.face_mask = u == 0.0 ? edge.a_mask : u == 1.0 ? edge.b_mask : edge.face_mask;
-      // The distance is between the element's axis and the edge (or its vertex): it does not
-      // change as the element slides along its axis, or along the edge, so it curves only across
-      // both (past a vertex), not as a point's distance from the edge would. Its change as the
-      // element turns is left out.
-      if (on_line) {
-        at.curvature_per_m.setZero();
-      } else {
-        const Vec3 m = v.normalized().cross(at.normal_W);
-        at.curvature_per_m = m * m.transpose() / lw;
-      }
-      // The distance moves with the axis point alone (the nearest point's own motion along the
-      // axis and the edge changes it only to second order); the surface point is r1 from it.
-      MaterialPoint mp = Material(Carrier::kElement, x_, i, theta, Vec3::Zero(), false);
-      mp.offset_W = -r1 * at.normal_W;
-      mp.point_W += mp.offset_W;
-      Sample* smp = Record(SampleKind::kSide, p, i, e, theta, weight, at, mp, Vec3::Zero());
+      Sample* smp =
+          RecordEdge(SampleKind::kSide, p, i, e, theta, weight, edge, on_line, q, u, w, lw, v);
       if (smp != nullptr) {
         // d above / d (a, b) through c = a + theta (b - a).
         const double v_dot = v.dot(d_above_dc);
@@ -498,22 +506,8 @@ class Finder {
       const double across = on_line ? Across(tangent, unit, d_across_dv) : 1.0;
       const double weight = across * above;
       if (weight <= 0.0) continue;
-      PartDistance at;
-      at.distance_m = lr - r1;
-      at.normal_W = r / lr;
-      at.point_W = from + u * (on_line ? ab : Vec3::Zero());
-      at.face_mask = on_line ? edge.face_mask : u == 0.0 ? edge.a_mask : edge.b_mask;
-      // As for an element's side (Side): the distance curves only across the tube past a vertex.
-      if (on_line) {
-        at.curvature_per_m.setZero();
-      } else {
-        const Vec3 m = tangent.normalized().cross(at.normal_W);
-        at.curvature_per_m = m * m.transpose() / lr;
-      }
-      MaterialPoint mp = Material(Carrier::kCurve, x_, i, theta, Vec3::Zero(), false);
-      mp.offset_W = -r1 * at.normal_W;
-      mp.point_W += mp.offset_W;
-      Sample* smp = Record(SampleKind::kCurve, p, i, e, theta, weight, at, mp, Vec3::Zero());
+      Sample* smp = RecordEdge(SampleKind::kCurve, p, i, e, theta, weight, edge, on_line,
+                               from + u * (on_line ? ab : Vec3::Zero()), u, r, lr, tangent);
       if (smp == nullptr) continue;
       // The share's gradient: the nearest point moves along the piece as the nodes move,
       // d theta / d x_k = -(w_k Q c' + w'_k r) / curvature (its condition r . Q c' = 0), and
