@@ -419,10 +419,10 @@ TEST_CASE("live over OpenIGTLink gets the verdicts of evaluate of its recording"
   const std::string stop = live_report["servo"]["stop"];
   // SCHED_FIFO where permitted (a note otherwise): a loaded machine stalls a normal thread often.
   // 2 s of a 5.5 s plan: the goal is not reached (exit 1). A loaded machine may stall the servo
-  // for 3 ms and more: the missed-deadline streak then ends the run, force zeroed (exit 3); the
+  // beyond the stall limits: that ends the run, force zeroed, as a device fault (exit 4); the
   // verdicts of what was recorded must still be evaluate's.
   if (stop == "missed deadlines") {
-    CHECK(code == 3);
+    CHECK(code == cli::kExitDeviceFault);
   } else {
     CHECK(stop == "completed");
     CHECK(code == 1);
