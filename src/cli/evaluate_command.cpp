@@ -109,7 +109,7 @@ bool GraphSections(const std::vector<Evaluated>& results,
       graph::ReplayedPlan r;
       for (const plan::TransitionVerdict& v : results[i].judgement.transitions)
         r.transitions.push_back(
-            {v.from, v.to, v.verdict != plan::Verdict::kInfeasible, v.t_start_s, v.t_end_s});
+            {v.from, v.to, plan::IsFeasible(v.verdict), v.t_start_s, v.t_end_s});
       for (const plan::Observation& ob : results[i].judgement.observed)
         r.observed.push_back({ob.t_s, ob.cf});
       replayed.push_back(std::move(r));
@@ -230,7 +230,8 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
           io::TrajectoryFileSamples samples(*l.trajectory_file);
           plan::SampleTicks ticks(samples, l.trajectory_file->t_first_s,
                                   l.trajectory_file->t_last_s, l.scene->model.time_step_s);
-          judgement = plan::Judge(*l.scene, ticks, l.plan->states, l.plan->limits, watch);
+          judgement = plan::Judge(*l.scene, ticks, l.plan->states, l.plan->limits, watch,
+                                  l.trajectory_file->stopped_early);
         } catch (const io::InputChanged& changed) {
           // Said after the batch, which then has no report: a result needs every plan.
           const std::lock_guard lock(changed_mutex);
@@ -250,7 +251,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
             plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(o.seed, files[i]), r),
             l.plan->states, l.plan->limits);
         for (std::size_t k = 0; k < jr.transitions.size(); ++k)
-          e.robust[k] += jr.transitions[k].verdict != plan::Verdict::kInfeasible;
+          e.robust[k] += plan::IsFeasible(jr.transitions[k].verdict);
         e.replayed_s += jr.replayed_s;
         e.run_s += jr.run_s;
       }

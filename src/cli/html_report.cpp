@@ -58,7 +58,15 @@ std::string Sig(double v) {
 const char* VerdictColour(plan::Verdict v) {
   return v == plan::Verdict::kFeasible             ? "#009E73"
          : v == plan::Verdict::kFeasibleWithDetour ? "#E69F00"
-                                                   : "#D55E00";
+         : v == plan::Verdict::kInfeasible         ? "#D55E00"
+                                                   : "#999999";
+}
+
+// The plan's verdict as a badge: "FEASIBLE", "INFEASIBLE" or "NOT JUDGED" on its colour.
+std::string Badge(const plan::Judgement& j) {
+  const plan::Verdict overall = plan::Overall(j);
+  return std::string("<span class=\"badge\" style=\"background:") + VerdictColour(overall) + "\">" +
+         Headline(overall) + "</span>";
 }
 
 // Plot points of a bin series: each bin's minimum and maximum in the order they happened, so the
@@ -480,12 +488,8 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
     const Evaluated& e = *plans[i].evaluated;
     // The whole replay's peak: the figure the 3D readout shows at the frame it opens on.
     const double peak = e.judgement.peak_force_N;
-    const plan::Verdict verdict =
-        e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible;
     o << "<tr><td><a href=\"#plan-" << i << "\">" << EscapeXml(e.plan.name) << "</a></td><td>"
-      << EscapeXml(e.file)
-      << "</td><td><span class=\"badge\" style=\"background:" << VerdictColour(verdict) << "\">"
-      << (e.judgement.feasible ? "FEASIBLE" : "INFEASIBLE") << "</span></td><td class=\"num\">"
+      << EscapeXml(e.file) << "</td><td>" << Badge(e.judgement) << "</td><td class=\"num\">"
       << e.judgement.transitions.size() << "</td><td class=\"num\">"
       << Fixed(e.judgement.replayed_s, 3) << "</td><td class=\"num\">" << Fixed(peak, 3)
       << "</td></tr>\n";
@@ -519,9 +523,7 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
     const HtmlPlan& p = plans[i];
     const Evaluated& e = *p.evaluated;
     o << "<section class=\"plan\" id=\"plan-" << i << "\" data-plan=\"" << i << "\"><h2>"
-      << EscapeXml(e.plan.name) << " <span class=\"badge\" style=\"background:"
-      << VerdictColour(e.judgement.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible)
-      << "\">" << (e.judgement.feasible ? "FEASIBLE" : "INFEASIBLE") << "</span></h2>\n"
+      << EscapeXml(e.plan.name) << " " << Badge(e.judgement) << "</h2>\n"
       << "<p class=\"meta\">" << EscapeXml(e.file) << " on " << EscapeXml(p.scene_path) << "; "
       << Fixed(e.judgement.replayed_s, 3) << " s replayed, " << e.judgement.ticks
       << " core ticks; limits: force " << Fixed(e.plan.limits.max_force_N, 3) << " N, strain "

@@ -1,6 +1,7 @@
 #include "report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
@@ -37,15 +38,21 @@ nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
                    [](const nlohmann::json& a, const nlohmann::json& b) {
                      return a["file"].get<std::string>() < b["file"].get<std::string>();
                    });
-  long feasible = 0;
-  for (const nlohmann::json& p : plans) feasible += p["feasible"].get<bool>();
+  long feasible = 0, not_judged = 0;
+  for (const nlohmann::json& p : plans) {
+    feasible += p["feasible"].get<bool>();
+    not_judged += p["outcome"] == "not judged";
+  }
   const long count = static_cast<long>(plans.size());
-  return {
-      {"tubeplan_evaluate", kEvaluateJsonVersion},
-      {"plan_set", {{"id", scope.plan_set_id}, {"plans", scope.plan_set_plans}}},
-      {"shard", {{"index", scope.shard_index}, {"count", scope.shard_count}}},
-      {"plans", plans},
-      {"summary", {{"plans", count}, {"feasible", feasible}, {"infeasible", count - feasible}}}};
+  return {{"tubeplan_evaluate", kEvaluateJsonVersion},
+          {"plan_set", {{"id", scope.plan_set_id}, {"plans", scope.plan_set_plans}}},
+          {"shard", {{"index", scope.shard_index}, {"count", scope.shard_count}}},
+          {"plans", plans},
+          {"summary",
+           {{"plans", count},
+            {"feasible", feasible},
+            {"infeasible", count - feasible - not_judged},
+            {"not_judged", not_judged}}}};
 }
 
 namespace {
@@ -96,6 +103,9 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
     plans.push_back({{"plan", e.plan.name},
                      {"file", e.file},
                      {"feasible", j.feasible},
+                     {"outcome", plan::ToString(plan::Overall(j))},
+                     {"stopped_early", j.stopped_early.empty() ? nlohmann::json(nullptr)
+                                                               : nlohmann::json(j.stopped_early)},
                      {"transitions", transitions},
                      {"after_goal", j.after_goal.started ? SpanJson(j.after_goal) : nullptr},
                      {"observed", observed},
@@ -137,22 +147,30 @@ void PrintSpan(std::ostream& t, const std::string& title, const plan::Transition
 
 }  // namespace
 
+std::string Headline(plan::Verdict overall) {
+  std::string text = plan::ToString(overall);
+  std::transform(text.begin(), text.end(), text.begin(),
+                 [](unsigned char c) { return char(std::toupper(c)); });
+  return text;
+}
+
 void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
   auto paint = [&](plan::Verdict v, const std::string& text) {
     if (!colour) return text;
     const char* code = v == plan::Verdict::kFeasible             ? "\033[32m"
                        : v == plan::Verdict::kFeasibleWithDetour ? "\033[33m"
-                                                                 : "\033[31m";
+                       : v == plan::Verdict::kInfeasible         ? "\033[31m"
+                                                                 : "\033[2m";
     return std::string(code) + text + "\033[0m";
   };
   const std::streamsize precision = t.precision(3);
   const plan::Judgement& j = e.judgement;
-  t << e.file << " (" << e.plan.name << "): "
-    << paint(j.feasible ? plan::Verdict::kFeasible : plan::Verdict::kInfeasible,
-             j.feasible ? "FEASIBLE" : "INFEASIBLE")
-    << ", " << j.transitions.size()
-    << (j.transitions.size() == 1 ? " transition, " : " transitions, ") << j.replayed_s
-    << " s replayed\n";
+  const plan::Verdict overall = plan::Overall(j);
+  t << e.file << " (" << e.plan.name << "): " << paint(overall, Headline(overall)) << ", "
+    << j.transitions.size() << (j.transitions.size() == 1 ? " transition, " : " transitions, ")
+    << j.replayed_s << " s replayed";
+  if (!j.stopped_early.empty()) t << "; the run stopped early: " << j.stopped_early;
+  t << "\n";
   if (!j.strain_warning.empty()) t << "  warning: " << j.strain_warning << "\n";
   for (std::size_t k = 0; k < j.transitions.size(); ++k) {
     const plan::TransitionVerdict& v = j.transitions[k];

@@ -51,5 +51,7 @@ nlohmann::json Report(nlohmann::json plans, const ReportScope& scope);
 nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope);
 /// One plan's verdicts as text: its line, then each transition with its figures.
 void PrintVerdicts(std::ostream& out, const Evaluated& e, bool colour);
+/// A plan's verdict (plan::Overall) as its headline: "FEASIBLE", "INFEASIBLE", "NOT JUDGED".
+std::string Headline(plan::Verdict overall);
 
 }  // namespace tubeplan::cli

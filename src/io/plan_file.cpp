@@ -45,23 +45,33 @@ std::string FormatPlanYaml(const plan::Plan& p) {
   return out.str();
 }
 
-std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz) {
+std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz,
+                                const std::vector<std::string>& extra_columns) {
   std::string out;
   if (!device.empty()) out += "# device: " + device + "\n";
   if (nominal_rate_Hz > 0.0) out += "# rate: " + Number(nominal_rate_Hz) + " Hz\n";
   out += "# units: m\n";
-  out += "t,px,py,pz,qw,qx,qy,qz\n";
+  out += "t,px,py,pz,qw,qx,qy,qz";
+  for (const std::string& c : extra_columns) out += "," + c;
+  out += "\n";
   return out;
 }
 
-void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s) {
+std::string TrajectoryCsvStopped(const std::string& stopped_early) {
+  return "# stopped: " + stopped_early + "\n";
+}
+
+void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s,
+                            std::string_view extra_fields) {
   char t[32];
   const auto [end, ec] = std::to_chars(t, t + sizeof t, s.t_s);  // shortest round trip
   out.append(t, ec == std::errc() ? end : t);
   char row[192];
-  std::snprintf(row, sizeof row, ",%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", s.p_WH_m.x(),
-                s.p_WH_m.y(), s.p_WH_m.z(), s.q_WH.w(), s.q_WH.x(), s.q_WH.y(), s.q_WH.z());
+  std::snprintf(row, sizeof row, ",%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f", s.p_WH_m.x(), s.p_WH_m.y(),
+                s.p_WH_m.z(), s.q_WH.w(), s.q_WH.x(), s.q_WH.y(), s.q_WH.z());
   out += row;
+  if (!extra_fields.empty()) out.append(",").append(extra_fields);
+  out += '\n';
 }
 
 std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
@@ -72,6 +82,7 @@ std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
                   s.p_WH_m.y(), s.p_WH_m.z(), s.q_WH.w(), s.q_WH.x(), s.q_WH.y(), s.q_WH.z());
     out += row;
   }
+  if (!t.stopped_early.empty()) out += TrajectoryCsvStopped(t.stopped_early);
   return out;
 }
 

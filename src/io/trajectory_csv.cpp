@@ -114,6 +114,7 @@ class RowParser {
   const std::vector<double>& extra_values() const { return extra_; }
   std::string device;
   double nominal_rate_Hz = 0.0;
+  std::string stopped_early;
   std::vector<std::string> extra_columns;
 
  private:
@@ -150,6 +151,8 @@ void RowParser::Metadata(std::string_view content, std::size_t leading, int line
   const int value_column = static_cast<int>(leading + colon + 1 + value_lead) + 1;
   if (key == "device") {
     device = std::string(value);
+  } else if (key == "stopped") {
+    stopped_early = std::string(value);
   } else if (key == "rate") {
     const QuantityResult rate = ParseQuantityAs(value, dim::kFrequency);
     if (!rate.quantity || !(rate.quantity->value_si > 0.0)) {
@@ -397,6 +400,7 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
   rows.Finish();
   trajectory.device = rows.device;
   trajectory.nominal_rate_Hz = rows.nominal_rate_Hz;
+  trajectory.stopped_early = rows.stopped_early;
   trajectory.extra_columns = rows.extra_columns;
   if (!result.diagnostics.HasErrors()) result.trajectory = std::move(trajectory);
   return result;
@@ -446,6 +450,7 @@ TrajectoryScanResult ScanTrajectoryFile(const std::filesystem::path& path,
   info.sample_count = rows.sample_count();
   info.device = rows.device;
   info.nominal_rate_Hz = rows.nominal_rate_Hz;
+  info.stopped_early = rows.stopped_early;
   info.extra_columns = rows.extra_columns;
   info.file_bytes = in.file().size();
   info.modified_ns = in.file().modified_ns();

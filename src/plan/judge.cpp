@@ -48,8 +48,22 @@ const char* ToString(Verdict verdict) {
       return "feasible-with-detour";
     case Verdict::kInfeasible:
       return "infeasible";
+    case Verdict::kNotJudged:
+      return "not judged";
   }
   return "infeasible";
+}
+
+Verdict Overall(const Judgement& judgement) {
+  if (judgement.feasible) return Verdict::kFeasible;
+  const auto infeasible = [](const TransitionVerdict& v) {
+    return v.verdict == Verdict::kInfeasible;
+  };
+  const bool any_infeasible =
+      std::any_of(judgement.transitions.begin(), judgement.transitions.end(), infeasible) ||
+      (judgement.after_goal.started && infeasible(judgement.after_goal));
+  return any_infeasible || judgement.stopped_early.empty() ? Verdict::kInfeasible
+                                                           : Verdict::kNotJudged;
 }
 
 std::string FlagWarning(std::size_t i, double seconds) {
@@ -248,11 +262,37 @@ void Judging::Counted() {
   }
 }
 
-Judgement Judging::Finish() {
+// A run that stopped early: the span under way, unless a limit already failed it, and every
+// span after it are not judged; the trajectory did not end, the run did.
+void Judging::NotJudged(double t_end) {
+  if (failed_) return;
+  const std::string why = "the run stopped: " + j_.stopped_early;
+  TransitionVerdict* under_way = UnderWay();
+  if (under_way && under_way->verdict == Verdict::kInfeasible && !under_way->reason.empty()) {
+    failed_ = true;  // judged before the stop; the spans after it are not reached
+    return;
+  }
+  if (under_way) {
+    under_way->t_end_s = t_end;
+    under_way->energy_exit_J = energy_last_;
+    under_way->detour = passed_;
+  }
+  for (std::size_t i = at_; i < n_; ++i) {
+    j_.transitions[i].verdict = Verdict::kNotJudged;
+    j_.transitions[i].reason = why;
+  }
+  j_.after_goal.verdict = Verdict::kNotJudged;
+  j_.after_goal.reason = why;
+  failed_ = true;
+}
+
+Judgement Judging::Finish(const std::string& stopped_early) {
   const std::vector<std::string>& states = states_;
   const double t_end = t_last_;
   const double T = step_s_;
   Flush();
+  j_.stopped_early = stopped_early;
+  if (!stopped_early.empty()) NotJudged(t_end);
   if (!failed_ && at_ < n_ && j_.transitions[at_].started) {
     TransitionVerdict& v = j_.transitions[at_];
     v.t_end_s = t_end;
@@ -297,8 +337,8 @@ Judgement Judging::Finish() {
       v.reason = "not reached: the plan failed at an earlier transition";
   }
   j_.feasible = std::all_of(j_.transitions.begin(), j_.transitions.end(),
-                            [](const auto& v) { return v.verdict != Verdict::kInfeasible; }) &&
-                after.started && after.verdict != Verdict::kInfeasible;
+                            [](const auto& v) { return IsFeasible(v.verdict); }) &&
+                after.started && IsFeasible(after.verdict);
   j_.replayed_s = t_end - t_first_;
   if (tube_) j_.strain_warning = StrainWarning(*tube_, j_.peak_strain, j_.peak_strain_t_s);
   return j_;
@@ -309,12 +349,12 @@ Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const TickWatcher& watch) {
   // One tick at a time (TickStream), not Resample: a long recording is not held twice.
   TickStream ticks(trajectory, scene.model.time_step_s);
-  return Judge(scene, ticks, states, limits, watch);
+  return Judge(scene, ticks, states, limits, watch, trajectory.stopped_early);
 }
 
 Judgement Judge(const scene::Scene& scene, TickSource& ticks,
                 const std::vector<std::string>& states, const Limits& limits,
-                const TickWatcher& watch) {
+                const TickWatcher& watch, const std::string& stopped_early) {
   const auto clock_start = std::chrono::steady_clock::now();
   const double T = scene.model.time_step_s;
   core::Core core(scene);
@@ -326,7 +366,7 @@ Judgement Judge(const scene::Scene& scene, TickSource& ticks,
     judging.Tick(sample.t_s, core.Step(sample.t_s, Pose(sample)), text);
     if (watch) watch(sample.t_s, core);
   }
-  Judgement j = judging.Finish();
+  Judgement j = judging.Finish(stopped_early);
   j.run_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
   return j;
 }

@@ -50,6 +50,8 @@ inline void CheckSameVerdicts(const nlohmann::json& live_report, const nlohmann:
   CHECK(a["observed"] == b["observed"]);
   CHECK(a["ticks"] == b["ticks"]);
   CHECK(a["feasible"] == b["feasible"]);
+  CHECK(a["outcome"] == b["outcome"]);
+  CHECK(a["stopped_early"] == b["stopped_early"]);
 }
 
 }  // namespace tubeplan::testing

@@ -32,7 +32,7 @@ struct SyntheticTick {
 
 // Feeds ticks 1 ms apart (t = 1 ms for the first) and returns the judgement.
 plan::Judgement Run(const std::vector<std::string>& states, const std::vector<SyntheticTick>& ticks,
-                    plan::Limits limits = {}) {
+                    plan::Limits limits = {}, const std::string& stopped_early = {}) {
   plan::Judging judging(states, limits, 1e-3);
   for (std::size_t k = 0; k < ticks.size(); ++k) {
     core::StepOutput out;
@@ -46,7 +46,7 @@ plan::Judgement Run(const std::vector<std::string>& states, const std::vector<Sy
     judging.Tick(1e-3 * double(k + 1), out,
                  [&] { return kNames[std::size_t(out.contact_count > 0 ? s.state : 0)]; });
   }
-  return judging.Finish();
+  return judging.Finish(stopped_early);
 }
 
 // `count` ticks in `state`, each with energy 1e-3 times its tick number (1-based, so the energy
@@ -246,4 +246,68 @@ TEST_CASE("Fault ticks are not a state of the tube and are warned about", "[plan
   const std::string text = Text(j, states);
   CHECK(text.find("      warning: for 0.03 s the core could not solve the tick (flag fault") !=
         std::string::npos);
+}
+
+TEST_CASE("A run that stopped early judges only what it finished", "[plan]") {
+  const std::vector<std::string> states = {kNames[0], kNames[1], kNames[2], kNames[3]};
+  const std::string stop = "interrupted at t = 0.110 s";
+  std::vector<SyntheticTick> ticks;
+  Add(ticks, 0, 50);
+  Add(ticks, 1, 50);
+  Add(ticks, 2, 10);  // {Fs n} entered at 101 ms, not yet counted (dwell 20 ms)
+  SECTION("the span under way and those after it are not judged") {
+    const plan::Judgement j = Run(states, ticks, {}, stop);
+    CHECK_FALSE(j.feasible);
+    CHECK(plan::Overall(j) == plan::Verdict::kNotJudged);
+    CHECK(j.stopped_early == stop);
+    CHECK(j.transitions[0].verdict == plan::Verdict::kFeasible);
+    const plan::TransitionVerdict& cut = j.transitions[1];
+    CHECK(cut.verdict == plan::Verdict::kNotJudged);
+    CHECK(cut.reason == "the run stopped: " + stop);
+    CHECK(cut.started);
+    CHECK(cut.t_start_s == Approx(0.051));
+    CHECK(cut.t_end_s == Approx(0.110));
+    CHECK(cut.detour.empty());  // {Fs n} entered, never counted: not a detour
+    CHECK(j.transitions[2].verdict == plan::Verdict::kNotJudged);
+    CHECK_FALSE(j.transitions[2].started);
+    CHECK_THAT(Text(j, states), Catch::Contains("NOT JUDGED, 3 transitions, 0.109 s replayed; "
+                                                "the run stopped early: " +
+                                                stop));
+    const nlohmann::json json = Json(j, states);
+    CHECK(json["outcome"] == "not judged");
+    CHECK(json["stopped_early"] == stop);
+    CHECK(json["transitions"][1]["verdict"] == "not judged");
+    cli::Evaluated e;
+    e.judgement = j;
+    const nlohmann::json summary = cli::ToJson({e}, {})["summary"];
+    CHECK(summary["not_judged"] == 1);
+    CHECK(summary["infeasible"] == 0);
+  }
+  SECTION("a limit exceeded before the stop is a verdict") {
+    ticks[59].force_N = 10.0;
+    const plan::Judgement j = Run(states, ticks, {}, stop);
+    CHECK(plan::Overall(j) == plan::Verdict::kInfeasible);
+    CHECK(j.transitions[1].verdict == plan::Verdict::kInfeasible);
+    CHECK(j.transitions[1].reason == "limit exceeded: operator force 10 N > 8.5 N at t = 0.060 s");
+    CHECK(j.transitions[2].reason == "not reached: the plan failed at an earlier transition");
+    CHECK(Json(j, states)["outcome"] == "infeasible");
+  }
+  SECTION("the goal reached, the stretch after it cut short") {
+    Add(ticks, 2, 40);
+    Add(ticks, 3, 50);
+    const plan::Judgement j = Run(states, ticks, {}, stop);
+    for (const plan::TransitionVerdict& v : j.transitions)
+      CHECK(v.verdict == plan::Verdict::kFeasible);
+    CHECK(j.after_goal.started);
+    CHECK(j.after_goal.verdict == plan::Verdict::kNotJudged);
+    CHECK_FALSE(j.feasible);
+    CHECK(plan::Overall(j) == plan::Verdict::kNotJudged);
+  }
+  SECTION("a trajectory that ended there is judged: the next state was never reached") {
+    const plan::Judgement j = Run(states, ticks);
+    CHECK(plan::Overall(j) == plan::Verdict::kInfeasible);
+    CHECK(j.transitions[1].verdict == plan::Verdict::kInfeasible);
+    CHECK_THAT(j.transitions[1].reason, Catch::StartsWith(kNames[2] + " never reached"));
+    CHECK(Json(j, states)["stopped_early"].is_null());
+  }
 }

@@ -1,13 +1,16 @@
 // Hand trajectories: resampling onto the core's step, and the CSV loader's values and messages.
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <unistd.h>
 #include <vector>
 
 #include <catch2/catch.hpp>
 
+#include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 
@@ -293,6 +296,42 @@ TEST_CASE("Extra columns hold any text and are kept by name", "[trajectory]") {
                            "t.csv")
             .diagnostics.FormatAll() ==
         "t.csv:3:7: error: 'zero' is not a number, expected a decimal number\n");
+}
+
+TEST_CASE("A live recording's marks read back: stalled ticks and where the run stopped",
+          "[trajectory]") {
+  std::string csv = tubeplan::io::TrajectoryCsvHeader("emulator", 1000.0, {"stalled"});
+  HandSample s;
+  for (int k = 0; k < 3; ++k) {
+    s.t_s = 1e-3 * k;
+    s.p_WH_m.x() = 1e-4 * k;
+    tubeplan::io::AppendTrajectoryCsvRow(csv, s, k == 1 ? "1" : "0");
+  }
+  csv += tubeplan::io::TrajectoryCsvStopped("missed deadlines at t = 0.002 s");
+  const auto loaded = LoadTrajectoryText(csv, "live.csv");
+  REQUIRE(loaded.diagnostics.FormatAll() == "");
+  const Trajectory& t = *loaded.trajectory;
+  CHECK(t.stopped_early == "missed deadlines at t = 0.002 s");
+  REQUIRE(t.extra_columns == std::vector<std::string>{"stalled"});
+  CHECK(t.extra_values[0][0] == 0.0);
+  CHECK(t.extra_values[1][0] == 1.0);
+  CHECK(t.samples[2].p_WH_m.x() == 2e-4);
+  // The streamed check of a file learns it too, and a trajectory written out keeps it.
+  const std::string path = std::string(std::getenv("TMPDIR") ? std::getenv("TMPDIR") : "/tmp") +
+                           "/tubeplan-stopped-" + std::to_string(::getpid()) + ".csv";
+  std::FILE* f = std::fopen(path.c_str(), "wb");
+  REQUIRE(f);
+  std::fwrite(csv.data(), 1, csv.size(), f);
+  std::fclose(f);
+  const auto scanned = tubeplan::io::ScanTrajectoryFile(path);
+  std::remove(path.c_str());
+  REQUIRE(scanned.info);
+  CHECK(scanned.info->stopped_early == t.stopped_early);
+  const std::string written = tubeplan::io::FormatTrajectoryCsv(t);
+  CHECK_THAT(written, Catch::EndsWith("\n# stopped: missed deadlines at t = 0.002 s\n"));
+  const auto again = LoadTrajectoryText(written, "again.csv");
+  REQUIRE(again.trajectory);
+  CHECK(again.trajectory->stopped_early == t.stopped_early);
 }
 
 TEST_CASE("Damaged trajectory files never throw", "[trajectory]") {

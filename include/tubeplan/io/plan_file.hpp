@@ -49,14 +49,21 @@ std::string FormatPlanYaml(const plan::Plan& plan);
 
 /// A trajectory as CSV in the format LoadTrajectoryText reads: '#' metadata lines (device,
 /// rate, units), the header t,px,py,pz,qw,qx,qy,qz, one row per sample (positions to the
-/// nanometre, quaternions to 1e-9).
+/// nanometre, quaternions to 1e-9), and the "# stopped:" line of a trajectory that has one.
 std::string FormatTrajectoryCsv(const plan::Trajectory& trajectory);
 
-/// The '#' metadata lines and the header of a trajectory CSV, as FormatTrajectoryCsv writes them.
-std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz);
+/// The '#' metadata lines and the header of a trajectory CSV, as FormatTrajectoryCsv writes them,
+/// with `extra_columns` after the pose columns.
+std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz,
+                                const std::vector<std::string>& extra_columns = {});
+/// The line that ends the recording of a run that stopped early (plan::Trajectory's
+/// stopped_early).
+std::string TrajectoryCsvStopped(const std::string& stopped_early);
 /// Appends one sample as a row for a streamed recording: t as the shortest text that reads back
 /// to the same double (so a replay's grid t0 + k T meets the samples exactly), the position to
-/// the nanometre and the quaternion to 1e-9 as written (the reader normalises it).
-void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& sample);
+/// the nanometre and the quaternion to 1e-9 as written (the reader normalises it), then
+/// `extra_fields` (the extra columns' fields, comma-separated) when not empty.
+void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& sample,
+                            std::string_view extra_fields = {});
 
 }  // namespace tubeplan::io

@@ -46,6 +46,7 @@ struct TrajectoryInfo {
   double t_last_s = 0.0;
   std::string device;                      ///< as plan::Trajectory's
   double nominal_rate_Hz = 0.0;            ///< as plan::Trajectory's
+  std::string stopped_early;               ///< as plan::Trajectory's
   std::vector<std::string> extra_columns;  ///< as plan::Trajectory's
   std::uintmax_t file_bytes = 0;           ///< the file as it was checked, to see it change
   std::int64_t modified_ns = 0;

@@ -19,8 +19,13 @@
 
 namespace tubeplan::plan {
 
-enum class Verdict { kFeasible, kFeasibleWithDetour, kInfeasible };
-const char* ToString(Verdict verdict);  ///< "feasible", "feasible-with-detour", "infeasible"
+/// kNotJudged: a live run stopped (a fault, Ctrl-C) before the replay finished the span.
+enum class Verdict { kFeasible, kFeasibleWithDetour, kInfeasible, kNotJudged };
+/// "feasible", "feasible-with-detour", "infeasible", "not judged"
+const char* ToString(Verdict verdict);
+inline bool IsFeasible(Verdict v) {
+  return v == Verdict::kFeasible || v == Verdict::kFeasibleWithDetour;
+}
 
 /// The core's flags a verdict warns about, in one place (the core may rename its flags; this
 /// table is the one mapping from them): per transition the time spent in ticks carrying each is
@@ -98,7 +103,15 @@ struct Judgement {
   long ticks = 0;
   double replayed_s = 0.0;  ///< trajectory time replayed
   double run_s = 0.0;       ///< wall time of the replay
+  /// Why and when the run that made the trajectory stopped before its end ("interrupted at t =
+  /// 2.310 s"); empty when the trajectory is whole. What it did not finish is kNotJudged.
+  std::string stopped_early;
 };
+
+/// The plan's verdict: kFeasible (Judgement::feasible), kInfeasible (a span judged infeasible,
+/// or a whole trajectory that did not get to the goal), or kNotJudged (none infeasible, but the
+/// run stopped before the replay judged them all).
+Verdict Overall(const Judgement& judgement);
 
 /// The judge, tick by tick: batch replay (Judge below) and the live servo loop feed it the core's
 /// output of every tick, so both give the same verdicts for the same ticks.
@@ -113,7 +126,9 @@ class Judging {
   /// called only on a tick whose formation key differs from the last one's.
   void Tick(double t_s, const core::StepOutput& out, const std::function<std::string()>& cf_text);
   /// Closes the judgement after the last tick (nothing is judged without a tick).
-  Judgement Finish();
+  /// `stopped_early`: why and when the run stopped before the trajectory's end (Judgement's), or
+  /// empty; the spans it cut short are then not judged, rather than judged never reached.
+  Judgement Finish(const std::string& stopped_early = {});
 
   // The judgement so far (live display).
   const std::vector<TransitionVerdict>& transitions() const { return j_.transitions; }
@@ -141,6 +156,7 @@ class Judging {
   void Measure(double t_s, const core::StepOutput& out);
   void Flush();  // pending_ into the span under way (or dropped once the plan failed)
   void Counted();
+  void NotJudged(double t_end);
   TransitionVerdict* UnderWay();
   void Fail(TransitionVerdict& v, const std::string& reason, double t_s);
 
@@ -169,14 +185,16 @@ class Judging {
 using TickWatcher = std::function<void(double t_s, const core::Core& core)>;
 
 /// Replays `trajectory` (resampled onto the scene's step) from its first pose and judges
-/// `states` (planned CFs, canonical) under `limits`; `watch` (may be empty) sees every tick.
+/// `states` (planned CFs, canonical) under `limits`; `watch` (may be empty) sees every tick. A
+/// recording of a run that stopped early (Trajectory::stopped_early) is judged as that run was.
 Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch = {});
 /// The same from ticks that come one at a time (a trajectory file replayed row by row,
 /// SampleTicks); `ticks` must be on the scene's step. The same ticks give the same judgement.
+/// `stopped_early` as Judging::Finish's.
 Judgement Judge(const scene::Scene& scene, TickSource& ticks,
                 const std::vector<std::string>& states, const Limits& limits,
-                const TickWatcher& watch = {});
+                const TickWatcher& watch = {}, const std::string& stopped_early = {});
 
 }  // namespace tubeplan::plan

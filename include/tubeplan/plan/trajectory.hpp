@@ -20,9 +20,12 @@ struct HandSample {
 };
 
 struct Trajectory {
-  std::vector<HandSample> samples;         ///< strictly increasing t_s, at least two
-  std::string device;                      ///< from the "# device:" line, may be empty
-  double nominal_rate_Hz = 0.0;            ///< from the "# rate:" line, 0 when not given
+  std::vector<HandSample> samples;  ///< strictly increasing t_s, at least two
+  std::string device;               ///< from the "# device:" line, may be empty
+  double nominal_rate_Hz = 0.0;     ///< from the "# rate:" line, 0 when not given
+  /// From the "# stopped:" line a live recording of a run that stopped early ends with: why and
+  /// when ("interrupted at t = 2.310 s"). Empty for a whole trajectory.
+  std::string stopped_early;
   std::vector<std::string> extra_columns;  ///< names of columns beyond the pose
   /// Per sample, in extra_columns order: the number a field spells, NaN for other text (extra
   /// columns may hold any text). Empty when there are no extra columns (an empty vector per
