@@ -19,6 +19,7 @@
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/emulator.hpp>
+#include <tubeplan/device/host_check.hpp>
 #include <tubeplan/device/openhaptics.hpp>
 #include <tubeplan/device/openigtlink.hpp>
 #include <tubeplan/device/servo.hpp>
@@ -40,6 +41,7 @@ struct LiveOptions {
   bool json = false;
   double duration_s = 0.0;  // 0: the emulator's trajectory and a settling time
   bool no_realtime = false;
+  bool check_host = false;
 };
 
 // What `--device emulator[:ARG,...]` asks for.
@@ -249,6 +251,68 @@ class Display {
   double max_force_N_;
   bool drawn_ = false;
 };
+
+// `live --check-host`: this host's wake-ups at the servo's rate, and what they mean for a run.
+int RunHostCheck(const LiveOptions& o, Streams io) {
+  // Every wake-up's lateness is kept (8 bytes a millisecond): an hour at most.
+  constexpr double kMaxCheck_s = 3600.0;
+  if (o.duration_s > kMaxCheck_s) {
+    io.err << "tubeplan live: error: --check-host --duration " << o.duration_s
+           << ": expected at most " << kMaxCheck_s << " s\n";
+    return kExitBadInput;
+  }
+  // The servo's period: the scene format's step (1 kHz).
+  const double period_s = scene::ModelOptions{}.time_step_s;
+  device::MonotonicClock clock;
+  const device::HostLatency l = device::MeasureHostLatency(
+      clock, o.duration_s > 0.0 ? o.duration_s : 10.0, period_s, !o.no_realtime);
+  const device::ServoConfig limits;
+  const device::HostVerdict v = device::JudgeHost(l, device::ReadHostFacts(), limits);
+  if (!l.realtime_note.empty()) io.err << "tubeplan live: note: " << l.realtime_note << "\n";
+  if (o.json) {
+    const nlohmann::json report = {{"tubeplan_host_check", 1},
+                                   {"period_us", period_s * 1e6},
+                                   {"duration_s", l.duration_s},
+                                   {"wakes", l.wakes},
+                                   {"median_us", l.median_us},
+                                   {"p99_us", l.p99_us},
+                                   {"p999_us", l.p999_us},
+                                   {"max_us", l.max_us},
+                                   {"stalls", l.stalls},
+                                   {"periods_lost", l.periods_lost},
+                                   {"worst_stalls_per_s", l.worst_stalls_per_s},
+                                   {"realtime", l.realtime_asked && l.realtime_note.empty()},
+                                   {"max_stall_ms", limits.max_stall_s * 1e3},
+                                   {"max_stalls_per_s", limits.max_stalls_per_s},
+                                   {"verdict", device::ToString(v.fitness)},
+                                   {"summary", v.summary},
+                                   {"advice", v.advice}};
+    io.out << report.dump(2) << "\n";
+    return kExitOk;
+  }
+  std::ostringstream t;
+  t << std::fixed << std::setprecision(1) << "host check: " << l.wakes << " wake-ups every "
+    << period_s * 1e3 << " ms over " << l.duration_s << " s, "
+    << (!l.realtime_asked         ? "normal priority (--no-realtime)"
+        : l.realtime_note.empty() ? "SCHED_FIFO (as the servo thread)"
+                                  : "normal priority (SCHED_FIFO not permitted)")
+    << "\n";
+  t << "lateness: median " << l.median_us << " us, p99 " << l.p99_us << " us, p99.9 " << l.p999_us
+    << " us, max " << l.max_us << " us\n";
+  t << "stalls (more than a period late): ";
+  if (l.stalls == 0)
+    t << "none";
+  else
+    t << l.stalls << ", " << l.periods_lost << " periods lost, at most " << l.worst_stalls_per_s
+      << " in one second";
+  t << " (a live run stops on one longer than " << std::lround(limits.max_stall_s * 1e3)
+    << " ms or more than " << limits.max_stalls_per_s << " in a second)\n";
+  t << "verdict: " << v.summary << "\n";
+  if (!v.advice.empty()) t << "what would help:\n";
+  for (const std::string& a : v.advice) t << "  - " << a << "\n";
+  io.out << t.str();
+  return kExitOk;
+}
 
 int RunLive(const LiveOptions& o, Streams io) {
   io::PlanLoadResult loaded = io::LoadPlanFile(o.plan);
@@ -517,7 +581,7 @@ Command AddLiveCommand(CLI::App& app, Streams streams) {
       "live",
       "Verify a plan live with a haptic device: the core at 1 kHz in a servo thread, a display, "
       "and at the end the verdicts as `evaluate` gives them plus the servo's timing.");
-  sub->add_option("plan", options->plan, "plan file (.yaml)")->required();
+  CLI::Option* plan_option = sub->add_option("plan", options->plan, "plan file (.yaml)");
   sub->add_option("--device", options->device,
                   "emulator[:FILE.csv][,fast][,mass=M][,stiffness=K][,damping=D]: a simulated "
                   "PHANToM Premium 1.5/6DOF held by a simulated hand following FILE (default: the "
@@ -528,8 +592,9 @@ Command AddLiveCommand(CLI::App& app, Streams streams) {
                   "openhaptics[:NAME]: a PHANToM through the OpenHaptics SDK (only in a build "
                   "with -DTUBEPLAN_OPENHAPTICS=ON)")
       ->capture_default_str();
-  sub->add_option("--record", options->record,
-                  "write the hand trajectory to FILE (trajectory CSV), completed by rename");
+  CLI::Option* record_option =
+      sub->add_option("--record", options->record,
+                      "write the hand trajectory to FILE (trajectory CSV), completed by rename");
   sub->add_flag("--json", options->json, "print the report as one JSON document");
   sub->add_option("--duration", options->duration_s,
                   "seconds to run (default: the emulator's trajectory and 0.5 s; other devices "
@@ -537,7 +602,21 @@ Command AddLiveCommand(CLI::App& app, Streams streams) {
       ->check(CLI::Range(0.001, 86400.0));
   sub->add_flag("--no-realtime", options->no_realtime,
                 "do not ask for SCHED_FIFO for the servo thread");
-  return {sub, [options, streams] { return RunLive(*options, streams); }};
+  sub->add_flag("--check-host", options->check_host,
+                "no plan, no device: wake at the servo's 1 kHz for --duration (default 10 s) and "
+                "report how late this host wakes the thread and what to expect of a live run")
+      ->excludes(plan_option)
+      ->excludes(record_option)
+      ->excludes("--device");
+  return {sub, [options, streams] {
+            if (options->check_host) return RunHostCheck(*options, streams);
+            if (options->plan.empty()) {
+              streams.err << "tubeplan live: error: a plan file is needed (or --check-host to "
+                             "check this host alone)\n";
+              return kExitBadInput;
+            }
+            return RunLive(*options, streams);
+          }};
 }
 
 }  // namespace tubeplan::cli

@@ -50,18 +50,20 @@ Eigen::Isometry3d PoseOf(const plan::HandSample& s) {
 // from_chars reads back to the same bits.
 double Nano(double v) { return std::round(v * 1e9) / 1e9; }
 
-// SCHED_FIFO at a high priority, leaving the top for the kernel's own threads; empty or a note.
+}  // namespace
+
+// A high priority, leaving the top for the kernel's own threads.
+int RealtimePriority() { return std::max(1, sched_get_priority_max(SCHED_FIFO) - 10); }
+
 std::string TryRealtime() {
   sched_param param{};
-  param.sched_priority = std::max(1, sched_get_priority_max(SCHED_FIFO) - 10);
+  param.sched_priority = RealtimePriority();
   const int e = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
   if (e == 0) return {};
   return std::string("real-time priority (SCHED_FIFO) not permitted: ") + std::strerror(e) +
          "; the servo runs at normal priority, expect more jitter (run as root or grant "
          "CAP_SYS_NICE / an rtprio limit)";
 }
-
-}  // namespace
 
 const char* ToString(StopReason reason) {
   switch (reason) {

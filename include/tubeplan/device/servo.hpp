@@ -115,6 +115,12 @@ class ScopedStopSignals {
   static void Clear();
 };
 
+/// The SCHED_FIFO priority the servo thread asks for (an rtprio limit must allow at least this).
+int RealtimePriority();
+/// Asks SCHED_FIFO at RealtimePriority() for the calling thread: empty when set, else a note of
+/// why not and what would permit it.
+std::string TryRealtime();
+
 /// The pose a recording (io::FormatTrajectoryCsvRow, 1 nm and 1e-9) gives back on reading,
 /// including the reader's normalisation of the quaternion. The servo feeds the core this pose,
 /// so a replay of the recording steps the core with the same bits and reaches the same verdicts.
