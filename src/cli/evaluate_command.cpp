@@ -108,8 +108,9 @@ bool GraphSections(const std::vector<Evaluated>& results,
     for (const std::size_t i : members) {
       graph::ReplayedPlan r;
       for (const plan::TransitionVerdict& v : results[i].judgement.transitions)
-        r.transitions.push_back(
-            {v.from, v.to, plan::IsFeasible(v.verdict), v.t_start_s, v.t_end_s});
+        if (v.verdict != plan::Verdict::kNotJudged)
+          r.transitions.push_back(
+              {v.from, v.to, plan::IsFeasible(v.verdict), v.t_start_s, v.t_end_s});
       for (const plan::Observation& ob : results[i].judgement.observed)
         r.observed.push_back({ob.t_s, ob.cf});
       replayed.push_back(std::move(r));

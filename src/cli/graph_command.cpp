@@ -81,7 +81,8 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
            (t.value("t_end_s", nlohmann::json()).is_number() ||
             t.value("t_end_s", nlohmann::json(0)).is_null());
       // A transition the replay never got to has no span (null times): no step falls in it.
-      if (ok)
+      // One a live run did not finish is no verdict on the arcs.
+      if (ok && t["verdict"] != "not judged")
         r.transitions.push_back({t["from"], t["to"], t["verdict"] != "infeasible",
                                  t["t_start_s"].is_null() ? 0.0 : t["t_start_s"].get<double>(),
                                  t["t_end_s"].is_null() ? 0.0 : t["t_end_s"].get<double>()});
