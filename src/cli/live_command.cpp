@@ -405,8 +405,8 @@ int RunLive(const LiveOptions& o, Streams io) {
       io.err << o.record << ": error: " << e << "\n";
       return kExitBadInput;
     }
-    recording.Append(
-        io::TrajectoryCsvHeader(dev->spec().name + ", tubeplan live " + plan.name, 1.0 / T));
+    recording.Append(io::TrajectoryCsvHeader(dev->spec().name + ", tubeplan live " + plan.name,
+                                             1.0 / T, {"stalled"}));
   }
 
   // A stepped run can outpace this thread: its ring holds the whole run. In real time 16 s of
@@ -442,6 +442,7 @@ int RunLive(const LiveOptions& o, Streams io) {
   std::string row, record_error;
   device::TickRecord record;
   long recorded = 0;
+  double t_last_s = 0.0;  // the last judged tick's trajectory time
   using Clock = std::chrono::steady_clock;
   auto next_draw = Clock::now(), next_flush = Clock::now(), next_line = Clock::now();
   std::string last_counted;
@@ -452,9 +453,10 @@ int RunLive(const LiveOptions& o, Streams io) {
       if (!record.stepped) continue;
       judging.Tick(record.hand.t_s, record.out,
                    [&] { return FormationText(record.out, elements); });
+      t_last_s = record.hand.t_s;
       if (!o.record.empty()) {
         row.clear();
-        io::AppendTrajectoryCsvRow(row, record.hand);
+        io::AppendTrajectoryCsvRow(row, record.hand, record.stalled ? "1" : "0");
         recording.Append(row);
         ++recorded;
       }
@@ -503,8 +505,19 @@ int RunLive(const LiveOptions& o, Streams io) {
            << device::ToString(stats.stop) << ")\n";
     return kExitInternal;
   }
+  // A fault or a signal ends the run before the trajectory does: what it cut short is not judged,
+  // in this report and in evaluate's of the recording.
+  std::string stopped_early;
+  if (stats.stop == device::StopReason::kSignal || device::IsFault(stats.stop)) {
+    char when[48];
+    std::snprintf(when, sizeof when, " at t = %.3f s", t_last_s);
+    stopped_early = (stats.stop == device::StopReason::kSignal ? std::string("interrupted")
+                                                               : device::ToString(stats.stop)) +
+                    when;
+  }
   if (!o.record.empty()) {
     if (recorded < 2) record_error = "fewer than two ticks recorded";
+    if (!stopped_early.empty()) recording.Append(io::TrajectoryCsvStopped(stopped_early));
     if (record_error.empty()) record_error = recording.Commit();
     if (!record_error.empty()) io.err << o.record << ": error: " << record_error << "\n";
   }
@@ -512,7 +525,7 @@ int RunLive(const LiveOptions& o, Streams io) {
   Evaluated e;
   e.file = o.plan;
   e.plan = plan;
-  e.judgement = judging.Finish();
+  e.judgement = judging.Finish(stopped_early);
   e.replayed_s = e.judgement.replayed_s;
   // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
   ReportScope scope;
@@ -554,8 +567,8 @@ int RunLive(const LiveOptions& o, Streams io) {
     io.out << t.str();
   }
   if (stats.stop == device::StopReason::kSignal) {
-    io.err << "tubeplan live: interrupted at t = " << e.judgement.replayed_s
-           << " s; the force was zeroed; the verdicts above cover the run until then\n";
+    io.err << "tubeplan live: " << stopped_early
+           << "; the force was zeroed; the transitions the run did not finish are not judged\n";
     return kExitInterrupted;
   }
   if (device::IsFault(stats.stop)) {
@@ -566,7 +579,8 @@ int RunLive(const LiveOptions& o, Streams io) {
                          " ms or more than " + std::to_string(config.max_stalls_per_s) +
                          " in a second; docs/live.md says what helps"
                    : std::string())
-           << "); the force was zeroed\n";
+           << ") " << stopped_early.substr(stopped_early.find(" at t"))
+           << "; the force was zeroed; the transitions the run did not finish are not judged\n";
     return stats.stop == device::StopReason::kNonFinite ? kExitInternal : kExitDeviceFault;
   }
   if (stats.dropped > 0 || !record_error.empty()) return kExitInternal;

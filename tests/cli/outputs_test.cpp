@@ -16,8 +16,11 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <tubeplan/cli/app.hpp>
+
+#include "../device/live_replay.hpp"
 
 namespace {
 
@@ -189,10 +192,10 @@ struct Signalled {
   std::string err;
 };
 
-// Runs the real binary with `args`, stdout to /dev/null; once `ready` holds (polled every 5 ms,
+// Runs the real binary with `args`, stdout to `out_path`; once `ready` holds (polled every 5 ms,
 // for at most 20 s) sends it `signal` after `delay_ms`, and waits for it.
 Signalled RunAndSignal(std::vector<std::string> args, const std::function<bool()>& ready,
-                       int signal, int delay_ms = 0) {
+                       int signal, int delay_ms = 0, const std::string& out_path = "/dev/null") {
   int pipe_fds[2];
   REQUIRE(::pipe(pipe_fds) == 0);
   std::vector<char*> argv{const_cast<char*>(TUBEPLAN_BINARY)};
@@ -202,8 +205,8 @@ Signalled RunAndSignal(std::vector<std::string> args, const std::function<bool()
   if (pid == 0) {
     ::dup2(pipe_fds[1], STDERR_FILENO);
     ::close(pipe_fds[0]);
-    const int null = ::open("/dev/null", O_WRONLY);
-    ::dup2(null, STDOUT_FILENO);
+    const int out = ::open(out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(out, STDOUT_FILENO);
     ::execv(TUBEPLAN_BINARY, argv.data());
     ::_exit(127);
   }
@@ -384,4 +387,57 @@ TEST_CASE("Every command refuses an output that is one of its inputs, and writes
   for (const auto& entry : fs::recursive_directory_iterator(dir))
     CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
   fs::remove_all(Scratch());
+}
+
+TEST_CASE("SIGINT during live exits 130 and leaves what the run cut short not judged",
+          "[cli][outputs][live]") {
+  const auto dir = Scratch() / "live";
+  std::filesystem::create_directories(dir);
+  const std::string recording = (dir / "live.csv").string(), report = (dir / "live.json").string();
+  // Signalled once the recording holds most of a second of ticks (about 95 bytes a row): the
+  // insertion, 5.5 s long, is then under way.
+  const auto recorded = [&] {
+    for (const std::string& name : Entries(dir))
+      if (name.rfind("live.csv.tmp.", 0) == 0 && std::filesystem::file_size(dir / name) > 80'000)
+        return true;
+    return false;
+  };
+  const Signalled s = RunAndSignal({"live", SourcePath("plans/groove-insert.yaml"), "--device",
+                                    "emulator", "--record", recording, "--json"},
+                                   recorded, SIGINT, 0, report);
+  INFO(s.err);
+  CHECK(s.exited);
+  const nlohmann::json live = nlohmann::json::parse(ReadFile(report));
+  // A loaded host may stall the servo beyond what a run survives before the signal: a device
+  // fault, which cuts the run short the same way.
+  const bool fault = live["servo"]["stop"] == "missed deadlines";
+  if (!fault) {
+    CHECK(live["servo"]["stop"] == "signal");
+    CHECK(s.exit_code == 130);
+    CHECK_THAT(s.err, Catch::Contains("tubeplan live: interrupted at t = "));
+  } else {
+    CHECK(s.exit_code == tubeplan::cli::kExitDeviceFault);
+  }
+  const nlohmann::json& plan = live["plans"][0];
+  const std::string stopped = plan["stopped_early"];
+  CHECK_THAT(stopped,
+             Catch::StartsWith(fault ? "missed deadlines at t = " : "interrupted at t = "));
+  CHECK(plan["outcome"] == "not judged");
+  CHECK(live["summary"]["not_judged"] == 1);
+  int not_judged = 0;
+  for (const nlohmann::json& v : plan["transitions"]) {
+    CHECK(v["verdict"] != "infeasible");
+    if (v["verdict"] == "not judged") {
+      ++not_judged;
+      CHECK(v["reason"] == "the run stopped: " + stopped);
+    }
+  }
+  CHECK(not_judged >= 1);
+  // The recording is whole and says where the run stopped: evaluate judges it as live did.
+  CHECK_THAT(ReadFile(recording), Catch::EndsWith("\n# stopped: " + stopped + "\n"));
+  const tubeplan::testing::Evaluated batch =
+      tubeplan::testing::EvaluateRecording(recording, dir / "live.yaml");
+  CHECK(batch.exit_code == 1);
+  tubeplan::testing::CheckSameVerdicts(live, batch.report);
+  std::filesystem::remove_all(Scratch());
 }
