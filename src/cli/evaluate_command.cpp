@@ -359,16 +359,18 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   std::ostringstream t;
   t << std::setprecision(3);
   double replayed_s = 0.0, run_s = 0.0;
-  long feasible = 0;
+  long feasible = 0, not_judged = 0;
   for (const Evaluated& e : results) {
     replayed_s += e.replayed_s;
     run_s += e.run_s;
     feasible += e.judgement.feasible;
+    not_judged += plan::Overall(e.judgement) == plan::Verdict::kNotJudged;
     PrintVerdicts(t, e, colour);
   }
   t << "summary: " << results.size() << " plan" << (results.size() == 1 ? "" : "s") << ", "
-    << feasible << " feasible, " << long(results.size()) - feasible << " infeasible; " << replayed_s
-    << " s of trajectories replayed in " << wall_s << " s on " << jobs << " thread"
+    << feasible << " feasible, " << long(results.size()) - feasible - not_judged << " infeasible"
+    << (not_judged > 0 ? ", " + std::to_string(not_judged) + " not judged" : std::string()) << "; "
+    << replayed_s << " s of trajectories replayed in " << wall_s << " s on " << jobs << " thread"
     << (jobs == 1 ? "" : "s") << " (" << (run_s > 0 ? replayed_s / run_s : 0.0)
     << "x real time per core)\n";
   if (!o.report_path.empty()) t << "report written to " << o.report_path << "\n";

@@ -439,5 +439,10 @@ TEST_CASE("SIGINT during live exits 130 and leaves what the run cut short not ju
       tubeplan::testing::EvaluateRecording(recording, dir / "live.yaml");
   CHECK(batch.exit_code == 1);
   tubeplan::testing::CheckSameVerdicts(live, batch.report);
+  const tubeplan::testing::Outcome text =
+      tubeplan::testing::RunTool({"evaluate", (dir / "live.yaml").string()});
+  CHECK_THAT(text.out, Catch::Contains("NOT JUDGED"));
+  CHECK_THAT(text.out,
+             Catch::Contains("summary: 1 plan, 0 feasible, 0 infeasible, 1 not judged; "));
   std::filesystem::remove_all(Scratch());
 }
