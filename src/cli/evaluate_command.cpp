@@ -3,7 +3,6 @@
 // All plan files are read and checked first; any problem in any of them is reported and nothing
 // is evaluated (exit 2).
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -11,7 +10,6 @@
 #include <iomanip>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -20,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
@@ -27,9 +26,7 @@
 #include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
-#include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
-#include <tubeplan/plan/perturb.hpp>
 
 #include "commands.hpp"
 #include "graphviz.hpp"
@@ -50,39 +47,6 @@ struct EvaluateOptions {
   int monte_carlo = 0;
   std::uint64_t seed = 1;
 };
-
-// The plan files named: files as given, directories' *.yaml files in name order.
-std::vector<std::string> PlanFiles(const std::vector<std::string>& inputs, std::ostream& err,
-                                   bool& ok) {
-  namespace fs = std::filesystem;
-  std::vector<std::string> files;
-  for (const std::string& input : inputs) {
-    std::error_code ec;
-    if (fs::is_directory(input, ec)) {
-      std::vector<std::string> in_dir;
-      for (const fs::directory_entry& e : fs::directory_iterator(input, ec))
-        if (e.is_regular_file() && e.path().extension() == ".yaml")
-          in_dir.push_back(e.path().string());
-      std::sort(in_dir.begin(), in_dir.end());
-      if (in_dir.empty()) {
-        err << input << ": error: no plan files (*.yaml) in this directory, expected plans\n";
-        ok = false;
-      }
-      files.insert(files.end(), in_dir.begin(), in_dir.end());
-    } else {
-      files.push_back(input);
-    }
-  }
-  return files;
-}
-
-// FNV-1a of the plan's path: each plan's replicates depend on the seed and the plan only, not on
-// which shard or thread judges it.
-std::uint64_t PlanSeed(std::uint64_t seed, const std::string& file) {
-  std::uint64_t h = 1469598103934665603ull ^ seed;
-  for (unsigned char c : file) h = (h ^ c) * 1099511628211ull;
-  return h;
-}
 
 // The graph section of the HTML report: each scene's pruned contact-state graph, explored with the
 // core as `tubeplan graph SCENE` does (same defaults), coloured by this run's verdicts, drawn by
@@ -135,43 +99,26 @@ bool GraphSections(const std::vector<Evaluated>& results,
 }
 
 int RunEvaluate(const EvaluateOptions& o, Streams io) {
-  bool ok = true;
-  const std::vector<std::string> named = PlanFiles(o.inputs, io.err, ok);
-  // One plan per file, however it is named (`plans/x.yaml`, `./plans/x.yaml`, a link to it): the
-  // first spelling given is the one shown. Plans are judged and reported in the order of their
-  // canonical paths, whatever the order or spelling given, so that every machine splits the same
-  // set into the same shards.
-  std::map<std::string, std::string> by_canonical;  // canonical path -> as given
-  for (const std::string& f : named) by_canonical.emplace(CanonicalPlanPath(f), f);
-  std::vector<std::string> files, canonical;
-  for (const auto& [path, given] : by_canonical) {
-    canonical.push_back(path);
-    files.push_back(given);
+  std::vector<std::string> errors;
+  batch::PlanSet set = batch::CollectPlanSet(o.inputs, errors);
+  for (const std::string& e : errors) io.err << e << "\n";
+  bool ok = errors.empty();
+  if (!o.shard.empty()) {
+    std::string error;
+    if (!batch::SelectShard(o.shard, set, error)) {
+      io.err << "tubeplan evaluate: error: " << error << "\n";
+      return kExitBadInput;
+    }
   }
+  const std::vector<std::string>& files = set.files;
   ReportScope scope;
-  scope.plan_set_id = PlanSetId(canonical);
-  scope.plan_set_plans = static_cast<long>(files.size());
+  scope.plan_set_id = set.id;
+  scope.plan_set_plans = set.size;
+  scope.shard_index = set.shard_index;
+  scope.shard_count = set.shard_count;
   // Every plan named is an input an output must not replace, in this shard or another.
   std::vector<io::RolePath> inputs;
   for (const std::string& f : files) inputs.push_back({"the plan", f});
-  if (!o.shard.empty()) {
-    // "I/N": the plans whose place in that order is I-1 modulo N.
-    int index = 0, count = 0;
-    char slash = 0, extra = 0;
-    std::istringstream in(o.shard);
-    if (!(in >> index >> slash >> count) || slash != '/' || in >> extra || count < 1 || index < 1 ||
-        index > count) {
-      io.err << "tubeplan evaluate: error: --shard \"" << o.shard
-             << "\" is not a shard, expected I/N with 1 <= I <= N, e.g. 2/8\n";
-      return kExitBadInput;
-    }
-    std::vector<std::string> mine;
-    for (std::size_t i = 0; i < files.size(); ++i)
-      if (static_cast<int>(i % std::size_t(count)) == index - 1) mine.push_back(files[i]);
-    files = std::move(mine);
-    scope.shard_index = index;
-    scope.shard_count = count;
-  }
   std::vector<io::PlanLoadResult> loaded;
   for (const std::string& f : files) {
     // Monte Carlo perturbs the trajectory and needs its samples; otherwise the trajectory is
@@ -201,80 +148,33 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       return kExitBadInput;
     }
   }
-  std::vector<Evaluated> results(files.size());
-  std::vector<ReplayRecording> recordings(o.html_path.empty() ? 0 : files.size());
   const int jobs = std::clamp(o.jobs > 0 ? o.jobs : int(std::thread::hardware_concurrency()), 1,
                               std::max<int>(1, int(files.size())));
-  std::atomic<std::size_t> next{0};
   const bool progress = isatty(STDERR_FILENO) != 0 && !o.json;
-  std::atomic<std::size_t> done{0};
-  std::atomic<std::size_t> judged{0};
   // Ctrl-C (SIGINT) or SIGTERM during the batch: the plans being judged finish, no new one
   // starts, and no report is written (a report is complete or absent, never half of a batch).
   // A second signal ends the process at once (io/interrupt.hpp).
   std::optional<io::DeferInterrupts> defer_interrupts;
   defer_interrupts.emplace();
-  std::mutex changed_mutex;
-  std::vector<std::string> changed_errors;  // trajectory files rewritten during their replay
-  auto work = [&] {
-    for (std::size_t i = next++; i < files.size() && !io::Interrupted(); i = next++) {
-      const io::PlanLoadResult& l = loaded[i];
-      // With --html the judged replay is recorded as it runs (no second replay).
-      ReplayRecorder recorder;
-      plan::TickWatcher watch;
-      if (!recordings.empty()) watch = std::ref(recorder);
-      std::optional<plan::Judgement> judgement;
-      if (l.trajectory) {
-        judgement = plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits, watch);
-      } else {
-        try {
-          io::TrajectoryFileSamples samples(*l.trajectory_file);
-          plan::SampleTicks ticks(samples, l.trajectory_file->t_first_s,
-                                  l.trajectory_file->t_last_s, l.scene->model.time_step_s);
-          judgement = plan::Judge(*l.scene, ticks, l.plan->states, l.plan->limits, watch,
-                                  l.trajectory_file->stopped_early);
-        } catch (const io::InputChanged& changed) {
-          // Said after the batch, which then has no report: a result needs every plan.
-          const std::lock_guard lock(changed_mutex);
-          changed_errors.emplace_back(changed.what());
-          continue;
-        }
-      }
-      Evaluated e{files[i], *l.plan, std::move(*judgement), 0, {}};
-      if (!recordings.empty()) recordings[i] = recorder.Finish();
-      e.runs = o.monte_carlo;
-      e.robust.assign(e.judgement.transitions.size(), 0);
-      e.replayed_s = e.judgement.replayed_s;
-      e.run_s = e.judgement.run_s;
-      for (int r = 0; r < o.monte_carlo && !io::Interrupted(); ++r) {
-        const plan::Judgement jr = plan::Judge(
-            *l.scene,
-            plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(o.seed, files[i]), r),
-            l.plan->states, l.plan->limits);
-        for (std::size_t k = 0; k < jr.transitions.size(); ++k)
-          e.robust[k] += plan::IsFeasible(jr.transitions[k].verdict);
-        e.replayed_s += jr.replayed_s;
-        e.run_s += jr.run_s;
-      }
-      if (io::Interrupted()) break;  // a Monte Carlo series cut short is not a result
-      results[i] = std::move(e);
-      ++judged;
-      if (progress) {
-        const std::size_t d = ++done;
-        // One short line per plan, on a terminal only (a log stays clean).
-        io.err << "\r[" + std::to_string(d) + "/" + std::to_string(files.size()) + "]"
-               << std::flush;
-      }
-    }
-  };
-  const auto clock_start = std::chrono::steady_clock::now();
-  std::vector<std::thread> threads;
-  for (int w = 1; w < jobs; ++w) threads.emplace_back(work);
-  work();
-  for (std::thread& t : threads) t.join();
+  // With --html each judged replay is recorded as it runs (no second replay).
+  std::vector<ReplayRecorder> recorders(o.html_path.empty() ? 0 : files.size());
+  batch::BatchOptions batch_options;
+  batch_options.jobs = jobs;
+  batch_options.monte_carlo = o.monte_carlo;
+  batch_options.seed = o.seed;
+  if (!recorders.empty())
+    batch_options.watch = [&](std::size_t i) { return plan::TickWatcher(std::ref(recorders[i])); };
+  // One short line per plan, on a terminal only (a log stays clean).
+  if (progress)
+    batch_options.judged = [&](std::size_t done) {
+      io.err << "\r[" + std::to_string(done) + "/" + std::to_string(files.size()) + "]"
+             << std::flush;
+    };
+  batch::BatchResult judged = batch::JudgeBatch(files, loaded, batch_options);
   if (progress) io.err << "\r";
-  const double wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
+  std::vector<Evaluated>& results = judged.results;
+  const double wall_s = judged.wall_s;
+  const std::vector<std::string>& changed_errors = judged.changed;
 
   if (!changed_errors.empty()) {
     for (const std::string& e : changed_errors) io.err << e << "\n";
@@ -283,8 +183,8 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
            << "\n";
     return kExitBadInput;
   }
-  if (judged.load() < files.size() || io::Interrupted()) {
-    io.err << "tubeplan evaluate: interrupted after " << judged.load() << " of " << files.size()
+  if (judged.judged < files.size() || io::Interrupted()) {
+    io.err << "tubeplan evaluate: interrupted after " << judged.judged << " of " << files.size()
            << " plans; no report written"
            << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
            << "\n";
@@ -320,7 +220,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     std::vector<HtmlPlan> pages;
     for (std::size_t i = 0; i < results.size(); ++i)
       pages.push_back(
-          {&results[i], &*loaded[i].scene, loaded[i].plan->scene, std::move(recordings[i])});
+          {&results[i], &*loaded[i].scene, loaded[i].plan->scene, recorders[i].Finish()});
     html_text = FormatHtmlReport(pages, html);
   }
   // Both files in their temporaries, then renamed one after the other: a signal while they are

@@ -384,7 +384,7 @@ int RunLive(const LiveOptions& o, Streams io) {
   e.replayed_s = e.judgement.replayed_s;
   // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
   ReportScope scope;
-  scope.plan_set_id = PlanSetId({CanonicalPlanPath(o.plan)});
+  scope.plan_set_id = batch::PlanSetId({batch::CanonicalPlanPath(o.plan)});
   scope.plan_set_plans = 1;
   nlohmann::json report = ToJson({e}, scope);
   report["servo"] = {{"ticks", stats.ticks},

@@ -12,25 +12,6 @@
 
 namespace tubeplan::cli {
 
-std::string CanonicalPlanPath(const std::string& path) {
-  std::error_code ec;
-  const std::filesystem::path absolute = std::filesystem::absolute(path, ec);
-  const std::filesystem::path canonical = std::filesystem::weakly_canonical(absolute, ec);
-  return (ec ? absolute.lexically_normal() : canonical).string();
-}
-
-std::string PlanSetId(std::vector<std::string> canonical_paths) {
-  std::sort(canonical_paths.begin(), canonical_paths.end());
-  std::uint64_t h = 1469598103934665603ull;
-  for (const std::string& path : canonical_paths) {
-    for (const unsigned char c : path) h = (h ^ c) * 1099511628211ull;
-    h = (h ^ static_cast<unsigned char>('\n')) * 1099511628211ull;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  return hex;
-}
-
 // A report's plans in file order, what it covers and its summary: what both `evaluate` and
 // `merge` write, so a merge of shard reports is the report of the unsharded run.
 nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/plan.hpp>
 
@@ -18,7 +19,7 @@ namespace tubeplan::cli {
 inline constexpr int kEvaluateJsonVersion = 3;
 
 /// What a report covers: shard `shard_index` of `shard_count` of one plan set, named by
-/// PlanSetId of its plans' canonical paths (`plan_set_plans` plans in the whole set). An
+/// batch::PlanSetId of its plans' canonical paths (`plan_set_plans` plans in the whole set). An
 /// unsharded run, a merge and a live run cover shard 1 of 1.
 struct ReportScope {
   std::string plan_set_id;
@@ -27,23 +28,8 @@ struct ReportScope {
   int shard_count = 1;
 };
 
-/// The identity of a plan set: 16 hex digits of FNV-1a over its plans' canonical paths (absolute,
-/// symbolic links and "." resolved), sorted, each ended by a newline. Two spellings of one file
-/// give one path, so the same set named another way has the same identity.
-std::string PlanSetId(std::vector<std::string> canonical_paths);
-/// The canonical path of a plan file as PlanSetId takes it (weakly canonical, absolute).
-std::string CanonicalPlanPath(const std::string& path);
-
-/// One judged plan.
-struct Evaluated {
-  std::string file;
-  plan::Plan plan;
-  plan::Judgement judgement;
-  int runs = 0;             // Monte-Carlo replicates
-  std::vector<int> robust;  // per transition: replicates in which it was feasible
-  double replayed_s = 0.0;  // trajectory time replayed, replicates included
-  double run_s = 0.0;       // wall time of those replays
-};
+/// One judged plan (batch::Evaluated): what the reports are made of.
+using batch::Evaluated;
 
 /// A report's plans in file order, what it covers and its summary.
 nlohmann::json Report(nlohmann::json plans, const ReportScope& scope);
