@@ -182,10 +182,15 @@ std::string OpenIGTLinkDevice::Open() {
   fd_ = Connect(options_, error);
   if (fd_ < 0) return error;
   stopping_.store(false);
+  closing_.store(false);
+  receiver_done_.store(false);
   link_failed_.store(false);
   link_error_.clear();
   out_pending_ = 0;
-  receiver_ = std::thread([this] { Receive(); });
+  receiver_ = std::thread([this] {
+    Receive();
+    receiver_done_.store(true, std::memory_order_release);
+  });
   // The servo's first tick needs a pose: wait for it here, where waiting is allowed.
   const auto deadline = std::chrono::steady_clock::now() +
                         std::chrono::microseconds(std::llround(options_.connect_timeout_s * 1e6));
@@ -228,12 +233,12 @@ void OpenIGTLinkDevice::Receive() {
       if (r > 0) {
         got += std::size_t(r);
       } else if (r == 0) {
-        if (!stopping_.load()) FailLink("the bridge closed the connection");
+        if (!stopping_.load() && !closing_.load()) FailLink("the bridge closed the connection");
         return false;
       } else if (errno == ECONNRESET) {
         // A peer that closes with our wrenches still unread in its buffer resets the connection
         // instead of ending it (RFC 1122, 4.2.2.13): the same hang-up, seen as an error.
-        if (!stopping_.load())
+        if (!stopping_.load() && !closing_.load())
           FailLink("the bridge closed the connection (reset: it closed with our data unread)");
         return false;
       } else if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) {
@@ -398,6 +403,16 @@ void OpenIGTLinkDevice::Close() {
     if (flush()) {
       Disable();
       flush();
+    }
+    // An orderly end: FIN after the zero, and the bridge's poses read until it closes its end
+    // (up to 0.5 s). Closing with poses unread, or with more arriving, resets the connection,
+    // and a bridge that meets the reset on a send loses the wrenches it had not read yet.
+    if (poses_.load(std::memory_order_relaxed) > 0) {
+      closing_.store(true, std::memory_order_release);
+      shutdown(fd_, SHUT_WR);
+      const std::int64_t end_due_ns = MonotonicNs() + 500'000'000;
+      while (!receiver_done_.load(std::memory_order_acquire) && MonotonicNs() < end_due_ns)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
   }
   stopping_.store(true, std::memory_order_release);

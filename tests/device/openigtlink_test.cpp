@@ -261,7 +261,8 @@ TEST_CASE("The servo's wrenches reach the bridge within the device's limits and 
   device::OpenIGTLinkDevice dev(options);
   REQUIRE(dev.Open().empty());
   // 4 s of the insertion: the side lands on the floor and presses (about 0.1 N at 3.5 s).
-  const ServoRun run = RunServo(dev, 4000, 1000, LenientLimits(dev));
+  const device::SafetyLimits limits = LenientLimits(dev);
+  const ServoRun run = RunServo(dev, 4000, 1000, limits);
   CHECK(run.stats.stop == StopReason::kCompleted);
   dev.Close();
   std::string summary;
@@ -280,14 +281,37 @@ TEST_CASE("The servo's wrenches reach the bridge within the device's limits and 
   Eigen::Vector3d previous = Eigen::Vector3d::Zero();
   for (const WrenchRow& r : forces) {
     largest_N = std::max(largest_N, r.value.norm());
-    largest_step_N = std::max(largest_step_N, (r.value - previous).norm());
+    // Going to zero (a stall, the end) is never rate-limited: removing force pushes nobody.
+    if (!r.value.isZero(0.0))
+      largest_step_N = std::max(largest_step_N, (r.value - previous).norm());
     previous = r.value;
   }
   CHECK(largest_N <= 0.05 * (1 + 1e-12));
-  CHECK(largest_N >= 0.05 * 0.999);  // the clamp was reached: the plan pushed harder
-  // The limiter's ramp (850 N/s at 1 ms; the 8.5 N device's, kept for a weaker one), doubled
-  // for each wrench the device skipped on a full socket.
-  CHECK(largest_step_N <= 0.85 * double(1 + counters.wrenches_skipped) * (1 + 1e-12));
+  // The bridge got what the servo sent, tick by tick (float64 on the wire: exactly).
+  if (counters.wrenches_skipped == 0) {
+    long differing = 0;
+    for (std::size_t k = 0; k < run.records.size(); ++k)
+      differing += forces[k].value != run.records[k].force_sent_N;
+    CHECK(differing == 0);
+  }
+  // The clamp is reached once the plan has pushed harder than it for 20 ticks without a stall:
+  // a stall drops the force to zero and the ramp back takes 10 ticks (0.005 N a tick), so a
+  // loaded machine that stalls the servo every few ticks may never let it reach the clamp.
+  long settled = 0, below_clamp = 0;
+  int pushing = 0;
+  for (const device::TickRecord& r : run.records) {
+    pushing = r.stepped && !r.stalled && r.out.force_W_N.norm() > 0.05 ? pushing + 1 : 0;
+    if (pushing < 20) continue;
+    ++settled;
+    below_clamp += r.force_sent_N.norm() < 0.05 * 0.999;
+  }
+  CHECK(below_clamp == 0);
+  if (settled == 0) WARN("the servo stalled too often for the force to reach the clamp");
+  // The limiter's ramp (this device's: 0.05 N in 10 ms, 0.005 N a tick), one more step for
+  // each wrench the device skipped on a full socket.
+  CHECK(limits.max_force_rate_N_per_s == Approx(5.0));
+  CHECK(largest_step_N <=
+        limits.max_force_rate_N_per_s * 1e-3 * double(1 + counters.wrenches_skipped) * (1 + 1e-9));
   CHECK(forces.back().value.isZero(0.0));  // the last wrench is zero (end of session, Close)
   for (const WrenchRow& r : rows)
     if (!r.force) CHECK(r.value.norm() <= 0.188 * (1 + 1e-12));

@@ -62,7 +62,8 @@ class OpenIGTLinkDevice final : public HapticDevice {
   const DeviceSpec& spec() const override { return options_.spec; }
   /// The newest pose; false once the link has failed (closed by the bridge, a bad message).
   bool Read(DeviceSample& sample) override;
-  /// Sends zero (waiting up to 100 ms for room), then disconnects.
+  /// Sends zero (waiting up to 100 ms for room), half-closes the link and reads until the bridge
+  /// closes its end (up to 0.5 s, so the link ends without a reset), then disconnects.
   void Close() override;
 
   /// Why the link failed, empty while it is up. Safe from any thread after Read returned false.
@@ -92,6 +93,8 @@ class OpenIGTLinkDevice final : public HapticDevice {
   int fd_ = -1;
   std::thread receiver_;
   std::atomic<bool> stopping_{false};
+  std::atomic<bool> closing_{false};        // Close half-closed the link: the bridge's end is due
+  std::atomic<bool> receiver_done_{false};  // the receiver thread has returned
   std::atomic<bool> link_failed_{false};
   mutable std::mutex error_mutex_;  // the receiver's error text (cold path only)
   std::string link_error_;
