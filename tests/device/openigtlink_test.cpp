@@ -1,10 +1,12 @@
 // The openigtlink:// device against the bridge emulator (tools/igtl-bridge) on loopback: poses
 // arrive as the trajectory has them, the wrenches that reach the bridge are within the device's
-// limits and end at zero, a bridge that stops sending or hangs up zeroes the force, a refused
+// limits and end at zero, drops and pauses shorter than the stale window are ridden out and a
+// longer pause is stale data, a bridge that stops sending or hangs up zeroes the force, a refused
 // connection says so, and a live run's verdicts equal `evaluate` of its recording. The servo
 // runs on the real clock here (the bridge does), so only bounds that hold on a loaded machine
 // are asserted: the missed-deadline streak is switched off where the loop itself is not under
-// test, and stale windows are long.
+// test, and stale windows are long where staleness is not under test.
+#include <algorithm>
 #include <arpa/inet.h>
 #include <cmath>
 #include <csignal>
@@ -30,6 +32,7 @@
 #include <tubeplan/device/servo.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
 
 #include "../alloc_count.hpp"
 #include "live_replay.hpp"
@@ -160,6 +163,21 @@ std::vector<WrenchRow> ReadWrenches(const fs::path& file) {
                     Eigen::Vector3d(std::stod(x), std::stod(y), std::stod(z)), std::stod(rt)});
   }
   return rows;
+}
+
+// The bridge's own counts, from its summary line: poses sent, dropped, delayed (held in a pause
+// and sent in its burst) and pauses begun; -1 where the line does not say.
+struct BridgeCounts {
+  long sent = -1, dropped = -1, delayed = -1, pauses = -1;
+};
+
+BridgeCounts ParseSummary(const std::string& summary) {
+  BridgeCounts c;
+  const std::size_t at = summary.find("sent ");
+  if (at != std::string::npos)
+    std::sscanf(summary.c_str() + at, "sent %ld poses, dropped %ld, delayed %ld in %ld pauses",
+                &c.sent, &c.dropped, &c.delayed, &c.pauses);
+  return c;
 }
 
 device::OpenIGTLinkOptions Loopback(int port) {
@@ -357,6 +375,152 @@ TEST_CASE("A bridge that hangs up makes the force zero (device error)",
   dev.Close();
   std::string summary;
   CHECK(bridge.Wait(summary) == 0);
+}
+
+TEST_CASE(
+    "Poses dropped and delayed within the stale window: the servo runs on, its wrenches "
+    "within the limits and ending at zero",
+    "[device][openigtlink][safety]") {
+  const fs::path dir = TempDir("lossy");
+  const fs::path wrenches = dir / "wrenches.csv";
+  // A fifth of the poses lost, and every 250 poses a pause of 10 ms whose poses then come at once.
+  Bridge bridge({"--drop", "0.2", "--seed", "7", "--delay-ms", "10", "--delay-every", "250",
+                 "--wrenches", wrenches.string()});
+  device::OpenIGTLinkOptions options = Loopback(bridge.port());
+  // Weaker than the plan needs (its peak is 0.19 N), so that the clamp and the ramp show.
+  options.spec.max_force_N = 0.05;
+  device::OpenIGTLinkDevice dev(options);
+  REQUIRE(dev.Open().empty());
+  const device::SafetyLimits limits = LenientLimits(dev);
+  // A stale window of 60 ms (as `stale=60ms` makes it): longer than a pause and the drops around
+  // it, with room for a loaded machine's scheduling of the bridge.
+  const ServoRun run = RunServo(dev, 3000, 60, limits);
+  CHECK(run.stats.stop == StopReason::kCompleted);
+  CHECK(run.records.size() == 3000);
+
+  // The velocity differences the poses' sample times, not their arrival: a drop (2 ms between
+  // two poses) or a burst (poses microseconds apart) leaves it the trajectory's. Read here, after
+  // the servo, where the bridge keeps streaming through its pauses (0.6 s: two of them).
+  const plan::Trajectory& trajectory = *InsertPlan().trajectory;
+  double fastest_m_per_s = 0.0;
+  for (std::size_t i = 1; i < trajectory.samples.size(); ++i)
+    fastest_m_per_s = std::max(
+        fastest_m_per_s, (trajectory.samples[i].p_WH_m - trajectory.samples[i - 1].p_WH_m).norm() /
+                             (trajectory.samples[i].t_s - trajectory.samples[i - 1].t_s));
+  double largest_v_m_per_s = 0.0;
+  for (int i = 0; i < 600; ++i) {
+    device::DeviceSample s;
+    REQUIRE(dev.Read(s));
+    largest_v_m_per_s = std::max(largest_v_m_per_s, s.v_W_m_per_s.norm());
+    ::usleep(1000);
+  }
+  // float32 millimetres on the wire: 2e-8 m over at least 1 ms, 2e-5 m/s.
+  CHECK(largest_v_m_per_s <= fastest_m_per_s + 1e-4);
+  dev.Close();
+  std::string summary;
+  REQUIRE(bridge.Wait(summary) == 0);  // non-zero: a wrench failed its CRC at the bridge
+  INFO(summary);
+
+  // What the bridge sent, every pose of it, reached the device (TCP); what it dropped did not.
+  const BridgeCounts bridge_counts = ParseSummary(summary);
+  const device::OpenIGTLinkCounters counters = dev.counters();
+  CHECK(counters.poses == std::uint64_t(bridge_counts.sent));
+  // A fifth of the poses dropped, within 5 standard deviations, sqrt(n p (1 - p)); a pause cut
+  // short by the end of the session holds at most 10 poses that are neither sent nor dropped.
+  const double sampled = double(bridge_counts.sent + bridge_counts.dropped);
+  CHECK(std::abs(double(bridge_counts.dropped) - 0.2 * sampled) <=
+        5.0 * std::sqrt(sampled * 0.2 * 0.8) + 10.0);
+  // At least 3.6 s of poses: a pause after each 250 of them, each holding its 10 ms of poses
+  // that were not dropped.
+  CHECK(bridge_counts.pauses >= 3600 / 250 - 1);
+  CHECK(bridge_counts.delayed <= 10 * bridge_counts.pauses);
+  CHECK(bridge_counts.delayed >= 5 * bridge_counts.pauses);
+
+  const std::vector<WrenchRow> rows = ReadWrenches(wrenches);
+  std::vector<WrenchRow> forces;
+  for (const WrenchRow& r : rows)
+    if (r.force) forces.push_back(r);
+  REQUIRE(forces.size() == counters.wrenches_sent);  // every wrench written reached the bridge
+  REQUIRE(forces.size() + counters.wrenches_skipped >= 3000);
+  // A burst moves the hand 10 ms at once; the force still rises by at most the limiter's step
+  // (0.05 N in 10 ms: 0.005 N a tick, one more for each wrench skipped on a full socket) and
+  // falls to zero only whole (a stall drops it).
+  const double step_N =
+      limits.max_force_rate_N_per_s * 1e-3 * double(1 + counters.wrenches_skipped);
+  double largest_N = 0.0, largest_step_N = 0.0;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  for (const WrenchRow& r : forces) {
+    largest_N = std::max(largest_N, r.value.norm());
+    if (!r.value.isZero(0.0))
+      largest_step_N = std::max(largest_step_N, (r.value - previous).norm());
+    previous = r.value;
+  }
+  CHECK(largest_N <= 0.05 * (1 + 1e-12));
+  CHECK(largest_N >= 0.05 * 0.999);  // the clamp was reached: the plan pushed harder
+  CHECK(largest_step_N <= step_N * (1 + 1e-9));
+  CHECK(forces.back().value.isZero(0.0));
+  for (const WrenchRow& r : rows)
+    if (!r.force) CHECK(r.value.norm() <= limits.max_torque_Nm * (1 + 1e-12));
+  CHECK(rows.back().value.isZero(0.0));
+  fs::remove_all(dir);
+}
+
+TEST_CASE(
+    "A pause longer than the stale window stops live: stale device data, force zero, "
+    "exit 4",
+    "[device][openigtlink][live][safety]") {
+  const fs::path dir = TempDir("pause");
+  const fs::path recording = dir / "live.csv";
+  const fs::path wrenches = dir / "wrenches.csv";
+  // One pause of 200 ms, 1 s into the stream (the hand moves then), against a window of 30 ms.
+  Bridge bridge({"--delay-ms", "200", "--delay-every", "1000", "--wrenches", wrenches.string()});
+  std::ostringstream out, err;
+  const int code = cli::Run(
+      std::vector<std::string>{
+          "live", SourcePath("plans/groove-insert.yaml"), "--device",
+          "openigtlink://127.0.0.1:" + std::to_string(bridge.port()) + ",stale=30ms,timeout=10s",
+          "--duration", "3", "--record", recording.string(), "--json"},
+      out, err);
+  INFO(err.str());
+  REQUIRE(!out.str().empty());
+  const nlohmann::json report = nlohmann::json::parse(out.str());
+  CHECK(report["servo"]["stop"] == "stale device data");
+  CHECK(code == cli::kExitDeviceFault);
+  CHECK_THAT(err.str(), Catch::Contains("the servo stopped on a fault (stale device data)"));
+  // Stopped in the pause, long before the 3001 ticks of the session.
+  const long ticks = report["servo"]["ticks"];
+  CHECK(ticks > 30);
+  CHECK(ticks < 2000);
+  std::string summary;
+  CHECK(bridge.Wait(summary) == 0);
+  INFO(summary);
+
+  // The servo stepped the core on the last pose for 30 ticks (the one that brought it and 29
+  // stale ones); the 30th stale tick stopped it unstepped. The hand moves: the pose before
+  // differs.
+  const io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(recording.string());
+  REQUIRE(loaded.trajectory);
+  const std::vector<plan::HandSample>& samples = loaded.trajectory->samples;
+  REQUIRE(samples.size() == std::size_t(ticks - 1));
+  const plan::HandSample& last = samples.back();
+  std::size_t same = 0;
+  while (same < samples.size() && samples[samples.size() - 1 - same].p_WH_m == last.p_WH_m &&
+         samples[samples.size() - 1 - same].q_WH.coeffs() == last.q_WH.coeffs())
+    ++same;
+  CHECK(same == 30);
+
+  // Every tick's wrench reached the bridge, then three zeros (after the loop, its Disable and
+  // Close's); from the faulted tick on, force and torque are zero.
+  const std::vector<WrenchRow> rows = ReadWrenches(wrenches);
+  std::vector<WrenchRow> forces, torques;
+  for (const WrenchRow& r : rows) (r.force ? forces : torques).push_back(r);
+  REQUIRE(forces.size() == std::size_t(ticks + 3));
+  REQUIRE(torques.size() == forces.size());
+  for (std::size_t i = forces.size() - 4; i < forces.size(); ++i) {
+    CHECK(forces[i].value.isZero(0.0));
+    CHECK(torques[i].value.isZero(0.0));
+  }
+  fs::remove_all(dir);
 }
 
 TEST_CASE("Reading and sending over OpenIGTLink allocate nothing in the servo thread",

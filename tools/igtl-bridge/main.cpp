@@ -11,7 +11,12 @@
 // CRC of every wrench is checked here).
 //
 // Faults for the tests: --stop-after S stops the poses (the link stays up: stale data),
-// --close-after S closes the connection.
+// --close-after S closes the connection, --drop P loses each pose with probability P (a
+// function of --seed N and the pose's index, so a run drops the same poses again), and
+// --delay-ms D with --delay-every K holds back the poses sampled in the D ms from pose K, 2K, ...
+// on and sends them with the next one, at once (a burst: the first arrives D ms late, and the
+// client sees no new pose for D ms). A pose dropped or held keeps its sample time and its place
+// in the trajectory; the summary line counts the poses sent, dropped, delayed and the pauses.
 #include <algorithm>
 #include <arpa/inet.h>
 #include <atomic>
@@ -77,6 +82,10 @@ struct Options {
   double rate_hz = 1000.0;
   double stop_after_s = 0.0;   // 0: never
   double close_after_s = 0.0;  // 0: never
+  double drop_probability = 0.0;
+  std::uint64_t seed = 1;
+  double delay_ms = 0.0;  // 0: no pauses
+  long delay_every = 1000;
   double accept_timeout_s = 30.0;
   double max_time_s = 600.0;
   std::string wrenches;
@@ -88,6 +97,15 @@ struct Wrench {
   double x, y, z;
   double round_trip_us;  // -1 when the wrench echoed no timestamp
 };
+
+// A uniform number in [0, 1) that depends only on the seed and the pose's index (splitmix64).
+double Uniform(std::uint64_t seed, std::uint64_t index) {
+  std::uint64_t z = seed + (index + 1) * 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return double(z >> 11) * 0x1.0p-53;
+}
 
 double Percentile(std::vector<double> values, double fraction) {
   if (values.empty()) return 0.0;
@@ -144,6 +162,10 @@ int Run(const Options& o) {
   std::vector<unsigned char> in;
   std::vector<Wrench> wrenches;
   long poses = 0, bad_crc = 0, other = 0;
+  // Poses sampled (the trajectory's index), dropped, held back in a pause, pauses begun.
+  long samples = 0, dropped = 0, delayed = 0, pauses = 0;
+  const long hold_count = std::lround(o.delay_ms * 1e-3 * o.rate_hz);
+  std::vector<unsigned char> held;
   const auto period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
   const std::int64_t start_ns = NowNs(CLOCK_MONOTONIC);
   const std::int64_t start_realtime_ns = NowNs(CLOCK_REALTIME);
@@ -171,7 +193,7 @@ int Run(const Options& o) {
       if (streaming) {
         // The pose of the trajectory at this tick's time; held at its last pose after its end.
         const tubeplan::plan::HandSample s =
-            tubeplan::plan::PoseAt(trajectory, t0 + double(poses) / o.rate_hz, cursor);
+            tubeplan::plan::PoseAt(trajectory, t0 + double(samples) / o.rate_hz, cursor);
         igtl::Matrix4x4 m;
         const Eigen::Matrix3d R = s.q_WH.normalized().toRotationMatrix();
         for (int i = 0; i < 3; ++i) {
@@ -185,14 +207,35 @@ int Run(const Options& o) {
         // client's finite-difference velocity then sees the trajectory's, not this process's
         // scheduling; the round trip counts from it, so any lateness of this send is in it.
         unsigned seconds = 0, fraction = 0;
-        SplitNs(start_realtime_ns + poses * period_ns, seconds, fraction);
+        SplitNs(start_realtime_ns + samples * period_ns, seconds, fraction);
         transform->SetTimeStamp(seconds, fraction);
         transform->Pack();
-        if (!SendAll(fd, transform->GetPackPointer(), std::size_t(transform->GetPackSize()))) {
-          ended = std::string("sending: ") + std::strerror(errno);
-          break;
+        const auto* packed = static_cast<const unsigned char*>(transform->GetPackPointer());
+        const auto packed_size = std::size_t(transform->GetPackSize());
+        // Faults: a pose lost, or held back in a pause and sent with the pose after it.
+        const long in_pause = samples % o.delay_every;
+        const bool hold = hold_count > 0 && samples >= o.delay_every && in_pause < hold_count;
+        pauses += hold && in_pause == 0;
+        if (o.drop_probability > 0.0 &&
+            Uniform(o.seed, std::uint64_t(samples)) < o.drop_probability) {
+          ++dropped;
+        } else if (hold) {
+          held.insert(held.end(), packed, packed + packed_size);
+          ++delayed;
+        } else {
+          if (!held.empty() && !SendAll(fd, held.data(), held.size())) {
+            ended = std::string("sending: ") + std::strerror(errno);
+            break;
+          }
+          poses += long(held.size() / packed_size);
+          held.clear();
+          if (!SendAll(fd, packed, packed_size)) {
+            ended = std::string("sending: ") + std::strerror(errno);
+            break;
+          }
+          ++poses;
         }
-        ++poses;
+        ++samples;
       }
       next_ns += period_ns;
       // Absolute deadlines; after a stall of more than 100 ms start afresh instead of bursting.
@@ -272,12 +315,13 @@ int Run(const Options& o) {
     if (!out) std::cerr << "igtl-bridge: error: cannot write " << o.wrenches << "\n";
   }
   std::printf(
-      "igtl-bridge: ended (%s): sent %ld poses, received %ld wrenches (%ld bad, %ld other "
-      "messages); max |force| %.3f N, last force (%g, %g, %g) N; round trip pose to wrench: "
-      "median %.0f us, p99 %.0f us, max %.0f us\n",
-      ended.c_str(), poses, forces, bad_crc, other, max_force_N, last_force ? last_force->x : 0.0,
-      last_force ? last_force->y : 0.0, last_force ? last_force->z : 0.0,
-      Percentile(round_trips, 0.5), Percentile(round_trips, 0.99), Percentile(round_trips, 1.0));
+      "igtl-bridge: ended (%s): sent %ld poses, dropped %ld, delayed %ld in %ld pauses; received "
+      "%ld wrenches (%ld bad, %ld other messages); max |force| %.3f N, last force (%g, %g, %g) N; "
+      "round trip pose to wrench: median %.0f us, p99 %.0f us, max %.0f us\n",
+      ended.c_str(), poses, dropped, delayed, pauses, forces, bad_crc, other, max_force_N,
+      last_force ? last_force->x : 0.0, last_force ? last_force->y : 0.0,
+      last_force ? last_force->z : 0.0, Percentile(round_trips, 0.5), Percentile(round_trips, 0.99),
+      Percentile(round_trips, 1.0));
   return bad_crc == 0 ? 0 : 1;
 }
 
@@ -304,6 +348,17 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 86400.0));
   app.add_option("--close-after", o.close_after_s, "close the connection after S seconds")
       ->check(CLI::Range(0.0, 86400.0));
+  app.add_option("--drop", o.drop_probability,
+                 "drop each pose with probability P (reproducible with --seed)")
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--seed", o.seed, "seed of the drops: the same seed drops the same poses")
+      ->capture_default_str();
+  app.add_option("--delay-ms", o.delay_ms,
+                 "pause D ms after every --delay-every poses, then send the held poses at once")
+      ->check(CLI::Range(0.0, 86'400'000.0));
+  app.add_option("--delay-every", o.delay_every, "poses between the starts of two pauses")
+      ->capture_default_str()
+      ->check(CLI::Range(1L, 1L << 40));
   app.add_option("--accept-timeout", o.accept_timeout_s, "give up when no client comes in S s")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 86400.0));
@@ -316,6 +371,14 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? 0 : 2;
+  }
+  // A pause holds whole poses and ends before the next one begins.
+  const long hold_count = std::lround(o.delay_ms * 1e-3 * o.rate_hz);
+  if (o.delay_ms > 0.0 && (hold_count < 1 || hold_count >= o.delay_every)) {
+    std::cerr << "igtl-bridge: error: --delay-ms " << o.delay_ms << " holds " << hold_count
+              << " poses at " << o.rate_hz << " poses/s; it must hold at least one and fewer than "
+              << "--delay-every (" << o.delay_every << ")\n";
+    return 2;
   }
   struct sigaction action {};
   action.sa_handler = OnSignal;
