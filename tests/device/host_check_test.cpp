@@ -188,7 +188,7 @@ TEST_CASE("live --check-host measures this host and reports consistent figures",
                      j["worst_stalls_per_s"].get<long>() > j["max_stalls_per_s"].get<long>();
   CHECK(j["verdict"] == (fault ? "fault" : stalls > 0 ? "stalls" : "fine"));
   CHECK(j["max_stall_ms"] == 100.0);
-  CHECK(j["max_stalls_per_s"] == 20);
+  CHECK(j["max_stalls_per_s"] == 50);
 }
 
 TEST_CASE("live --check-host refuses a plan and a device, and live without it needs a plan",
