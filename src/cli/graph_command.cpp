@@ -472,8 +472,9 @@ int RunPlans(const PlansOptions& o, Streams io) {
                  << (c.judgement.feasible ? "feasible"
                                           : "infeasible: " + plan::FirstFailure(c.judgement));
     if (c.tries > 1)
-      verdict_text << " (at " << c.peak_speed_m_per_s * 1e3 << " mm/s after " << c.tries - 1
-                   << (c.tries == 2 ? " slower try" : " slower tries") << ")";
+      verdict_text << " (try " << c.tries << ": "
+                   << (c.held ? "the held end's poses" : "the hand's") << " at "
+                   << c.peak_speed_m_per_s * 1e3 << " mm/s)";
     verdict_text << "; peak operator force " << c.judgement.peak_force_N << " N";
     const std::string verdict = verdict_text.str();
     std::string name = "(not written)";

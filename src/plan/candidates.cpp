@@ -6,13 +6,16 @@ namespace tubeplan::plan {
 
 namespace {
 
-// The hand's poses: the scene's start, then the hand at each later state's witness.
+// The hand's poses: the scene's start, then the hand at each later state's witness, or with
+// `held` the held end's pose there (the hand no longer pulling the coupling out).
 std::vector<Eigen::Isometry3d> Waypoints(const scene::Scene& scene,
-                                         const graph::ContactGraph& graph,
-                                         const graph::Path& path) {
+                                         const graph::ContactGraph& graph, const graph::Path& path,
+                                         bool held) {
   std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
-  for (std::size_t j = 1; j < path.nodes.size(); ++j)
-    waypoints.push_back(graph.nodes[std::size_t(path.nodes[j])].X_W_hand);
+  for (std::size_t j = 1; j < path.nodes.size(); ++j) {
+    const graph::Node& node = graph.nodes[std::size_t(path.nodes[j])];
+    waypoints.push_back(held ? node.X_WH : node.X_W_hand);
+  }
   return waypoints;
 }
 
@@ -30,16 +33,20 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     c.plan.scene = options.scene_ref;
     c.plan.limits.max_force_N = scene.device.max_force_N;
     c.plan.limits.dwell_s = options.dwell_s;
-    const std::vector<Eigen::Isometry3d> waypoints = Waypoints(scene, graph, *c.path);
-    // The asked speed, then each slower one until a replay is feasible.
+    // The asked speed, then each slower one until a replay is feasible; then the same aiming
+    // the hand at the held end's poses.
     SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    for (std::size_t k = 0; k <= options.slower.size(); ++k) {
-      if (k > 0)
-        synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s / options.slower[k - 1];
+    const std::size_t speeds = options.slower.size() + 1;
+    for (std::size_t k = 0; k < 2 * speeds; ++k) {
+      const std::vector<Eigen::Isometry3d> waypoints =
+          Waypoints(scene, graph, *c.path, k >= speeds);
+      synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s /
+                                     (k % speeds > 0 ? options.slower[k % speeds - 1] : 1.0);
       c.trajectory = SynthesizeTrajectory(waypoints, synthesis);
       c.duration_s = c.trajectory.samples.back().t_s;
       c.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
+      c.held = k >= speeds;
       c.tries = int(k) + 1;
       const std::optional<Trajectory> read = as_written(c.trajectory);
       c.judgement = read ? Judge(scene, *read, c.plan.states, c.plan.limits) : Judgement{};

@@ -1,5 +1,5 @@
 // Candidate plans made from graph paths: each is replayed through the judge, a candidate that
-// fails is tried again slower, and the feasible come first.
+// fails is tried again slower and then aimed at the held end's poses, and the feasible come first.
 #include <string>
 #include <vector>
 
@@ -13,16 +13,19 @@ namespace {
 using namespace tubeplan;
 
 // The groove's start and goal as a two-node graph whose goal witness has the hand at height z
-// over the floor with the tube turned as the shipped lay-flat plan ends.
-graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m) {
+// over the floor and the held end at height held_z, with the tube turned as the shipped lay-flat
+// plan ends.
+graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m, double held_z_m) {
   graph::ContactGraph g;
   g.nodes.resize(2);
   g.nodes[0].cf = "{}";
-  g.nodes[0].X_W_hand = scene.X_WH_start;
+  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
   g.nodes[1].cf = "{Fs - floor.top}";
   g.nodes[1].X_W_hand.linear() =
       Eigen::Quaterniond(0.737277337, -0.675590208, 0.0, 0.0).toRotationMatrix();
+  g.nodes[1].X_WH.linear() = g.nodes[1].X_W_hand.linear();
   g.nodes[1].X_W_hand.translation() = Eigen::Vector3d(0.0, -0.09, hand_z_m);
+  g.nodes[1].X_WH.translation() = Eigen::Vector3d(0.0, -0.09, held_z_m);
   g.start = 0;
   g.goal = 1;
   return g;
@@ -30,16 +33,20 @@ graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m) {
 
 }  // namespace
 
-TEST_CASE("Candidates: a failing one is retried slower and the feasible are put first", "[plan]") {
+TEST_CASE("Candidates: a failing one is retried slower, then at the held poses; feasible first",
+          "[plan]") {
   const io::SceneLoadResult loaded =
       io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
   REQUIRE(loaded.scene);
   const scene::Scene& scene = *loaded.scene;
-  // One graph, two witnesses of the goal: the lay-flat plan's hand pose (8.16 mm over the floor)
-  // and the same 40 mm lower, which drives the hand through the floor to the device's limit.
-  graph::ContactGraph g = LayFlatGraph(scene, 0.00816);
-  g.nodes.push_back(LayFlatGraph(scene, 0.00816 - 0.040).nodes[1]);
-  const std::vector<graph::Path> paths = {{{0, 2}, 1.0}, {{0, 1}, 2.0}};
+  // One graph, three witnesses of the goal: the lay-flat plan's pose (8.16 mm over the floor);
+  // the hand 40 mm lower, through the floor to the device's limit, with the tube held at the
+  // lay-flat pose (the coupling stretched); and the held end down there too.
+  const double z = 0.00816, deep = z - 0.040;
+  graph::ContactGraph g = LayFlatGraph(scene, z, z);
+  g.nodes.push_back(LayFlatGraph(scene, deep, z).nodes[1]);
+  g.nodes.push_back(LayFlatGraph(scene, deep, deep).nodes[1]);
+  const std::vector<graph::Path> paths = {{{0, 3}, 1.0}, {{0, 2}, 1.5}, {{0, 1}, 2.0}};
   plan::CandidateOptions options;
   options.synthesis.peak_speed_m_per_s = 0.08;
   options.dwell_s = 0.02;
@@ -50,25 +57,34 @@ TEST_CASE("Candidates: a failing one is retried slower and the feasible are put 
         ++replays;
         return std::optional<plan::Trajectory>(t);
       });
-  REQUIRE(c.size() == 2);
-  // The reachable witness replays feasible at the asked speed, and comes first.
+  REQUIRE(c.size() == 3);
+  // The stretched witness fails at each speed aimed at the hand's pose, and replays feasible
+  // aimed at the held end's, at the asked speed; the feasible come first in the paths' order.
   CHECK(c[0].path == &paths[1]);
   CHECK(c[0].judgement.feasible);
-  CHECK(c[0].tries == 1);
+  CHECK(c[0].tries == 4);
+  CHECK(c[0].held);
   CHECK(c[0].peak_speed_m_per_s == 0.08);
-  CHECK(c[0].judgement.peak_force_N < scene.device.max_force_N);
-  CHECK(c[0].plan.states == std::vector<std::string>{"{}", "{Fs - floor.top}"});
-  // The other is tried at 1/2 and 1/4 of the speed and kept infeasible, at the device's limit,
-  // with the slowest try's longer trajectory.
-  CHECK(c[1].path == &paths[0]);
-  CHECK_FALSE(c[1].judgement.feasible);
-  CHECK(c[1].tries == 3);
-  CHECK(c[1].peak_speed_m_per_s == Approx(0.02));
-  CHECK(c[1].duration_s > 2.0 * c[0].duration_s);
-  CHECK(c[1].judgement.peak_force_N == Approx(scene.device.max_force_N));
+  CHECK(c[0].judgement.peak_force_N < 1.0);
+  // The reachable witness replays feasible at once.
+  CHECK(c[1].path == &paths[2]);
+  CHECK(c[1].judgement.feasible);
+  CHECK(c[1].tries == 1);
+  CHECK_FALSE(c[1].held);
+  CHECK(c[1].judgement.peak_force_N < scene.device.max_force_N);
+  CHECK(c[1].plan.states == std::vector<std::string>{"{}", "{Fs - floor.top}"});
+  // The witness whose tube was pushed through the floor too stays infeasible after all six
+  // tries, at the device's limit, with the slowest try's longer trajectory.
+  CHECK(c[2].path == &paths[0]);
+  CHECK_FALSE(c[2].judgement.feasible);
+  CHECK(c[2].tries == 6);
+  CHECK(c[2].held);
+  CHECK(c[2].peak_speed_m_per_s == Approx(0.02));
+  CHECK(c[2].duration_s > 2.0 * c[1].duration_s);
+  CHECK(c[2].judgement.peak_force_N == Approx(scene.device.max_force_N));
   // Its reason is the judge's, not a load failure (pushed through the floor, the tube leaves
   // the goal's lying-flat state).
-  const std::string failure = plan::FirstFailure(c[1].judgement);
+  const std::string failure = plan::FirstFailure(c[2].judgement);
   CHECK(failure.find("after the goal") != std::string::npos);
-  CHECK(replays == 4);
+  CHECK(replays == 4 + 1 + 6);
 }

@@ -1,8 +1,8 @@
 #pragma once
 // Candidate plans from paths through the contact-state graph: the hand moves by minimum jerk
 // through the witnesses of each path's states, and every candidate is replayed through the same
-// judge as `evaluate`. A candidate that replays infeasible is tried again at slower speeds before
-// it is given up (docs/graph.md, "Plans").
+// judge as `evaluate`. A candidate that replays infeasible is tried again at slower speeds, then
+// aiming at the held end's poses, before it is given up (docs/graph.md, "Plans").
 
 #include <functional>
 #include <optional>
@@ -25,7 +25,11 @@ struct CandidateOptions {
   double dwell_s = 0.0;        ///< the plans' dwell (the explorer's)
   std::string scene_ref;       ///< the scene as the plan files name it
   /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
-  /// less): the first try is at the asked speed.
+  /// less): the first try is at the asked speed. When none replays feasible, the same speeds
+  /// are tried again aiming the hand at the held end's poses at the witnesses (Node::X_WH) rather
+  /// than the hand's: a witness the explorer reached while the tube held back from the hand (the
+  /// coupling stretched, the tube pushed hard, or still moving) is then approached without the
+  /// push that carried the tube on.
   std::vector<double> slower = {2.0, 4.0};
 };
 
@@ -35,6 +39,7 @@ struct Candidate {
   Trajectory trajectory;
   double duration_s = 0.0;
   double peak_speed_m_per_s = 0.0;  ///< of the try kept
+  bool held = false;                ///< the try kept aims at the held end's poses
   int tries = 0;                    ///< 1 when the first was kept
   Judgement judgement;
 };
