@@ -114,6 +114,29 @@ TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-shelf"));
 }
 
+TEST_CASE("plans: the pocket scene gives a verified plan that puts the tube's end in",
+          "[cli][explore]") {
+  // A hole entered end first: the tube hangs over a blind pocket and its end goes down onto the
+  // pocket's floor. The goal's witness has the hand pushing on; the plan that holds comes from
+  // aiming at the held end's poses. 300 motions keep the test short (about 10 s).
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-pocket") / "out";
+  const Outcome r = RunTool({"plans", SourcePath("scenes/pocket.yaml"), "--budget", "300", "--jobs",
+                             "2", "--out-dir", dir.string()});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::size_t line = r.out.find("pocket-candidate-1: cost");
+  REQUIRE(line != std::string::npos);
+  const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
+  CHECK(said.find("-> {Fe - base.top}; feasible") != std::string::npos);
+  const double peak_N = std::stod(said.substr(said.rfind("force ") + 6));
+  CHECK(peak_N > 0.0);
+  CHECK(peak_N < 1.0);  // set down, not pushed: the device gives 8.5 N
+  const Outcome judged = RunTool({"evaluate", dir.string()});
+  INFO(judged.out);
+  CHECK(judged.exit_code == 0);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-pocket"));
+}
+
 TEST_CASE("plans: the tilted groove's two-PC goal gives verified plans on a small budget",
           "[cli][explore]") {
   // Parts turned about a non-vertical axis and a goal of two PCs (the tube seated in the corner
