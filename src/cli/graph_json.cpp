@@ -1,5 +1,7 @@
 #include "graph_json.hpp"
 
+#include <cmath>
+
 namespace tubeplan::cli {
 namespace {
 
@@ -56,6 +58,8 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                      {"friction_N", n.friction_N},
                      {"friction_limit_N", n.friction_limit_N},
                      {"force_N", n.force_N},
+                     {"min_force_N", std::isfinite(n.min_force_N) ? nlohmann::json(n.min_force_N)
+                                                                  : nlohmann::json(nullptr)},
                      {"distance_m", n.distance_m >= 0.0 ? nlohmann::json(n.distance_m) : nullptr},
                      {"ticks", n.ticks},
                      {"from_replay", n.from_replay},

@@ -625,7 +625,10 @@ std::vector<Move> Probes(const scene::Scene& scene, const Eigen::Isometry3d& X_W
 
 class Merger {
  public:
-  explicit Merger(ContactGraph& graph) : graph_(graph) {}
+  // `witness_limit_N`: a stay with a larger operator force is a witness only where the node has
+  // no stay within it.
+  Merger(ContactGraph& graph, double witness_limit_N)
+      : graph_(graph), witness_limit_N_(witness_limit_N) {}
 
   // Returns whether the result added a node or an arc.
   bool Add(const MotionResult& r) {
@@ -635,9 +638,15 @@ class Merger {
       const int i = NodeOf(s.cf);
       Node& n = graph_.nodes[std::size_t(i)];
       if (!s.refined) n.ticks += s.length;
+      n.min_force_N = std::min(n.min_force_N, s.sample.force_N);
+      // The witness: a stay within the force limit before any beyond it, then a settled stay
+      // before a refined one, then the longest.
       Best& best = best_[std::size_t(i)];
-      const bool better = best.length < 0 || (best.refined && !s.refined) ||
-                          (best.refined == s.refined && s.length > best.length);
+      const bool within = s.sample.force_N <= witness_limit_N_;
+      const bool better =
+          best.length < 0 || (within && !best.within) ||
+          (within == best.within &&
+           ((best.refined && !s.refined) || (best.refined == s.refined && s.length > best.length)));
       // Probes start from the settled stay that is quickest to replay (any stay if none is).
       const int ticks = s.witness.substeps > 0 ? s.witness.tick - 1 : s.witness.tick;
       Entry& entry = entry_[std::size_t(i)];
@@ -652,7 +661,7 @@ class Merger {
                  s.witness.substeps == 0 ? r.stay_points[j] : nullptr};
       }
       if (better) {
-        best = {s.length, s.refined};
+        best = {s.length, s.refined, within};
         n.pcs = s.pcs;
         n.witness = s.witness;
         n.X_W_hand = s.sample.X_W_hand;
@@ -717,6 +726,7 @@ class Merger {
   struct Best {
     long length = -1;
     bool refined = true;
+    bool within = false;  // its operator force within the witness limit
   };
   struct Entry {     // where probes start from (a stay of the node)
     int ticks = -1;  // ticks of its motion up to there
@@ -737,6 +747,7 @@ class Merger {
     return it->second;
   }
   ContactGraph& graph_;
+  double witness_limit_N_;
   std::map<std::string, int> node_of_;
   std::map<std::pair<int, int>, int> arc_of_;
   std::vector<Best> best_;
@@ -860,7 +871,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
                                     std::chrono::duration<double>(o.time_limit_s));
   ContactGraph graph;
-  Merger merger(graph);
+  Merger merger(graph,
+                o.witness_force_N > 0.0 ? o.witness_force_N : 0.5 * scene.device.max_force_N);
   std::vector<std::unique_ptr<core::Core>> cores;
   cores.push_back(std::make_unique<core::Core>(scene));
   core::Core& probe = *cores.front();

@@ -352,6 +352,10 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
     // The witness data is the core's at that tick (the same bits: the core is deterministic).
     CHECK(core.last().energy_J == n.energy_J);
     CHECK(core.last().X_WH.translation() == n.X_WH.translation());
+    CHECK(core.last().force_W_N.norm() == n.force_N);
+    // Within half the device's force wherever some stay of the node was.
+    CHECK(n.min_force_N <= n.force_N);
+    if (n.min_force_N <= 0.5 * s.device.max_force_N) CHECK(n.force_N <= 0.5 * s.device.max_force_N);
   }
   // Every arc's witness tick is in the arc's target CF... except where the core re-entered the
   // source within the dwell time; the first tick of the target must at least exist.

@@ -4,6 +4,7 @@
 // core classifies as that CF, replayable with graph::ReplayTo); arcs are transitions the core
 // produced between them. Plain data; built by graph::Explore, pruned by graph::Prune.
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,8 @@ struct Node {
   double friction_N = 0.0;        ///< sum of |friction force| over the PCs at the witness
   double friction_limit_N = 0.0;  ///< sum of f_max over the PCs: the friction they can resist with
   double force_N = 0.0;           ///< operator force at the witness
+  /// The least operator force of all its stays (each stay's middle tick): what reaching it takes.
+  double min_force_N = std::numeric_limits<double>::infinity();
   /// Motion of the held end still needed to reach the goal: |p_H - p_H,goal| + (l/2) angle
   /// (R_H, R_H,goal) between the witnesses (the tube's middle moves by about l/2 per radian).
   /// Negative when the goal was never reached.

@@ -51,7 +51,11 @@ struct ExploreOptions {
   std::function<void(const ExploreStatus&)> status;
   double status_interval_s = 1.0;
   int jobs = 1;
-  double push_N = 2.0;          ///< guard force of the probing moves
+  double push_N = 2.0;  ///< guard force of the probing moves
+  /// A node's witness is a stay whose operator force is at most this [N] wherever the node has
+  /// one (0: half the device's maximum force, 4.25 N for the PHANToM Premium): plans start from
+  /// states an operator reaches well within the device.
+  double witness_force_N = 0.0;
   double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)
   int substeps = 16;            ///< sub-ticks per tick when refining a multi-PC change
   /// A CF counts once the core has kept it this long (the plan judge's dwell); briefer states
