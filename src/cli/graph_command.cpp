@@ -21,6 +21,7 @@
 
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
+#include <tubeplan/graph/completeness.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/motion.hpp>
@@ -53,6 +54,7 @@ struct GraphOptions {
   std::string weights;
   std::optional<double> tolerance;
   std::string verdicts_path;  // graph only: an evaluate report
+  int check = 0;              // graph only: independent random motions measuring completeness
 };
 
 // The judged plans of an evaluate report (docs/evaluate.md), or nullopt after reporting why not.
@@ -335,6 +337,30 @@ int RunGraph(const GraphOptions& o, Streams io) {
       << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.from_replay; })
       << " transitions seen only in the replays added\n";
   }
+  if (o.check > 0) {
+    // Random motions of another seed than the explorer's: motions it did not make.
+    const std::vector<graph::Motion> motions =
+        graph::RandomMotions(s, o.seed + 1000003, 0, o.check, explore);
+    const graph::Completeness c = graph::CheckCompleteness(s, g, motions, explore.dwell_s);
+    const auto percent = [](long part, long all) { return all > 0 ? 100.0 * part / all : 100.0; };
+    t << "completeness: " << c.motions << " independent random motions counted " << c.states_seen
+      << " states, " << c.states_in_graph << " in the graph ("
+      << percent(c.states_in_graph, c.states_seen) << " %), and " << c.transitions_seen
+      << " transitions, " << c.transitions_in_graph << " in it ("
+      << percent(c.transitions_in_graph, c.transitions_seen) << " %); by use, "
+      << percent(c.ticks_in_graph, c.ticks) << " % of their ticks and "
+      << percent(c.taken_in_graph, c.taken) << " % of the transitions taken\n";
+    for (std::size_t i = 0; i < c.missing_states.size() && i < 8; ++i)
+      t << "  missing state: " << c.missing_states[i] << "\n";
+    for (std::size_t i = 0; i < c.missing_transitions.size() && i < 8; ++i)
+      t << "  missing transition: " << c.missing_transitions[i].first.first << " -> "
+        << c.missing_transitions[i].first.second << " (taken " << c.missing_transitions[i].second
+        << (c.missing_transitions[i].second == 1 ? " time)\n" : " times)\n");
+    const std::size_t more = c.missing_states.size() + c.missing_transitions.size() -
+                             std::min<std::size_t>(c.missing_states.size(), 8) -
+                             std::min<std::size_t>(c.missing_transitions.size(), 8);
+    if (more > 0) t << "  and " << more << " more\n";
+  }
   if (!o.dot_path.empty()) t << "DOT written to " << o.dot_path << "\n";
   if (!o.svg_path.empty()) t << "SVG (Graphviz dot) written to " << o.svg_path << "\n";
   if (!o.json_path.empty()) t << "JSON written to " << o.json_path << "\n";
@@ -530,6 +556,10 @@ Command AddGraphCommand(CLI::App& app, Streams streams) {
   sub->add_flag("--unpruned", options->unpruned,
                 "DOT: draw every arc, the dropped ones dashed with their reason (default: the "
                 "pruned graph only)");
+  sub->add_option("--check", options->check,
+                  "after exploring, run N random guarded motions of another seed and report the "
+                  "states and transitions they reach that the graph lacks (docs/graph.md)")
+      ->check(CLI::Range(0, 100000));
   AddGraphOptions(sub, *options);
   return {sub, [options, streams] { return RunGraph(*options, streams); }};
 }

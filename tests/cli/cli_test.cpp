@@ -114,6 +114,28 @@ TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-shelf"));
 }
 
+TEST_CASE("graph --check measures the graph against motions it did not make", "[cli][explore]") {
+  // A budget of 40 motions leaves the shelf's graph unsaturated: 30 motions of another seed
+  // then find what it lacks, and the line's figures agree with each other.
+  const Outcome r = RunTool(
+      {"graph", SourcePath("scenes/shelf.yaml"), "--budget", "40", "--jobs", "2", "--check", "30"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code != 2);
+  const std::size_t at = r.out.find("completeness: 30 independent random motions counted ");
+  REQUIRE(at != std::string::npos);
+  long states = 0, states_in = 0, arcs = 0, arcs_in = 0;
+  REQUIRE(std::sscanf(r.out.c_str() + at,
+                      "completeness: 30 independent random motions counted %ld states, %ld in the "
+                      "graph (%*f %%), and %ld transitions, %ld in it",
+                      &states, &states_in, &arcs, &arcs_in) == 4);
+  CHECK(states_in <= states);
+  CHECK(arcs_in <= arcs);
+  CHECK(states >= 3);
+  // An unsaturated graph lacks something those motions reach, and each missing one is listed.
+  CHECK(states_in + arcs_in < states + arcs);
+  CHECK(r.out.find("  missing ") != std::string::npos);
+}
+
 TEST_CASE("plans: the pocket scene gives a verified plan that puts the tube's end in",
           "[cli][explore]") {
   // A hole entered end first: the tube hangs over a blind pocket and its end goes down onto the

@@ -1,0 +1,78 @@
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/graph/completeness.hpp>
+
+namespace tubeplan::graph {
+
+Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
+                               std::span<const Motion> motions, double dwell_s) {
+  std::set<std::string> nodes;
+  std::set<std::pair<std::string, std::string>> arcs;
+  for (const Node& n : graph.nodes) nodes.insert(n.cf);
+  for (const Arc& a : graph.arcs)
+    arcs.insert({graph.nodes[std::size_t(a.from)].cf, graph.nodes[std::size_t(a.to)].cf});
+  // A two-PC change the graph records through a brief state in between (A -> C -> B).
+  const auto in_graph = [&](const std::pair<std::string, std::string>& a) {
+    if (arcs.contains(a)) return true;
+    return std::any_of(nodes.begin(), nodes.end(), [&](const std::string& c) {
+      return arcs.contains({a.first, c}) && arcs.contains({c, a.second});
+    });
+  };
+
+  const double step_s = scene.model.time_step_s;
+  const int dwell = std::max(1, static_cast<int>(std::lround(dwell_s / step_s)));
+  std::map<std::string, long> ticks_in;                      // ticks spent per state
+  std::map<std::pair<std::string, std::string>, int> taken;  // transitions counted
+  std::set<std::string> seen;                                // states counted
+  core::Core core(scene);
+  for (const Motion& m : motions) {
+    core.Reset(scene.X_WH_start);
+    MotionRunner runner(m, scene.X_WH_start, step_s);
+    std::string counted, current;
+    int held = 0;
+    for (int k = 1; !runner.Done(); ++k) {
+      if (core.Step(k * step_s, runner.Next(core.last())).flags & core::kProxySeparated) break;
+      const std::string cf = core.FormationText();
+      ++ticks_in[cf];
+      held = cf == current ? held + 1 : 1;
+      current = cf;
+      if (k == 1) counted = cf, seen.insert(cf);
+      if (held == dwell && cf != counted) {
+        ++taken[{counted, cf}];
+        seen.insert(cf);
+        counted = cf;
+      }
+    }
+  }
+
+  Completeness c;
+  c.motions = static_cast<int>(motions.size());
+  for (const auto& [cf, ticks] : ticks_in) {
+    c.ticks += ticks;
+    if (nodes.contains(cf)) c.ticks_in_graph += ticks;
+  }
+  for (const std::string& cf : seen) {
+    ++c.states_seen;
+    if (nodes.contains(cf))
+      ++c.states_in_graph;
+    else
+      c.missing_states.push_back(cf);
+  }
+  for (const auto& [a, n] : taken) {
+    ++c.transitions_seen;
+    c.taken += n;
+    if (in_graph(a)) {
+      ++c.transitions_in_graph;
+      c.taken_in_graph += n;
+    } else {
+      c.missing_transitions.push_back({a, n});
+    }
+  }
+  return c;
+}
+
+}  // namespace tubeplan::graph
