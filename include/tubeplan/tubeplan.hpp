@@ -1,0 +1,25 @@
+#pragma once
+// tubeplan as a library: everything a program calls to do what the commands do. Load a scene
+// and a plan (io), step the core with a hand pose (core), judge a plan's replay (plan), judge a
+// set of plans (batch), explore and prune the contact-state graph and make candidate plans
+// (graph, plan), run the 1 kHz servo against a device (device). Each header says what it holds;
+// README.md, "Layout", says which library each folder is.
+
+#include <tubeplan/batch/evaluate.hpp>
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/device/device.hpp>
+#include <tubeplan/device/device_choice.hpp>
+#include <tubeplan/device/host_check.hpp>
+#include <tubeplan/device/servo.hpp>
+#include <tubeplan/graph/completeness.hpp>
+#include <tubeplan/graph/dot.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/paths.hpp>
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/candidates.hpp>
+#include <tubeplan/plan/judge.hpp>
+#include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/scene/scene.hpp>
+#include <tubeplan/states/contact_formation.hpp>
