@@ -32,6 +32,7 @@
 #include "graphviz.hpp"
 #include "html_report.hpp"
 #include "report.hpp"
+#include "report_assets.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -137,6 +138,12 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
                     io.err))
     return kExitBadInput;
 
+  if (!o.html_path.empty() && !assets::Available()) {
+    io.err << "tubeplan evaluate: error: --html: this tubeplan was built without the HTML report "
+              "(node was not found when it was configured, or TUBEPLAN_HTML_REPORT was off); "
+              "install nodejs and npm (tools/setup does) and build again\n";
+    return kExitBadInput;
+  }
   // Graphviz is checked before the replays: a missing `dot` should not cost a batch.
   if (o.html_graph) {
     if (o.html_path.empty()) {

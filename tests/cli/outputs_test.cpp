@@ -266,6 +266,7 @@ TEST_CASE("SIGINT or SIGTERM during simulate --out removes the temporary and exi
   }
 }
 
+#if TUBEPLAN_HTML_REPORT
 TEST_CASE("Ctrl-C while evaluate makes its HTML page exits 130 and writes no report",
           "[cli][outputs]") {
   const auto dir = Scratch() / "html";
@@ -290,6 +291,21 @@ TEST_CASE("Ctrl-C while evaluate makes its HTML page exits 130 and writes no rep
   CHECK(Entries(dir) == std::vector<std::string>{"report.json"});
   std::filesystem::remove_all(Scratch());
 }
+#else
+TEST_CASE("evaluate --html in a build without the HTML report says why, before any replay",
+          "[cli][outputs]") {
+  const auto dir = Scratch() / "no-html";
+  std::filesystem::create_directories(dir);
+  const std::string html = (dir / "report.html").string();
+  const tubeplan::testing::Outcome r = tubeplan::testing::RunTool(
+      {"evaluate", SourcePath("plans/groove-insert-coarse.yaml"), "--html", html});
+  CHECK(r.exit_code == 2);
+  CHECK_THAT(r.err, Catch::Contains("--html: this tubeplan was built without the HTML report"));
+  CHECK(r.out.empty());
+  CHECK(Entries(dir).empty());
+  std::filesystem::remove_all(Scratch());
+}
+#endif
 
 TEST_CASE("Every command refuses an output that is one of its inputs, and writes nothing",
           "[cli][outputs]") {
