@@ -22,7 +22,7 @@ nlohmann::json Report(nlohmann::json plans, const ReportScope& scope) {
   long feasible = 0, not_judged = 0;
   for (const nlohmann::json& p : plans) {
     feasible += p["feasible"].get<bool>();
-    not_judged += p["outcome"] == "not judged";
+    not_judged += p.value("outcome", std::string()) == "not judged";
   }
   const long count = static_cast<long>(plans.size());
   return {{"tubeplan_evaluate", kEvaluateJsonVersion},
