@@ -261,7 +261,7 @@ int RunLive(const LiveOptions& o, Streams io) {
       return kExitBadInput;
     }
     recording.Append(io::TrajectoryCsvHeader(dev->spec().name + ", tubeplan live " + plan.name,
-                                             1.0 / T, {"stalled"}));
+                                             1.0 / T, {"stall_ms"}));
   }
 
   // A stepped run can outpace this thread: its ring holds the whole run. In real time 16 s of
@@ -311,7 +311,10 @@ int RunLive(const LiveOptions& o, Streams io) {
       t_last_s = record.hand.t_s;
       if (!o.record.empty()) {
         row.clear();
-        io::AppendTrajectoryCsvRow(row, record.hand, record.stalled ? "1" : "0");
+        // The stall's lateness to 0.01 ms, "0" on a tick that woke in time.
+        char stall[24] = "0";
+        if (record.stalled) std::snprintf(stall, sizeof stall, "%.2f", double(record.stall_ms));
+        io::AppendTrajectoryCsvRow(row, record.hand, stall);
         recording.Append(row);
         ++recorded;
       }

@@ -202,6 +202,7 @@ ServoStats ServoLoop::Run() {
     record.tick = k;
     record.stepped = false;
     record.stalled = missed;
+    record.stall_ms = missed ? float(double(latency_ns) * 1e-6) : 0.0f;
     record.buttons = sample.buttons;
     LimitedWrench wrench;
     if (reason == StopReason::kNone && !finite) {

@@ -229,6 +229,8 @@ TEST_CASE("A stall is survived: zero force on its tick, the force back after, th
   REQUIRE(at + 1 < s.records.size());
   CHECK(s.records[at].tick == injected);
   CHECK(s.records[at - 1].tick == injected - 1);
+  CHECK(s.records[at].stall_ms == Approx(s.stats.longest_stall_ms));
+  CHECK(s.records[at - 1].stall_ms == 0.0f);
   CHECK(s.records[at - 1].force_sent_N.norm() >= kLoaded_N * 0.9);
   CHECK(s.records[at].force_sent_N.isZero(0.0));
   CHECK(s.records[at].stepped);

@@ -72,6 +72,7 @@ struct TickRecord {
   Eigen::Vector3d torque_sent_Nm = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;
   bool stalled = false;          ///< this tick woke more than a period late: its force was zero
+  float stall_ms = 0.0f;         ///< how late it woke when it stalled [ms], 0 otherwise
   std::int32_t response_ns = 0;  ///< from the tick's deadline to its wrench sent
 };
 
