@@ -165,6 +165,28 @@ std::vector<WrenchRow> ReadWrenches(const fs::path& file) {
   return rows;
 }
 
+// The forces the bridge received, in order, with their largest size and their largest rise
+// from one to the next (a step to zero, a stall or the end, is never rate-limited: removing
+// force pushes nobody).
+struct BridgeForces {
+  std::vector<WrenchRow> forces;
+  double largest_N = 0.0, largest_rise_N = 0.0;
+};
+
+BridgeForces ForcesOf(const std::vector<WrenchRow>& rows) {
+  BridgeForces f;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  for (const WrenchRow& r : rows) {
+    if (!r.force) continue;
+    f.forces.push_back(r);
+    f.largest_N = std::max(f.largest_N, r.value.norm());
+    if (!r.value.isZero(0.0))
+      f.largest_rise_N = std::max(f.largest_rise_N, (r.value - previous).norm());
+    previous = r.value;
+  }
+  return f;
+}
+
 // The bridge's own counts, from its summary line: poses sent, dropped, delayed (held in a pause
 // and sent in its burst) and pauses begun; -1 where the line does not say.
 struct BridgeCounts {
@@ -288,22 +310,13 @@ TEST_CASE("The servo's wrenches reach the bridge within the device's limits and 
   INFO(summary);
   const device::OpenIGTLinkCounters counters = dev.counters();
   const std::vector<WrenchRow> rows = ReadWrenches(wrenches);
-  std::vector<WrenchRow> forces;
-  for (const WrenchRow& r : rows)
-    if (r.force) forces.push_back(r);
+  const BridgeForces received = ForcesOf(rows);
+  const std::vector<WrenchRow>& forces = received.forces;
+  const double largest_N = received.largest_N, largest_step_N = received.largest_rise_N;
   // Every wrench written reached the bridge (TCP on loopback; none was lost or garbled).
   REQUIRE(forces.size() == counters.wrenches_sent);
   // One per tick and the zeros at the end, less any skipped on a full socket.
   REQUIRE(forces.size() + counters.wrenches_skipped >= 4000);
-  double largest_N = 0.0, largest_step_N = 0.0;
-  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
-  for (const WrenchRow& r : forces) {
-    largest_N = std::max(largest_N, r.value.norm());
-    // Going to zero (a stall, the end) is never rate-limited: removing force pushes nobody.
-    if (!r.value.isZero(0.0))
-      largest_step_N = std::max(largest_step_N, (r.value - previous).norm());
-    previous = r.value;
-  }
   CHECK(largest_N <= 0.05 * (1 + 1e-12));
   // The bridge got what the servo sent, tick by tick (float64 on the wire: exactly).
   if (counters.wrenches_skipped == 0) {
@@ -437,9 +450,8 @@ TEST_CASE(
   CHECK(bridge_counts.delayed >= 5 * bridge_counts.pauses);
 
   const std::vector<WrenchRow> rows = ReadWrenches(wrenches);
-  std::vector<WrenchRow> forces;
-  for (const WrenchRow& r : rows)
-    if (r.force) forces.push_back(r);
+  const BridgeForces received = ForcesOf(rows);
+  const std::vector<WrenchRow>& forces = received.forces;
   REQUIRE(forces.size() == counters.wrenches_sent);  // every wrench written reached the bridge
   REQUIRE(forces.size() + counters.wrenches_skipped >= 3000);
   // A burst moves the hand 10 ms at once; the force still rises by at most the limiter's step
@@ -447,14 +459,7 @@ TEST_CASE(
   // falls to zero only whole (a stall drops it).
   const double step_N =
       limits.max_force_rate_N_per_s * 1e-3 * double(1 + counters.wrenches_skipped);
-  double largest_N = 0.0, largest_step_N = 0.0;
-  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
-  for (const WrenchRow& r : forces) {
-    largest_N = std::max(largest_N, r.value.norm());
-    if (!r.value.isZero(0.0))
-      largest_step_N = std::max(largest_step_N, (r.value - previous).norm());
-    previous = r.value;
-  }
+  const double largest_N = received.largest_N, largest_step_N = received.largest_rise_N;
   CHECK(largest_N <= 0.05 * (1 + 1e-12));
   CHECK(largest_N >= 0.05 * 0.999);  // the clamp was reached: the plan pushed harder
   CHECK(largest_step_N <= step_N * (1 + 1e-9));
