@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <array>
 
 #include <tubeplan/plan/candidates.hpp>
 
@@ -38,9 +39,10 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
     const std::size_t speeds = options.slower.size() + 1;
+    const std::array<std::vector<Eigen::Isometry3d>, 2> aims = {
+        Waypoints(scene, graph, *c.path, false), Waypoints(scene, graph, *c.path, true)};
     for (std::size_t k = 0; k < 2 * speeds; ++k) {
-      const std::vector<Eigen::Isometry3d> waypoints =
-          Waypoints(scene, graph, *c.path, k >= speeds);
+      const std::vector<Eigen::Isometry3d>& waypoints = aims[k >= speeds ? 1 : 0];
       synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s /
                                      (k % speeds > 0 ? options.slower[k % speeds - 1] : 1.0);
       c.trajectory = SynthesizeTrajectory(waypoints, synthesis);
