@@ -6,6 +6,8 @@
 // README.md, "Layout", says which library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
+#include <tubeplan/batch/merge.hpp>
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/device/device.hpp>
 #include <tubeplan/device/device_choice.hpp>

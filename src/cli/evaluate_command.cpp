@@ -11,7 +11,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <set>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -19,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/batch/evaluate.hpp>
+#include <tubeplan/batch/merge.hpp>
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
@@ -209,7 +209,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
                                                                    : " are left as they were)");
   io::SetInterruptMessage("tubeplan evaluate: interrupted; no report written" + left_as_it_was);
   defer_interrupts.reset();
-  const nlohmann::json report = ToJson(results, scope);
+  const nlohmann::json report = batch::ToJson(results, scope);
   std::string html_text;
   if (!o.html_path.empty()) {
     HtmlOptions html;
@@ -327,158 +327,15 @@ struct MergeOptions {
   std::string report_path;
 };
 
-// One shard report as merge reads it.
-struct ShardReport {
-  std::string path;
-  ReportScope scope;
-  nlohmann::json plans;
-};
-
-// The report at `path`, or nullopt after saying why it is not one merge can take.
-std::optional<ShardReport> ReadShardReport(const std::string& path, std::ostream& err) {
-  const std::optional<std::string> text = io::ReadTextFile(path);
-  nlohmann::json report;
-  if (text) report = nlohmann::json::parse(*text, nullptr, /*allow_exceptions=*/false);
-  if (!text || report.is_discarded() || !report.is_object() ||
-      !report.value("tubeplan_evaluate", nlohmann::json()).is_number_integer()) {
-    err << path
-        << ": error: not a tubeplan evaluate report, expected the JSON that "
-           "`tubeplan evaluate --report` writes (version "
-        << kEvaluateJsonVersion << ")\n";
-    return std::nullopt;
-  }
-  const int version = report["tubeplan_evaluate"].get<int>();
-  if (version != kEvaluateJsonVersion) {
-    err << path << ": error: a report of version " << version
-        << (version < 2 ? ", which does not say which shard of which plan set it holds; expected "
-                          "version "
-            : version < kEvaluateJsonVersion ? ", made by an earlier core; expected version "
-                                             : ", expected version ")
-        << kEvaluateJsonVersion << ": evaluate the shard again with this tubeplan\n";
-    return std::nullopt;
-  }
-  const nlohmann::json set = report.value("plan_set", nlohmann::json());
-  const nlohmann::json shard = report.value("shard", nlohmann::json());
-  const bool scoped = set.is_object() && set.value("id", nlohmann::json()).is_string() &&
-                      set.value("plans", nlohmann::json()).is_number_integer() &&
-                      set["plans"].get<long>() >= 0 && shard.is_object() &&
-                      shard.value("index", nlohmann::json()).is_number_integer() &&
-                      shard.value("count", nlohmann::json()).is_number_integer() &&
-                      shard["count"].get<long>() >= 1 && shard["index"].get<long>() >= 1 &&
-                      shard["index"].get<long>() <= shard["count"].get<long>() &&
-                      shard["count"].get<long>() <= 1000000;
-  if (!scoped || !report.contains("plans") || !report["plans"].is_array()) {
-    err << path
-        << ": error: a report without a readable \"plan_set\" {id, plans}, \"shard\" {index, "
-           "count} or \"plans\", expected the JSON that `tubeplan evaluate --report` writes\n";
-    return std::nullopt;
-  }
-  ShardReport r;
-  r.path = path;
-  r.scope.plan_set_id = set["id"].get<std::string>();
-  r.scope.plan_set_plans = set["plans"].get<long>();
-  r.scope.shard_index = shard["index"].get<int>();
-  r.scope.shard_count = shard["count"].get<int>();
-  r.plans = report["plans"];
-  return r;
-}
-
-std::string ShardText(const ReportScope& s) {
-  return std::to_string(s.shard_index) + "/" + std::to_string(s.shard_count);
-}
-
-// "3/8" or "3/8, 5/8 and 6/8".
-std::string ShardList(const std::vector<int>& indices, int count) {
-  std::string text;
-  for (std::size_t i = 0; i < indices.size(); ++i) {
-    if (i > 0) text += i + 1 == indices.size() ? " and " : ", ";
-    text += std::to_string(indices[i]) + "/" + std::to_string(count);
-  }
-  return text;
-}
-
 int RunMerge(const MergeOptions& o, Streams io) {
-  // Every report is read and checked first; every problem is said, then nothing is merged.
-  std::vector<ShardReport> shards;
-  bool ok = true;
-  for (const std::string& path : o.reports) {
-    std::optional<ShardReport> r = ReadShardReport(path, io.err);
-    if (r)
-      shards.push_back(std::move(*r));
-    else
-      ok = false;
-  }
-  if (!ok) return kExitBadInput;
-  // Exactly shards 1..N of one plan set, each once: the first report names the set and N.
-  const ShardReport& first = shards.front();
-  std::map<int, const ShardReport*> by_index;
-  for (const ShardReport& r : shards) {
-    const std::string what = "shard " + ShardText(r.scope) + " of plan set " + r.scope.plan_set_id +
-                             " (" + std::to_string(r.scope.plan_set_plans) + " plans)";
-    if (r.scope.plan_set_id != first.scope.plan_set_id ||
-        r.scope.plan_set_plans != first.scope.plan_set_plans) {
-      io.err << r.path << ": error: " << what << " is from another plan set than " << first.path
-             << " (plan set " << first.scope.plan_set_id << ", " << first.scope.plan_set_plans
-             << " plans), expected the shards of one `tubeplan evaluate` plan set\n";
-      ok = false;
-    } else if (r.scope.shard_count != first.scope.shard_count) {
-      io.err << r.path << ": error: " << what << " is from a split into " << r.scope.shard_count
-             << " shards, but " << first.path << " from one into " << first.scope.shard_count
-             << ", expected the shards of one split (--shard I/" << first.scope.shard_count
-             << ")\n";
-      ok = false;
-    } else if (const auto [it, inserted] = by_index.emplace(r.scope.shard_index, &r); !inserted) {
-      io.err << r.path << ": error: shard " << ShardText(r.scope) << " is given twice (also "
-             << it->second->path << "), expected each shard once\n";
-      ok = false;
-    }
-  }
-  if (!ok) return kExitBadInput;
-  const int count = first.scope.shard_count;
-  std::vector<int> missing;
-  for (int i = 1; i <= count; ++i)
-    if (!by_index.contains(i)) missing.push_back(i);
-  if (!missing.empty()) {
-    io.err << "tubeplan merge: error: shard" << (missing.size() == 1 ? " " : "s ")
-           << ShardList(missing, count) << " of plan set " << first.scope.plan_set_id << " ("
-           << first.scope.plan_set_plans << " plans) " << (missing.size() == 1 ? "is" : "are")
-           << " missing, expected all " << count << " shards\n";
-    return kExitBadInput;
-  }
-  nlohmann::json plans = nlohmann::json::array();
-  std::set<std::string> files;
-  for (const auto& [index, r] : by_index) {
-    for (const nlohmann::json& p : r->plans) {
-      if (!p.is_object() || !p.contains("file") || !p["file"].is_string() ||
-          !p.contains("feasible") || !p["feasible"].is_boolean()) {
-        io.err << r->path
-               << ": error: a plan without \"file\" or \"feasible\", expected the "
-                  "entries `tubeplan evaluate` writes\n";
-        ok = false;
-        continue;
-      }
-      if (!files.insert(p["file"].get<std::string>()).second) {
-        io.err << r->path << ": error: plan " << p["file"] << " is in two reports, expected "
-               << "disjoint shards\n";
-        ok = false;
-      }
-      plans.push_back(p);
-    }
-  }
-  if (ok && static_cast<long>(plans.size()) != first.scope.plan_set_plans) {
-    io.err << "tubeplan merge: error: the " << count << " shards hold " << plans.size()
-           << " plans, but their plan set " << first.scope.plan_set_id << " has "
-           << first.scope.plan_set_plans
-           << ", expected reports as `tubeplan evaluate` wrote them\n";
-    ok = false;
-  }
-  if (!ok) return kExitBadInput;
+  std::vector<std::string> errors;
+  const std::optional<nlohmann::json> report = batch::MergeShardReports(o.reports, errors);
+  for (const std::string& e : errors) io.err << e << "\n";
+  if (!report) return kExitBadInput;
   std::vector<io::RolePath> inputs;
   for (const std::string& path : o.reports) inputs.push_back({"the report", path});
   if (!OutputsApart("merge", {{"--report", o.report_path}}, inputs, io.err)) return kExitBadInput;
-  ReportScope whole = first.scope;
-  whole.shard_index = whole.shard_count = 1;
-  const nlohmann::json merged = Report(std::move(plans), whole);
+  const nlohmann::json& merged = *report;
   if (!o.report_path.empty()) {
     if (const std::string e = io::WriteTextFileAtomically(o.report_path, merged.dump(1) + "\n");
         !e.empty()) {

@@ -389,7 +389,7 @@ int RunLive(const LiveOptions& o, Streams io) {
   ReportScope scope;
   scope.plan_set_id = batch::PlanSetId({batch::CanonicalPlanPath(o.plan)});
   scope.plan_set_plans = 1;
-  nlohmann::json report = ToJson({e}, scope);
+  nlohmann::json report = batch::ToJson({e}, scope);
   report["servo"] = {{"ticks", stats.ticks},
                      {"overruns", stats.overruns},
                      {"median_us", stats.median_us},

@@ -1,6 +1,6 @@
 #pragma once
-// Private to the cli library: the evaluation report (text and JSON, docs/evaluate.md) that
-// `evaluate`, `merge` and `live` all write, so their verdicts read the same.
+// Private to the cli library: the evaluation report's text (docs/evaluate.md) that `evaluate`
+// and `live` print, so their verdicts read the same; its JSON is batch::ToJson.
 
 #include <ostream>
 #include <string>
@@ -9,32 +9,16 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/batch/evaluate.hpp>
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/plan.hpp>
 
 namespace tubeplan::cli {
 
-/// Version 2 added the plan set and the shard a report covers (`plan_set`, `shard`); version 3
-/// has the implicit core's flag times (`fault_s`, `beyond_linear_s`, `unconverged_s`).
-inline constexpr int kEvaluateJsonVersion = 3;
-
-/// What a report covers: shard `shard_index` of `shard_count` of one plan set, named by
-/// batch::PlanSetId of its plans' canonical paths (`plan_set_plans` plans in the whole set). An
-/// unsharded run, a merge and a live run cover shard 1 of 1.
-struct ReportScope {
-  std::string plan_set_id;
-  long plan_set_plans = 0;
-  int shard_index = 1;
-  int shard_count = 1;
-};
-
-/// One judged plan (batch::Evaluated): what the reports are made of.
+/// One judged plan (batch::Evaluated) and what a report covers (batch::ReportScope).
 using batch::Evaluated;
+using batch::ReportScope;
 
-/// A report's plans in file order, what it covers and its summary.
-nlohmann::json Report(nlohmann::json plans, const ReportScope& scope);
-/// The report of judged plans.
-nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& scope);
 /// One plan's verdicts as text: its line, then each transition with its figures.
 void PrintVerdicts(std::ostream& out, const Evaluated& e, bool colour);
 /// A plan's verdict (plan::Overall) as its headline: "FEASIBLE", "INFEASIBLE", "NOT JUDGED".

@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/judge.hpp>
 
@@ -75,7 +76,7 @@ nlohmann::json Json(const plan::Judgement& j, const std::vector<std::string>& st
   e.plan.name = "synthetic";
   e.plan.states = states;
   e.judgement = j;
-  return cli::ToJson({e}, {})["plans"][0];
+  return batch::ToJson({e}, {})["plans"][0];
 }
 
 }  // namespace
@@ -279,7 +280,7 @@ TEST_CASE("A run that stopped early judges only what it finished", "[plan]") {
     CHECK(json["transitions"][1]["verdict"] == "not judged");
     cli::Evaluated e;
     e.judgement = j;
-    const nlohmann::json summary = cli::ToJson({e}, {})["summary"];
+    const nlohmann::json summary = batch::ToJson({e}, {})["summary"];
     CHECK(summary["not_judged"] == 1);
     CHECK(summary["infeasible"] == 0);
   }
