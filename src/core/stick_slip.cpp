@@ -168,7 +168,9 @@ void CarryFriction(const Model& model, Data& data) {
         smp.friction_work_J = lim.kinetic_N * (u.norm() - stretch.norm());
       }
     }
-    // Re-anchored at the contact point as it is now, in its tangent plane, with the same stretch.
+    // Re-anchored at the friction point's material point as it is now (where the next tick's
+    // spring will measure it from: a node's sphere's point turned square to the tube), in its
+    // tangent plane, with the same stretch.
     stretch -= stretch.dot(smp.normal_W) * smp.normal_W;
     smp.friction_W_N = -K * stretch;
     smp.sliding = sliding;
@@ -182,7 +184,7 @@ void CarryFriction(const Model& model, Data& data) {
     nf.feature = smp.feature;
     nf.theta = smp.theta;
     nf.offset_W = smp.offset_W;
-    nf.anchor_W = smp.point_W - stretch;
+    nf.anchor_W = FrictionMaterial(model, nf, data.state.x_W).point_W - stretch;
     nf.normal_W = smp.normal_W;
     nf.sliding = sliding;
     nf.limit_N = sliding ? lim.kinetic_N : lim.static_N;

@@ -56,14 +56,20 @@ TEST_CASE("The shipped plans get their expected verdicts", "[plan]") {
   CHECK(report["summary"]["plans"] == 5);
   CHECK(report["summary"]["feasible"] == 3);
 
+  // The side lands on the floor still bent for a moment (40 ms) before the tube straightens:
+  // a detour the plan does not name.
   const nlohmann::json& insert = PlanNamed(report, "groove-insert");
   CHECK(insert["feasible"] == true);
-  for (const nlohmann::json& t : insert["transitions"]) CHECK(t["verdict"] == "feasible");
+  CHECK(insert["transitions"][0]["verdict"] == "feasible");
+  CHECK(insert["transitions"][1]["verdict"] == "feasible");
+  CHECK(insert["transitions"][2]["verdict"] == "feasible-with-detour");
+  CHECK(insert["transitions"][2]["detour"] == nlohmann::json::array({"{Fs n floor.top}"}));
 
   const nlohmann::json& coarse = PlanNamed(report, "groove-insert-coarse");
   CHECK(coarse["feasible"] == true);
   CHECK(coarse["transitions"][1]["verdict"] == "feasible-with-detour");
-  CHECK(coarse["transitions"][1]["detour"] == nlohmann::json::array({"{Ee ~ floor.top}"}));
+  CHECK(coarse["transitions"][1]["detour"] ==
+        nlohmann::json::array({"{Ee ~ floor.top}", "{Fs n floor.top}"}));
 
   CHECK(PlanNamed(report, "groove-lay-flat")["feasible"] == true);
 
