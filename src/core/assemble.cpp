@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace tubeplan::core {
 namespace {
@@ -184,6 +186,156 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   return 0.5 * K * depth * depth;
 }
 
+// A side section's distance on its stencil (the nodes its point and its share move with): the
+// gradient of its distance, less epsilon times its share's (a fading section is taken farther
+// off), and the distance's curvature J^T C J (the share's own is left out).
+struct SectionStencil {
+  int first = 0, nodes = 0;
+  Eigen::Matrix<double, 9, 1> gradient = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::Matrix<double, 9, 9> curvature = Eigen::Matrix<double, 9, 9>::Zero();
+};
+
+SectionStencil StencilOf(const Sample& smp, std::span<const Vec3> x_W, double eps, bool curvature) {
+  const MaterialPoint mp =
+      Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
+  SectionStencil st;
+  const bool fades = smp.weight_nodes > 0;
+  st.first = fades ? std::min(mp.first, smp.weight_first) : mp.first;
+  st.nodes = (fades ? std::max(mp.first + mp.nodes, smp.weight_first + smp.weight_nodes)
+                    : mp.first + mp.nodes) -
+             st.first;
+  const int d0 = 3 * (mp.first - st.first);
+  st.gradient.segment(d0, 9 - d0) = (mp.jacobian.transpose() * smp.normal_W).head(9 - d0);
+  if (fades) {
+    const int w0 = 3 * (smp.weight_first - st.first);
+    st.gradient.segment(w0, 9 - w0) -= eps * smp.weight_gradient.head(9 - w0);
+  }
+  // A face's distance does not curve: only an edge's or a vertex's has a curvature to add.
+  if (!curvature || smp.curvature_per_m.isZero(0.0)) return st;
+  const Eigen::Matrix<double, 3, 9> CJ = smp.curvature_per_m * mp.jacobian;
+  const Eigen::Matrix<double, 9, 9> JCJ = mp.jacobian.transpose().lazyProduct(CJ);
+  st.curvature.block(d0, d0, 9 - d0, 9 - d0) = JCJ.topLeftCorner(9 - d0, 9 - d0);
+  return st;
+}
+
+// The first and last node of a side section's stencil (StencilOf's, without its derivatives).
+std::pair<int, int> SectionNodes(const Sample& smp) {
+  const int first = smp.kind == SampleKind::kNode ? smp.node - 1 : smp.node;
+  const int last = smp.node + 1;
+  return {smp.weight_nodes > 0 ? std::min(first, smp.weight_first) : first,
+          smp.weight_nodes > 0 ? std::max(last, smp.weight_first + smp.weight_nodes - 1) : last};
+}
+
+// A side section's softmin weight below which it is left out of the mean gradient m's span (its
+// part of m is below the rounding of the rest).
+constexpr double kNegligibleWeight = 1e-14;
+
+// Groups the side's sections (IsSideSection) by the part element they press on, in the order
+// their first section was found; sections beyond kMaxSideGroups elements stay on their own.
+void GroupSideSections(Scratch& s) {
+  s.side_group_count = 0;
+  int members = 0;
+  std::array<bool, kMaxSamples> grouped{};
+  for (int k = 0; k < s.sample_count; ++k) {
+    const Sample& first = s.samples[std::size_t(k)];
+    if (grouped[std::size_t(k)] || !IsSideSection(first)) continue;
+    if (s.side_group_count == kMaxSideGroups) break;
+    SideGroup& g = s.side_groups[std::size_t(s.side_group_count++)];
+    g.first = members;
+    for (int j = k; j < s.sample_count; ++j) {
+      const Sample& smp = s.samples[std::size_t(j)];
+      if (grouped[std::size_t(j)] || !IsSideSection(smp) || smp.part != first.part ||
+          smp.face_mask != first.face_mask)
+        continue;
+      grouped[std::size_t(j)] = true;
+      s.side_members[std::size_t(members++)] = j;
+    }
+    g.count = members - g.first;
+  }
+}
+
+// The side's sections on one part element press as one contact, as the rim's points do: its
+// distance is the smooth minimum d = -tau log sum exp(-d_j / tau) of theirs, where a section
+// whose share w_j fades is taken (1 - w_j) epsilon farther off, and the paper's K (eps - d)+ is
+// shared by the softmin's weights. A side lying along a face is then one contact of stiffness K
+// however many sections bear on it, and a curved side presses with its nearest section.
+// Its Hessian K m m^T + (F / tau) (sum s_j g_j g_j^T - m m^T) - F sum s_j C_j (m the weighted
+// mean of the distances' gradients g_j, C_j their curvatures) goes into the band where m fits
+// in it, and as a band part and a rank-one term c m m^T otherwise (SolveEquilibrium).
+double AddSideGroup(const Model& model, Data& data, std::span<const Vec3> x_W, const SideGroup& g,
+                    Assembler& a) {
+  Scratch& sc = data.scratch;
+  const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
+  const double tau = kRimSoftness * eps;
+  const auto member = [&](int j) -> Sample& {
+    return sc.samples[std::size_t(sc.side_members[std::size_t(g.first + j)])];
+  };
+  const auto distance = [&](const Sample& smp) {
+    return smp.distance_m + (1.0 - smp.weight) * eps;
+  };
+  double d_min = distance(member(0));
+  for (int j = 1; j < g.count; ++j) d_min = std::min(d_min, distance(member(j)));
+  double sum = 0.0;
+  for (int j = 0; j < g.count; ++j) sum += std::exp(-(distance(member(j)) - d_min) / tau);
+  const double d = d_min - tau * std::log(sum);
+  const double depth = eps - d;
+  const double force = depth > 0.0 ? K * depth : 0.0;
+  for (int j = 0; j < g.count; ++j) {
+    Sample& smp = member(j);
+    smp.contact_distance_m = d;
+    smp.normal_force_N = force * std::exp(-(distance(smp) - d_min) / tau) / sum;
+  }
+  if (!(depth > 0.0)) return 0.0;
+  if (!a.gradient()) return 0.5 * K * depth * depth;
+  // The nodes the sections of any weight span: the mean gradient m lies on them.
+  int lo = std::numeric_limits<int>::max(), hi = -1;
+  for (int j = 0; j < g.count; ++j) {
+    const Sample& smp = member(j);
+    if (!(smp.normal_force_N > kNegligibleWeight * force)) continue;
+    const auto [first, last] = SectionNodes(smp);
+    lo = std::min(lo, first);
+    hi = std::max(hi, last);
+  }
+  // m in the band (three nodes at most), else as a rank-one term of its own while there is room
+  // for one (beyond, its term is left out of the Hessian: the gradient stays exact).
+  const bool banded = hi - lo <= 2;
+  const bool low_rank = a.hessian() && !banded && sc.low_rank_count < kMaxSideGroups;
+  Eigen::Matrix<double, 9, 1> band_mean = Eigen::Matrix<double, 9, 1>::Zero();
+  Eigen::VectorXd* mean = low_rank ? &sc.low_rank_u[std::size_t(sc.low_rank_count)] : nullptr;
+  if (mean != nullptr) mean->setZero();
+  for (int j = 0; j < g.count; ++j) {
+    const Sample& smp = member(j);
+    const double weight = smp.normal_force_N / force;
+    const SectionStencil st = StencilOf(smp, x_W, eps, a.hessian());
+    StencilTerm t;
+    t.first = st.first;
+    t.nodes = st.nodes;
+    t.gradient = -force * weight * st.gradient;
+    if (a.hessian()) {
+      t.hessian = (force / tau) * weight * st.gradient * st.gradient.transpose() -
+                  force * weight * st.curvature;
+      if (banded && weight > kNegligibleWeight)
+        band_mean.segment(3 * (t.first - lo), 3 * t.nodes) +=
+            weight * st.gradient.head(3 * t.nodes);
+      if (mean != nullptr)
+        mean->segment(3 * t.first, 3 * t.nodes) += weight * st.gradient.head(3 * t.nodes);
+    }
+    a.AddStencil(t);
+  }
+  if (!a.hessian()) return 0.5 * K * depth * depth;
+  const double c = K - force / tau;
+  if (banded) {
+    StencilTerm t;
+    t.first = lo;
+    t.nodes = hi - lo + 1;
+    t.hessian = c * band_mean * band_mean.transpose();
+    a.AddStencil(t);
+  } else if (low_rank && std::abs(c) > 1e-12 * K) {
+    sc.low_rank_c[std::size_t(sc.low_rank_count++)] = c;
+  }
+  return 0.5 * K * depth * depth;
+}
+
 // The terms of a contact point's share w that fades with the nodes: E = (K/2) w depth^2 gives
 // (K/2) depth^2 grad w, and -K depth (grad w grad d^T + grad d grad w^T) in the Hessian, both on
 // the three-node window that holds the share's nodes and the point's.
@@ -241,8 +393,19 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
   // the distance near an edge or vertex (a point rolling round it); the rim's points on one
   // part press as one contact.
   const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
+  Scratch& sc = data.scratch;
+  if (a.hessian()) sc.low_rank_count = 0;
+  GroupSideSections(sc);
+  std::array<bool, kMaxSamples> in_group{};
+  for (int g = 0; g < sc.side_group_count; ++g) {
+    const SideGroup& group = sc.side_groups[std::size_t(g)];
+    for (int j = 0; j < group.count; ++j)
+      in_group[std::size_t(sc.side_members[std::size_t(group.first + j)])] = true;
+    energy += AddSideGroup(model, data, x_W, group, a);
+  }
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     Sample& smp = data.scratch.samples[std::size_t(k)];
+    if (in_group[std::size_t(k)]) continue;
     if (smp.kind == SampleKind::kRim) {
       int end = k + 1;
       while (end < data.scratch.sample_count &&

@@ -41,8 +41,6 @@ constexpr double kKeepDirection = 0.01;
 // The fraction of a curve piece at either end over which its node's sphere takes back the share
 // it yields to the piece (YieldNode).
 constexpr double kPieceEnd = 0.1;
-// The feature of the held end's sphere, apart from the element sides' edges (0 and up).
-constexpr int kHeldFeature = -1;
 
 // Smooth step from 0 at a = 0 to 1 at a = 1.
 double SmoothStep(double a) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -36,8 +37,8 @@ struct Sample {
   std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
   int part = 0;                ///< index into Model::parts
   int node = 0;                ///< the section's node, or the segment's first node
-  int feature = 0;     ///< ring position (kRim), edge (kSide, kCurve) or vertex (kEndFace)
-  double theta = 0.0;  ///< position along the segment (kSide) or the piece (kCurve), 0..1
+  int feature = 0;             ///< ring position (kRim), edge (kSide, kCurve) or vertex (kEndFace)
+  double theta = 0.0;          ///< position along the segment (kSide) or the piece (kCurve), 0..1
   double weight = 1.0;         ///< share of K it carries
   /// d weight / d nodes from weight_first on (two or three): a share that fades moves with them.
   Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
@@ -98,6 +99,23 @@ struct FrictionPoint {
 };
 
 inline constexpr int kMaxSamples = 512;
+/// The feature of the held end's section's contact point (a kSide at node 0).
+inline constexpr int kHeldFeature = -1;
+/// Part elements the side can press on at once as one contact each (SideGroup); the side's
+/// sections on any more press each on their own.
+inline constexpr int kMaxSideGroups = 16;
+
+/// Whether a contact point is one of the side's sections that press on a part element together
+/// as one contact: the spheres at the inner nodes and the held end's section.
+inline bool IsSideSection(const Sample& s) {
+  return s.kind == SampleKind::kNode || (s.kind == SampleKind::kSide && s.feature == kHeldFeature);
+}
+
+/// The side's sections on one part element: samples side_members[first, first + count).
+struct SideGroup {
+  int first = 0;
+  int count = 0;
+};
 inline constexpr int kMaxFrictionPoints = 256;
 
 /// What a tick carries to the next: the rod, the held end, the hand, friction.
@@ -147,6 +165,19 @@ struct Scratch {
   };
   std::array<SectionChoice, 128> section_pending{};
   int section_pending_count = 0;
+  /// The side's sections grouped by the part element they press on (Assemble).
+  std::array<int, kMaxSamples> side_members{};
+  std::array<SideGroup, kMaxSideGroups> side_groups{};
+  int side_group_count = 0;
+  /// The Hessian is the band `hessian` plus sum_k c_k u_k u_k^T over the side groups whose
+  /// sections span more than the band (one term each), and the solve's B^-1 u_k.
+  std::array<Eigen::VectorXd, kMaxSideGroups> low_rank_u, low_rank_z;
+  std::array<double, kMaxSideGroups> low_rank_c{};
+  int low_rank_count = 0;
+  /// The factors of the capacitance C^-1 + U^T B^-1 U of those terms (Woodbury's identity).
+  using Capacitance =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSideGroups, kMaxSideGroups>;
+  Eigen::LDLT<Capacitance> capacitance;
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
 };

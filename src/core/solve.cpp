@@ -34,6 +34,53 @@ double StepFraction(const Model& model, const Scratch& s, const Eigen::VectorXd&
   return fraction;
 }
 
+// Factors the Hessian: its band B, then the capacitance S = C^-1 + U^T B^-1 U of its rank-one
+// terms U C U^T (Woodbury). False where B + U C U^T is not positive definite: B is not, or S has
+// not as many negative eigenvalues as C (Haynsworth's inertia additivity).
+bool FactorHessian(Scratch& s, double min_pivot) {
+  if (!s.factor.Factor(s.hessian, min_pivot)) return false;
+  const int k = s.low_rank_count;
+  if (k == 0) return true;
+  Scratch::Capacitance S(k, k);
+  int negative = 0;
+  for (int i = 0; i < k; ++i) {
+    s.low_rank_z[std::size_t(i)] = s.low_rank_u[std::size_t(i)];
+    s.factor.Solve(s.low_rank_z[std::size_t(i)]);
+    negative += s.low_rank_c[std::size_t(i)] < 0.0;
+  }
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j)
+      S(i, j) = s.low_rank_u[std::size_t(i)].dot(s.low_rank_z[std::size_t(j)]) +
+                (i == j ? 1.0 / s.low_rank_c[std::size_t(i)] : 0.0);
+  s.capacitance.compute(S);
+  int found = 0;
+  for (int i = 0; i < k; ++i) {
+    const double d = s.capacitance.vectorD()[i];
+    if (!(std::abs(d) > 1e-13 * std::abs(S(i, i)))) return false;
+    found += d < 0.0;
+  }
+  return found == negative;
+}
+
+// x = H^-1 x, in place, with the factors of FactorHessian.
+void SolveHessian(Scratch& s, Eigen::VectorXd& x) {
+  s.factor.Solve(x);
+  const int k = s.low_rank_count;
+  if (k == 0) return;
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSideGroups, 1> b(k), w(k);
+  for (int i = 0; i < k; ++i) b[i] = s.low_rank_u[std::size_t(i)].dot(x);
+  w = s.capacitance.solve(b);
+  for (int i = 0; i < k; ++i) x -= w[i] * s.low_rank_z[std::size_t(i)];
+}
+
+// y = H x: the band and the rank-one terms.
+void MultiplyHessian(const Scratch& s, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  s.hessian.Multiply(x, y);
+  for (int i = 0; i < s.low_rank_count; ++i)
+    y += (s.low_rank_c[std::size_t(i)] * s.low_rank_u[std::size_t(i)].dot(x)) *
+         s.low_rank_u[std::size_t(i)];
+}
+
 // Factors H + (shift + lambda) I with the smallest lambda >= 0 (0, then growing from a small
 // fraction of the diagonal) that is positive definite. Returns lambda, or -1 if none was found.
 double FactorShifted(Scratch& s, double shift) {
@@ -42,11 +89,11 @@ double FactorShifted(Scratch& s, double shift) {
   const double min_pivot = 1e-13 * diag;
   s.hessian.AddDiagonal(shift);
   double lambda = 0.0;
-  bool ok = s.factor.Factor(s.hessian, min_pivot);
+  bool ok = FactorHessian(s, min_pivot);
   for (double add = 1e-7 * diag; !ok && add < 1e3 * diag; add *= 4.0) {
     s.hessian.AddDiagonal(add - lambda);
     lambda = add;
-    ok = s.factor.Factor(s.hessian, min_pivot);
+    ok = FactorHessian(s, min_pivot);
   }
   s.hessian.AddDiagonal(-shift - lambda);
   return ok ? lambda : -1.0;
@@ -61,10 +108,10 @@ double NegativeCurvature(Scratch& s, Eigen::VectorXd& v) {
   for (int i = 0; i < v.size(); ++i) v[i] = 1.0 + 0.5 * std::sin(1.7 * i + 0.3);
   v.normalize();
   for (int k = 0; k < 8; ++k) {
-    s.factor.Solve(v);
+    SolveHessian(s, v);
     v.normalize();
   }
-  s.hessian.Multiply(v, s.work);
+  MultiplyHessian(s, v, s.work);
   return v.dot(s.work);
 }
 
@@ -80,7 +127,7 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
   const bool balanced = data.solve.residual_N <= model.solver.tolerance_N;
   if (balanced && lambda == 0.0) return Outcome::kConverged;
   s.step = -s.gradient;
-  s.factor.Solve(s.step);
+  SolveHessian(s, s.step);
   if (lambda > 0.0) {
     const double curvature = NegativeCurvature(s, s.direction);
     if (curvature < 0.0) {

@@ -1,6 +1,7 @@
 // The solve's gradient against central differences of its own energy, on random bent tubes
 // near an edge and a wall: every contact term (a node's sphere and its fading share, the smooth
-// side about a node on the edge, the end's rim) and the rod's and the coupling's.
+// side about a node on the edge, the end's rim) and the rod's and the coupling's; and its
+// Hessian (band and rank-one terms) against central differences of the gradient.
 #include "core/assemble.hpp"
 
 #include <algorithm>
@@ -172,4 +173,75 @@ TEST_CASE("An element's side on an edge bears continuously across the edge's fac
                                   energy_J[std::size_t(k - 1)]));
   CHECK(energy_J.back() > 1e-3);
   CHECK(kink_J < 1e-6);
+}
+
+TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's derivative",
+          "[core][gradient]") {
+  // The rubber tube lying level along a floor, every section within epsilon: its sections press
+  // as one contact whose smooth minimum spreads over all of them, so its Hessian has a term
+  // coupling every node (the rank-one term the solve adds to the band). Tipped up by 0.5 mm
+  // over its length, its held end bears alone and the term fits in the band. Either way, H v
+  // must be the central difference of the gradient along v.
+  scene::Scene s;
+  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
+  s.contact = {1e4, 1e-3, 1e-4};
+  s.device.coupling_stiffness_N_per_m = 400.0;
+  s.device.coupling_damping_Ns_per_m = 0.0;
+  const double l = s.tube.length_m, r1 = s.tube.outer_radius_m;
+  scene::BoxPart floor;
+  floor.name = "floor";
+  floor.size_m = Eigen::Vector3d(0.4, 0.2, 0.02);
+  floor.X_WP.translation() = Eigen::Vector3d(0.1, 0.0, -0.01);
+  s.parts = {floor};
+  s.X_WH_start.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX())
+          .toRotationMatrix();
+  std::mt19937_64 rng(20261203);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (const double rise_m : {0.0, 0.5e-3}) {
+    core::Model model;
+    core::Data data;
+    Build(s, model, data);
+    const int n = model.rod.elements;
+    std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
+    for (int k = 0; k <= n; ++k) {
+      const double along = k * model.rod.segment_m;
+      x[std::size_t(k)] = Eigen::Vector3d(along, 0.0, r1 + 0.4e-3 + rise_m * along / l);
+    }
+    data.input.p_hand_W = x[0] + Eigen::Vector3d(0.0, 0.0, -0.2e-3);
+    core::FindContacts(model, x, data, core::Choices::kKeep);
+    core::Assemble(model, data, x, core::Derivatives::kHessian);
+    const core::Scratch& sc = data.scratch;
+    INFO("rise " << rise_m << " m: " << sc.low_rank_count << " rank-one terms");
+    CHECK(sc.low_rank_count == (rise_m == 0.0 ? 1 : 0));
+    const core::BandMatrix band = sc.hessian;
+    std::vector<Eigen::VectorXd> u;
+    std::vector<double> c;
+    for (int i = 0; i < sc.low_rank_count; ++i) {
+      u.push_back(sc.low_rank_u[std::size_t(i)]);
+      c.push_back(sc.low_rank_c[std::size_t(i)]);
+    }
+    const auto gradient_at = [&](const Eigen::VectorXd& step) {
+      std::vector<Eigen::Vector3d> y = x;
+      for (int k = 0; k <= n; ++k) y[std::size_t(k)] += step.segment<3>(3 * k);
+      core::FindContacts(model, y, data, core::Choices::kPending);
+      core::Assemble(model, data, y, core::Derivatives::kGradient);
+      return Eigen::VectorXd(data.scratch.gradient);
+    };
+    for (int trial = 0; trial < 6; ++trial) {
+      Eigen::VectorXd v(3 * (n + 1));
+      for (int i = 0; i < v.size(); ++i) v[i] = u01(rng) - 0.5;
+      Eigen::VectorXd Hv(v.size());
+      band.Multiply(v, Hv);
+      for (std::size_t i = 0; i < u.size(); ++i) Hv += c[i] * u[i].dot(v) * u[i];
+      // A step far inside the smooth minimum's width (kRimSoftness eps = 0.2 um), where its
+      // weights change smoothly; the gradient's rounding (1e-16 of ~1 N over 2e-11 m) is ~1e-5
+      // of H v's ~F / tau.
+      const double h = 1e-11;
+      const Eigen::VectorXd fd = (gradient_at(h * v) - gradient_at(-h * v)) / (2.0 * h);
+      const double scale = Hv.lpNorm<Eigen::Infinity>();
+      INFO("trial " << trial);
+      CHECK((Hv - fd).lpNorm<Eigen::Infinity>() < 1e-4 * scale);
+    }
+  }
 }

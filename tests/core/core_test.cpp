@@ -141,6 +141,42 @@ TEST_CASE("A frictionless wall facing the end: K (eps - d) in series with the co
   }
 }
 
+TEST_CASE(
+    "A side lying along a frictionless floor is one contact of stiffness K, whatever the elements",
+    "[core]") {
+  // A short solid steel rod (l = 50 mm, r1 = 3 mm) held level, within epsilon of a floor, pushed
+  // down: it moves as a rigid body (a floor of stiffness K spread along it bends it by
+  // k l^4 / EI = 0.1 of its give, at most 1/8 of that at the grip: under 0.2 % of the force), so
+  // every section presses alike. Its side's sections are one contact of stiffness K, and its
+  // end's rim, level on the floor too, another: 2K in series with the coupling, at any element
+  // count. Taken per section, the floor would be N + 1 K stiff.
+  scene::Scene s = SteelScene();
+  s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
+  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  const double K = s.contact.stiffness_N_per_m, Kc = 2000.0;
+  s.device.coupling_stiffness_N_per_m = Kc;
+  s.X_WH_start = Held({0.0, 0.0, r1 + 0.5e-3}, Eigen::Vector3d::UnitX());
+  s.parts.push_back(Box("floor", {0.2, 0.1, 0.02}, {0.0, 0.0, -0.01}));
+  for (const int elements : {4, 8, 16}) {
+    s.model.elements = elements;
+    core::Core c(s);
+    double t = 0.0;
+    for (const double push_m : {1e-3, 3e-3}) {
+      Eigen::Isometry3d X = s.X_WH_start;
+      X.translation().z() -= push_m;
+      const core::StepOutput& out = MoveTo(c, X, 200, 200, t);
+      INFO(elements << " elements, push " << push_m << " m: " << c.FormationText());
+      REQUIRE(out.contact_count == 1);
+      CHECK(out.contacts[0].tube == states::TubeElement::kSide);
+      CHECK(out.contacts[0].marker == states::Marker::kNone);
+      // Springs in series from the hand to the floor's epsilon surface, 0.5 mm above the side.
+      const double expected = (push_m - (0.5e-3 - eps)) / (1.0 / Kc + 1.0 / (2.0 * K));
+      CHECK(out.force_W_N.z() == Approx(expected).epsilon(2e-3));
+      CHECK(out.contacts[0].normal_force_N == Approx(expected).epsilon(2e-3));
+    }
+  }
+}
+
 TEST_CASE("A frictionless side wall at the tip: 3EI/l^3 in series, a small-deflection cantilever",
           "[core]") {
   // The steel tube along +z and a wall beside its tip, turned 3 deg so that it leans away from
