@@ -169,6 +169,169 @@ int RunHostCheck(const LiveOptions& o, Streams io) {
   return kExitOk;
 }
 
+// Refuses a coupling stiffer than the device renders stably (docs/scene-format.md, "Device").
+bool CouplingFits(const core::Core& core, const device::HapticDevice& dev,
+                  const std::string& plan_path, std::ostream& err) {
+  if (core.coupling_stiffness_N_per_m() <= dev.spec().max_stiffness_N_per_m) return true;
+  err << plan_path << ": error: the scene's coupling stiffness "
+      << core.coupling_stiffness_N_per_m() << " N/m is more than " << dev.spec().name
+      << " renders stably (" << dev.spec().max_stiffness_N_per_m
+      << " N/m), expected a softer device.coupling_stiffness\n";
+  return false;
+}
+
+// What the servo and the judge did over a run.
+struct Served {
+  device::ServoStats stats;
+  double t_last_s = 0.0;  ///< the last judged tick's trajectory time
+  long recorded = 0;      ///< rows written to the recording
+  std::string record_error;
+};
+
+// Runs the servo on its thread and, on this one, judges and records every tick it hands over
+// and redraws the display, until the servo stops.
+Served Serve(device::ServoLoop& servo, device::SpscRing<device::TickRecord>& ring,
+             device::Seqlock<device::ServoStatus>& status, plan::Judging& judging,
+             const std::vector<scene::PartElement>& elements, io::StreamingTextFile* recording,
+             Display* display) {
+  Served served;
+  std::atomic<bool> done{false};
+  std::thread servo_thread([&] {
+    served.stats = servo.Run();
+    done.store(true, std::memory_order_release);
+  });
+  std::string row;
+  device::TickRecord record;
+  using Clock = std::chrono::steady_clock;
+  auto next_draw = Clock::now(), next_flush = Clock::now(), next_line = Clock::now();
+  std::string last_counted;
+  auto drain = [&] {
+    bool any = false;
+    while (ring.TryPop(record)) {
+      any = true;
+      if (!record.stepped) continue;
+      judging.Tick(record.hand.t_s, record.out,
+                   [&] { return FormationText(record.out, elements); });
+      served.t_last_s = record.hand.t_s;
+      if (recording == nullptr) continue;
+      row.clear();
+      // The stall's lateness to 0.01 ms, "0" on a tick that woke in time.
+      char stall[24] = "0";
+      if (record.stalled) std::snprintf(stall, sizeof stall, "%.2f", double(record.stall_ms));
+      io::AppendTrajectoryCsvRow(row, record.hand, stall);
+      recording->Append(row);
+      ++served.recorded;
+    }
+    return any;
+  };
+  for (;;) {
+    const bool finished = done.load(std::memory_order_acquire);
+    const bool any = drain();
+    const auto now = Clock::now();
+    if (display != nullptr && now >= next_draw) {
+      if (const std::optional<device::ServoStatus> st = status.Load()) {
+        // Plain output: a line a second and one whenever a new state counts.
+        const bool line = now >= next_line || judging.counted() != last_counted;
+        display->Draw(judging, *st, line);
+        if (line) next_line = now + std::chrono::seconds(1);
+        last_counted = judging.counted();
+      }
+      next_draw = now + std::chrono::milliseconds(33);  // ~30 Hz
+    }
+    if (recording != nullptr && now >= next_flush) {
+      if (std::string e = recording->Flush(); !e.empty() && served.record_error.empty())
+        served.record_error = e;
+      next_flush = now + std::chrono::milliseconds(100);
+    }
+    if (finished && !any) break;
+    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  servo_thread.join();
+  drain();
+  return served;
+}
+
+// "interrupted at t = 2.310 s" or "<fault> at t = ...", when a signal or a fault ended the run
+// before its trajectory did; empty otherwise.
+std::string StoppedEarly(const device::ServoStats& stats, double t_last_s) {
+  if (stats.stop != device::StopReason::kSignal && !device::IsFault(stats.stop)) return {};
+  char when[48];
+  std::snprintf(when, sizeof when, " at t = %.3f s", t_last_s);
+  return (stats.stop == device::StopReason::kSignal ? std::string("interrupted")
+                                                    : device::ToString(stats.stop)) +
+         when;
+}
+
+// evaluate's report of the run's one plan, with the servo's figures.
+nlohmann::json LiveReport(const Evaluated& e, const device::ServoStats& stats,
+                          const std::string& device_name, bool stepped) {
+  // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
+  ReportScope scope;
+  scope.plan_set_id = batch::PlanSetId({batch::CanonicalPlanPath(e.file)});
+  scope.plan_set_plans = 1;
+  nlohmann::json report = batch::ToJson({e}, scope);
+  report["servo"] = {{"ticks", stats.ticks},
+                     {"overruns", stats.overruns},
+                     {"median_us", stats.median_us},
+                     {"p999_us", stats.p999_us},
+                     {"max_us", stats.max_us},
+                     {"rate_hz", stats.rate_hz},
+                     {"max_latency_us", stats.max_latency_us},
+                     {"max_jitter_us", stats.max_jitter_us},
+                     {"dropped", stats.dropped},
+                     {"stalls", stats.stalls},
+                     {"ticks_lost", stats.ticks_lost},
+                     {"longest_stall_ms", stats.longest_stall_ms},
+                     {"stop", device::ToString(stats.stop)},
+                     {"realtime", stats.realtime_note.empty()},
+                     {"device", device_name},
+                     {"clock", stepped ? "stepped" : "monotonic"}};
+  return report;
+}
+
+// The run's verdicts and the servo's figures as text.
+void PrintLiveText(std::ostream& out, const Evaluated& e, const device::ServoStats& stats,
+                   bool stepped, bool colour, const std::string& recording_written) {
+  std::ostringstream t;
+  PrintVerdicts(t, e, colour);
+  t << std::fixed << std::setprecision(1) << "servo: " << stats.ticks << " ticks at "
+    << stats.rate_hz << " Hz (" << (stepped ? "stepped clock" : "real time") << "), "
+    << stats.overruns << " overruns; tick median " << stats.median_us << " us, p99.9 "
+    << stats.p999_us << " us, worst " << stats.max_us
+    << " us; ended: " << device::ToString(stats.stop) << "\n";
+  if (stats.stalls > 0)
+    t << "servo: " << stats.stalls << (stats.stalls == 1 ? " stall" : " stalls")
+      << " (the loop woke more than a tick late; first at t = " << stats.first_stall_s
+      << " s, longest " << stats.longest_stall_ms << " ms, " << stats.ticks_lost
+      << " periods lost): the force went to zero and ramped back in over 10 ms each time\n";
+  if (!recording_written.empty()) t << "recording written to " << recording_written << "\n";
+  out << t.str();
+}
+
+// The exit code of a run, saying on `err` why a signal or a fault ended it.
+int LiveExitCode(const Served& served, const device::ServoConfig& config,
+                 const std::string& stopped_early, bool feasible, std::ostream& err) {
+  const device::ServoStats& stats = served.stats;
+  if (stats.stop == device::StopReason::kSignal) {
+    err << "tubeplan live: " << stopped_early
+        << "; the force was zeroed; the transitions the run did not finish are not judged\n";
+    return kExitInterrupted;
+  }
+  if (device::IsFault(stats.stop)) {
+    err << "tubeplan live: error: the servo stopped on a fault (" << device::ToString(stats.stop)
+        << (stats.stop == device::StopReason::kMissedDeadlines
+                ? ": a stall longer than " + std::to_string(std::lround(config.max_stall_s * 1e3)) +
+                      " ms or more than " + std::to_string(config.max_stalls_per_s) +
+                      " in a second; docs/live.md says what helps"
+                : std::string())
+        << ") " << stopped_early.substr(stopped_early.find(" at t"))
+        << "; the force was zeroed; the transitions the run did not finish are not judged\n";
+    return stats.stop == device::StopReason::kNonFinite ? kExitInternal : kExitDeviceFault;
+  }
+  if (stats.dropped > 0 || !served.record_error.empty()) return kExitInternal;
+  return feasible ? kExitOk : kExitNegative;
+}
+
 int RunLive(const LiveOptions& o, Streams io) {
   io::PlanLoadResult loaded = io::LoadPlanFile(o.plan);
   io.err << loaded.diagnostics.FormatAll();
@@ -206,45 +369,26 @@ int RunLive(const LiveOptions& o, Streams io) {
     clock = std::make_unique<device::SteppedClock>();
   else
     clock = std::make_unique<device::MonotonicClock>();
-  std::unique_ptr<device::HapticDevice> dev;
-  device::EmulatorDevice* emulator = nullptr;
-  device::OpenIGTLinkDevice* igtl = nullptr;
-  switch (choice.kind) {
-    case device::DeviceChoice::Kind::kEmulator:
-      dev = std::make_unique<device::EmulatorDevice>(*clock, target, args.hand);
-      emulator = static_cast<device::EmulatorDevice*>(dev.get());
-      break;
-    case device::DeviceChoice::Kind::kOpenIGTLink:
-      dev = std::make_unique<device::OpenIGTLinkDevice>(choice.igtl);
-      igtl = static_cast<device::OpenIGTLinkDevice*>(dev.get());
-      break;
-    case device::DeviceChoice::Kind::kOpenHaptics:
-      dev = device::MakeOpenHapticsDevice(choice.openhaptics_name, error);
-      if (!dev) {
-        io.err << "tubeplan live: error: --device \"" << o.device << "\": " << error << "\n";
-        return kExitBadInput;
-      }
-      break;
+  const std::unique_ptr<device::HapticDevice> dev =
+      device::MakeDevice(choice, *clock, target, error);
+  if (!dev) {
+    io.err << "tubeplan live: error: --device \"" << o.device << "\": " << error << "\n";
+    return kExitBadInput;
   }
+  auto* emulator = emulated ? static_cast<device::EmulatorDevice*>(dev.get()) : nullptr;
+  auto* igtl = choice.kind == device::DeviceChoice::Kind::kOpenIGTLink
+                   ? static_cast<device::OpenIGTLinkDevice*>(dev.get())
+                   : nullptr;
   core::Core core(scene);
-  // The coupling must be stable on this device (docs/scene-format.md, "Device"): refuse a stiffer
-  // one. A device that reports its limits at Open (openhaptics) is checked again after it.
-  auto too_stiff = [&] {
-    if (core.coupling_stiffness_N_per_m() <= dev->spec().max_stiffness_N_per_m) return false;
-    io.err << o.plan << ": error: the scene's coupling stiffness "
-           << core.coupling_stiffness_N_per_m() << " N/m is more than " << dev->spec().name
-           << " renders stably (" << dev->spec().max_stiffness_N_per_m
-           << " N/m), expected a softer device.coupling_stiffness\n";
-    return true;
-  };
-  if (choice.kind != device::DeviceChoice::Kind::kOpenHaptics && too_stiff()) return kExitBadInput;
+  // A device that reports its limits at Open (openhaptics) is checked after it.
+  const bool limits_at_open = choice.kind == device::DeviceChoice::Kind::kOpenHaptics;
+  if (!limits_at_open && !CouplingFits(core, *dev, o.plan, io.err)) return kExitBadInput;
   // The emulator's trajectory, then 0.5 s for the last state to settle and count (many
   // dwells); a real device runs until --duration or Ctrl-C.
   const double duration_s = o.duration_s > 0.0 ? o.duration_s
                             : emulator         ? emulator->target_duration_s() + 0.5
                                                : 0.0;
   const long ticks = duration_s > 0.0 ? std::lround(duration_s / T) + 1 : 0;
-
   if (std::string e = dev->Open(); !e.empty()) {
     io.err << "tubeplan live: error: cannot open the device: " << e << "\n";
     return kExitBadInput;
@@ -253,7 +397,7 @@ int RunLive(const LiveOptions& o, Streams io) {
     io.err << "tubeplan live: error: cannot calibrate the device: " << e << "\n";
     return kExitBadInput;
   }
-  if (choice.kind == device::DeviceChoice::Kind::kOpenHaptics && too_stiff()) return kExitBadInput;
+  if (limits_at_open && !CouplingFits(core, *dev, o.plan, io.err)) return kExitBadInput;
   io::StreamingTextFile recording;
   if (!o.record.empty()) {
     if (const std::string e = recording.Open(o.record); !e.empty()) {
@@ -278,72 +422,15 @@ int RunLive(const LiveOptions& o, Streams io) {
   device::ServoLoop servo(core, *dev, *clock, device::LimitsFor(dev->spec(), scene.device), config,
                           &ring, &status);
   plan::Judging judging(plan.states, plan.limits, T, scene.tube);
-  const std::vector<scene::PartElement>& elements = core.elements();
-
   const bool stdout_terminal = isatty(STDOUT_FILENO) != 0;
   // With --json stdout carries the report alone: the display goes to stderr on a terminal.
   const bool show = o.json ? isatty(STDERR_FILENO) != 0 : true;
   Display display(o.json ? io.err : io.out, o.json ? true : stdout_terminal,
                   std::min(plan.limits.max_force_N, dev->spec().max_force_N));
-
   device::ScopedStopSignals signals;
-  device::ServoStats stats;
-  std::atomic<bool> done{false};
-  std::thread servo_thread([&] {
-    stats = servo.Run();
-    done.store(true, std::memory_order_release);
-  });
-
-  std::string row, record_error;
-  device::TickRecord record;
-  long recorded = 0;
-  double t_last_s = 0.0;  // the last judged tick's trajectory time
-  using Clock = std::chrono::steady_clock;
-  auto next_draw = Clock::now(), next_flush = Clock::now(), next_line = Clock::now();
-  std::string last_counted;
-  auto drain = [&] {
-    bool any = false;
-    while (ring.TryPop(record)) {
-      any = true;
-      if (!record.stepped) continue;
-      judging.Tick(record.hand.t_s, record.out,
-                   [&] { return FormationText(record.out, elements); });
-      t_last_s = record.hand.t_s;
-      if (!o.record.empty()) {
-        row.clear();
-        // The stall's lateness to 0.01 ms, "0" on a tick that woke in time.
-        char stall[24] = "0";
-        if (record.stalled) std::snprintf(stall, sizeof stall, "%.2f", double(record.stall_ms));
-        io::AppendTrajectoryCsvRow(row, record.hand, stall);
-        recording.Append(row);
-        ++recorded;
-      }
-    }
-    return any;
-  };
-  for (;;) {
-    const bool finished = done.load(std::memory_order_acquire);
-    const bool any = drain();
-    const auto now = Clock::now();
-    if (show && now >= next_draw) {
-      if (const std::optional<device::ServoStatus> s = status.Load()) {
-        // Plain output: a line a second and one whenever a new state counts.
-        const bool line = now >= next_line || judging.counted() != last_counted;
-        display.Draw(judging, *s, line);
-        if (line) next_line = now + std::chrono::seconds(1);
-        last_counted = judging.counted();
-      }
-      next_draw = now + std::chrono::milliseconds(33);  // ~30 Hz
-    }
-    if (!o.record.empty() && now >= next_flush) {
-      if (std::string e = recording.Flush(); !e.empty() && record_error.empty()) record_error = e;
-      next_flush = now + std::chrono::milliseconds(100);
-    }
-    if (finished && !any) break;
-    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-  }
-  servo_thread.join();
-  drain();
+  Served served = Serve(servo, ring, status, judging, core.elements(),
+                        o.record.empty() ? nullptr : &recording, show ? &display : nullptr);
+  const device::ServoStats& stats = served.stats;
   dev->Close();
   if (igtl) {
     const device::OpenIGTLinkCounters c = igtl->counters();
@@ -352,7 +439,6 @@ int RunLive(const LiveOptions& o, Streams io) {
     if (const std::string e = igtl->link_error(); !e.empty()) io.err << "; the link failed: " << e;
     io.err << "\n";
   }
-
   if (!stats.realtime_note.empty())
     io.err << "tubeplan live: note: " << stats.realtime_note << "\n";
   if (stats.dropped > 0)
@@ -365,16 +451,10 @@ int RunLive(const LiveOptions& o, Streams io) {
   }
   // A fault or a signal ends the run before the trajectory does: what it cut short is not judged,
   // in this report and in evaluate's of the recording.
-  std::string stopped_early;
-  if (stats.stop == device::StopReason::kSignal || device::IsFault(stats.stop)) {
-    char when[48];
-    std::snprintf(when, sizeof when, " at t = %.3f s", t_last_s);
-    stopped_early = (stats.stop == device::StopReason::kSignal ? std::string("interrupted")
-                                                               : device::ToString(stats.stop)) +
-                    when;
-  }
+  const std::string stopped_early = StoppedEarly(stats, served.t_last_s);
   if (!o.record.empty()) {
-    if (recorded < 2) record_error = "fewer than two ticks recorded";
+    std::string& record_error = served.record_error;
+    if (served.recorded < 2) record_error = "fewer than two ticks recorded";
     if (!stopped_early.empty()) recording.Append(io::TrajectoryCsvStopped(stopped_early));
     if (record_error.empty()) record_error = recording.Commit();
     if (!record_error.empty()) io.err << o.record << ": error: " << record_error << "\n";
@@ -385,64 +465,12 @@ int RunLive(const LiveOptions& o, Streams io) {
   e.plan = plan;
   e.judgement = judging.Finish(stopped_early);
   e.replayed_s = e.judgement.replayed_s;
-  // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
-  ReportScope scope;
-  scope.plan_set_id = batch::PlanSetId({batch::CanonicalPlanPath(o.plan)});
-  scope.plan_set_plans = 1;
-  nlohmann::json report = batch::ToJson({e}, scope);
-  report["servo"] = {{"ticks", stats.ticks},
-                     {"overruns", stats.overruns},
-                     {"median_us", stats.median_us},
-                     {"p999_us", stats.p999_us},
-                     {"max_us", stats.max_us},
-                     {"rate_hz", stats.rate_hz},
-                     {"max_latency_us", stats.max_latency_us},
-                     {"max_jitter_us", stats.max_jitter_us},
-                     {"dropped", stats.dropped},
-                     {"stalls", stats.stalls},
-                     {"ticks_lost", stats.ticks_lost},
-                     {"longest_stall_ms", stats.longest_stall_ms},
-                     {"stop", device::ToString(stats.stop)},
-                     {"realtime", stats.realtime_note.empty()},
-                     {"device", dev->spec().name},
-                     {"clock", stepped ? "stepped" : "monotonic"}};
-  if (o.json) {
-    io.out << report.dump(2) << "\n";
-  } else {
-    std::ostringstream t;
-    PrintVerdicts(t, e, stdout_terminal);
-    t << std::fixed << std::setprecision(1) << "servo: " << stats.ticks << " ticks at "
-      << stats.rate_hz << " Hz (" << (stepped ? "stepped clock" : "real time") << "), "
-      << stats.overruns << " overruns; tick median " << stats.median_us << " us, p99.9 "
-      << stats.p999_us << " us, worst " << stats.max_us
-      << " us; ended: " << device::ToString(stats.stop) << "\n";
-    if (stats.stalls > 0)
-      t << "servo: " << stats.stalls << (stats.stalls == 1 ? " stall" : " stalls")
-        << " (the loop woke more than a tick late; first at t = " << stats.first_stall_s
-        << " s, longest " << stats.longest_stall_ms << " ms, " << stats.ticks_lost
-        << " periods lost): the force went to zero and ramped back in over 10 ms each time\n";
-    if (!o.record.empty() && record_error.empty()) t << "recording written to " << o.record << "\n";
-    io.out << t.str();
-  }
-  if (stats.stop == device::StopReason::kSignal) {
-    io.err << "tubeplan live: " << stopped_early
-           << "; the force was zeroed; the transitions the run did not finish are not judged\n";
-    return kExitInterrupted;
-  }
-  if (device::IsFault(stats.stop)) {
-    io.err << "tubeplan live: error: the servo stopped on a fault (" << device::ToString(stats.stop)
-           << (stats.stop == device::StopReason::kMissedDeadlines
-                   ? ": a stall longer than " +
-                         std::to_string(std::lround(config.max_stall_s * 1e3)) +
-                         " ms or more than " + std::to_string(config.max_stalls_per_s) +
-                         " in a second; docs/live.md says what helps"
-                   : std::string())
-           << ") " << stopped_early.substr(stopped_early.find(" at t"))
-           << "; the force was zeroed; the transitions the run did not finish are not judged\n";
-    return stats.stop == device::StopReason::kNonFinite ? kExitInternal : kExitDeviceFault;
-  }
-  if (stats.dropped > 0 || !record_error.empty()) return kExitInternal;
-  return e.judgement.feasible ? kExitOk : kExitNegative;
+  if (o.json)
+    io.out << LiveReport(e, stats, dev->spec().name, stepped).dump(2) << "\n";
+  else
+    PrintLiveText(io.out, e, stats, stepped, stdout_terminal,
+                  !o.record.empty() && served.record_error.empty() ? o.record : std::string());
+  return LiveExitCode(served, config, stopped_early, e.judgement.feasible, io.err);
 }
 
 }  // namespace

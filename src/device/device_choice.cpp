@@ -1,6 +1,7 @@
 #include <cstdlib>
 
 #include <tubeplan/device/device_choice.hpp>
+#include <tubeplan/device/openhaptics.hpp>
 #include <tubeplan/io/units.hpp>
 
 namespace tubeplan::device {
@@ -137,6 +138,19 @@ bool ParseDeviceChoice(const std::string& text, DeviceChoice& choice, std::strin
   error = "--device \"" + text + "\": unknown device kind \"" + kind +
           "\", expected emulator[:ARGS], openigtlink://HOST:PORT[,ARGS] or openhaptics[:NAME]";
   return false;
+}
+
+std::unique_ptr<HapticDevice> MakeDevice(const DeviceChoice& choice, Clock& clock,
+                                         const plan::Trajectory& target, std::string& error) {
+  switch (choice.kind) {
+    case DeviceChoice::Kind::kEmulator:
+      return std::make_unique<EmulatorDevice>(clock, target, choice.emulator.hand);
+    case DeviceChoice::Kind::kOpenIGTLink:
+      return std::make_unique<OpenIGTLinkDevice>(choice.igtl);
+    case DeviceChoice::Kind::kOpenHaptics:
+      break;
+  }
+  return MakeOpenHapticsDevice(choice.openhaptics_name, error);
 }
 
 }  // namespace tubeplan::device

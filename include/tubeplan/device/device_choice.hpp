@@ -3,8 +3,10 @@
 // trajectory, clock and hand model, a bridge over OpenIGTLink with its address, windows and
 // limits, or OpenHaptics with a device name; every argument with a unit checked.
 
+#include <memory>
 #include <string>
 
+#include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/emulator.hpp>
 #include <tubeplan/device/openigtlink.hpp>
 
@@ -29,5 +31,11 @@ struct DeviceChoice {
 /// `openigtlink://HOST:PORT[,timeout=T][,stale=T][,max_force=F]...`, `openhaptics[:NAME]`) into
 /// `choice`; false with `error` naming the argument and what was expected when it is not one.
 bool ParseDeviceChoice(const std::string& text, DeviceChoice& choice, std::string& error);
+
+/// The device `choice` names, not yet opened: the emulator following `target` on `clock`, a
+/// bridge over OpenIGTLink, or OpenHaptics; null with `error` when it cannot be made (OpenHaptics
+/// not built in, or its device not found).
+std::unique_ptr<HapticDevice> MakeDevice(const DeviceChoice& choice, Clock& clock,
+                                         const plan::Trajectory& target, std::string& error);
 
 }  // namespace tubeplan::device
