@@ -442,6 +442,38 @@ TEST_CASE("A flat end pushed along a wall slides at the kinetic ratio at a fine 
   CHECK(std::abs(out.force_W_N.x()) / std::abs(out.force_W_N.z()) == Approx(0.3).epsilon(0.02));
 }
 
+TEST_CASE("A side lying along a floor slides along it at the kinetic ratio", "[core]") {
+  // The short steel rod of the line-contact case pressed about 1 N flat on a floor with friction
+  // (mu_s = mu_k = 0.3, beta = 1), then the hand moves 20 mm along the rod's axis at 20 mm/s:
+  // the side sticks, then slides, and sliding, the floor's force along it is mu_k times the
+  // force across, however the contact's force is spread over its sections.
+  scene::Scene s = SteelScene();
+  s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
+  s.friction = scene::Friction{0.3, 0.3, 1.0, 1.0};
+  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  const double K = s.contact.stiffness_N_per_m;
+  s.X_WH_start = Held({0.0, 0.0, r1 + 0.5e-3}, Eigen::Vector3d::UnitX());
+  s.parts.push_back(Box("floor", {0.3, 0.1, 0.02}, {0.05, 0.0, -0.01}));
+  core::Core c(s);
+  double t = 0.0;
+  // About 1 N across: the side's contact and the rim's, 2K, in series with the coupling.
+  Eigen::Isometry3d X = s.X_WH_start;
+  X.translation().z() -= (0.5e-3 - eps) + 1.0 * (1.0 / 400.0 + 1.0 / (2.0 * K));
+  MoveTo(c, X, 500, 200, t);
+  REQUIRE(c.last().contact_count == 1);
+  CHECK(c.last().force_W_N.z() == Approx(1.0).epsilon(0.02));
+  Eigen::Isometry3d along = X;
+  along.translation().x() += 0.02;
+  const core::StepOutput& out = MoveTo(c, along, 1000, 0, t);
+  REQUIRE(out.contact_count == 1);
+  CHECK(out.contacts[0].sliding);
+  std::array<Eigen::Vector3d, 2> ends;
+  c.Centreline(ends);
+  CHECK(ends[0].x() > 0.01);
+  // Sliding at 20 mm/s: the anchors lag one tick, 20 um, against a 20 mm path.
+  CHECK(std::abs(out.force_W_N.x()) / std::abs(out.force_W_N.z()) == Approx(0.3).epsilon(0.02));
+}
+
 TEST_CASE("A stiff tube jammed over a part's end at the device's force converges", "[core]") {
   // The steel tube tipped 15 deg down, its hand driven so low that its end passes a floor's end
   // and dips below the floor's top, the coupling at the device's force. The last element's side
