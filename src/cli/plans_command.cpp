@@ -1,0 +1,241 @@
+// `tubeplan plans SCENE [--k N] [--out-dir DIR] [--all] [--speed V] [--tremor A] [--quantum Q]`
+// and the exploration's options: the k best start -> goal paths of the pruned contact-state
+// graph, each with a minimum-jerk hand trajectory through its witnesses, replayed as `evaluate`
+// would; the feasible ones written as plan files.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <iomanip>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <thread>
+#include <tuple>
+#include <unistd.h>
+#include <variant>
+
+#include <nlohmann/json.hpp>
+
+#include <tubeplan/cli/app.hpp>
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/graph/completeness.hpp>
+#include <tubeplan/graph/dot.hpp>
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/motion.hpp>
+#include <tubeplan/graph/paths.hpp>
+#include <tubeplan/graph/verdicts.hpp>
+#include <tubeplan/io/plan_file.hpp>
+#include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/io/text_file.hpp>
+#include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/plan/candidates.hpp>
+
+#include "commands.hpp"
+#include "graph_build.hpp"
+#include "graph_json.hpp"
+#include "graphviz.hpp"
+
+namespace tubeplan::cli {
+namespace {
+
+struct PlansOptions {
+  GraphOptions graph;
+  int k = 3;
+  bool all = false;
+  std::string out_dir;
+  std::string tremor = "0";
+  std::string quantum = "0";
+  std::string speed = "80 mm/s";
+};
+
+// Why a replay was judged infeasible: its first infeasible transition and the reason.
+int RunPlans(const PlansOptions& o, Streams io) {
+  // Quantities first: a typo should not cost an exploration.
+  double tremor_m = 0.0, quantum_m = 0.0, speed_m_per_s = 0.0;
+  for (auto [option, text, dimension, target] :
+       {std::tuple{"--tremor", &o.tremor, io::dim::kLength, &tremor_m},
+        std::tuple{"--quantum", &o.quantum, io::dim::kLength, &quantum_m},
+        std::tuple{"--speed", &o.speed, io::dim::kVelocity, &speed_m_per_s}}) {
+    std::string error;
+    const auto values = ParseQuantityList(option, *text, 1, 1, dimension, error);
+    if (!values) {
+      io.err << "tubeplan plans: error: " << error << "\n";
+      return kExitBadInput;
+    }
+    *target = values->front();
+  }
+  if (tremor_m < 0.0 || tremor_m > 0.005 || quantum_m < 0.0 || quantum_m > 0.005 ||
+      !(speed_m_per_s > 0.0 && speed_m_per_s <= 1.0)) {
+    io.err << "tubeplan plans: error: expected --tremor and --quantum between 0 and 5 mm and "
+              "--speed above 0 and at most 1 m/s\n";
+    return kExitBadInput;
+  }
+  // The files it may write, named before the exploration: none may be the scene it reads.
+  namespace fs = std::filesystem;
+  if (const io::SceneLoadResult scene = io::LoadSceneFile(o.graph.scene_path); scene.scene) {
+    const fs::path dir =
+        o.out_dir.empty() ? fs::path(scene.scene->name + "-plans") : fs::path(o.out_dir);
+    std::vector<io::RolePath> outputs;
+    for (int i = 1; i <= o.k; ++i) {
+      const std::string name = scene.scene->name + "-candidate-" + std::to_string(i);
+      outputs.push_back({"the plan file", dir / (name + ".yaml")});
+      outputs.push_back({"the plan's trajectory", dir / (name + ".csv")});
+    }
+    if (!OutputsApart("plans", outputs, {{"the scene", o.graph.scene_path}}, io.err))
+      return kExitBadInput;
+  }
+  // A goal the tube starts in leaves nothing to plan: said before any exploration.
+  const auto nothing_to_plan = [&](const scene::Scene& s, const std::string& start) {
+    io.err << o.graph.scene_path << ": nothing to plan: the goal " << states::ToString(s.goal)
+           << " is the state the tube starts in (" << start
+           << " at the scene's start pose), so a plan would be that one state and no move; no "
+              "plan written. Give the scene a goal the tube has to be moved to\n";
+    return kExitNegative;
+  };
+  std::variant<Built, int> built =
+      BuildGraph(o.graph, io, [&](const scene::Scene& s) -> std::optional<int> {
+        core::Core core(s);
+        core.Reset(graph::MotionStart(s));
+        core.Step(s.model.time_step_s, graph::MotionStart(s));
+        const std::string start = core.FormationText();
+        if (start != states::ToString(s.goal)) return std::nullopt;
+        return nothing_to_plan(s, start);
+      });
+  if (const int* code = std::get_if<int>(&built)) return *code;
+  const Built& b = std::get<Built>(built);
+  const graph::ContactGraph& g = b.graph;
+  // The explorer's start state can differ from a tick at rest (its first tick moves the hand).
+  if (g.goal >= 0 && g.goal == g.start)
+    return nothing_to_plan(b.scene, g.nodes[std::size_t(g.start)].cf);
+  if (g.goal < 0) {
+    io.err << o.graph.scene_path << ": error: exploration never reached the goal "
+           << states::ToString(b.scene.goal) << ", so there is no plan to extract; expected a "
+           << "goal the tube can reach (try a larger --budget)\n";
+    return kExitNegative;
+  }
+  const std::vector<graph::Path> paths =
+      graph::KShortestPaths(g, graph::ArcCosts(g, b.weights), o.k);
+
+  const fs::path out_dir =
+      o.out_dir.empty() ? fs::path(b.scene.name + "-plans") : fs::path(o.out_dir);
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (ec) {
+    io.err << out_dir.string() << ": error: cannot create the directory (" << ec.message()
+           << "), expected a writable place for the plans\n";
+    return kExitBadInput;
+  }
+  const std::string scene_rel =
+      fs::relative(fs::absolute(o.graph.scene_path), fs::absolute(out_dir), ec).generic_string();
+  plan::CandidateOptions candidate_options;
+  candidate_options.synthesis.peak_speed_m_per_s = speed_m_per_s;
+  candidate_options.synthesis.tremor_m = tremor_m;
+  candidate_options.synthesis.quantum_m = quantum_m;
+  candidate_options.synthesis.seed = o.graph.seed;
+  candidate_options.dwell_s = b.explore.dwell_s;
+  candidate_options.scene_ref = scene_rel;
+  // Each replayed as its file will read: what `evaluate` on the written plan sees.
+  std::vector<plan::Candidate> candidates =
+      plan::MakeCandidates(b.scene, g, paths, candidate_options,
+                           [](const plan::Trajectory& t) -> std::optional<plan::Trajectory> {
+                             io::TrajectoryLoadResult read =
+                                 io::LoadTrajectoryText(io::FormatTrajectoryCsv(t), "candidate");
+                             return std::move(read.trajectory);
+                           });
+  const auto feasible =
+      std::count_if(candidates.begin(), candidates.end(),
+                    [](const plan::Candidate& c) { return c.judgement.feasible; });
+
+  std::ostringstream t;
+  t << std::setprecision(3);
+  t << paths.size() << " candidate plan" << (paths.size() == 1 ? "" : "s") << " (of " << o.k
+    << " asked) through the pruned graph of " << b.scene.name << " (" << g.nodes.size() << " CFs, "
+    << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
+    << " kept arcs), each replayed as `evaluate` would: " << feasible << " feasible"
+    << (o.all || feasible == 0 || feasible == long(candidates.size())
+            ? ""
+            : " (the others are not written; --all writes them, marked)")
+    << "; written to " << out_dir.string() << ":\n";
+  // Fewer than asked: the pruned graph holds no more loopless paths to the goal.
+  if (static_cast<int>(paths.size()) < o.k)
+    t << "  (the pruned graph has no other loopless path from the start to the goal: a larger "
+         "--tolerance keeps more arcs, a larger --budget explores more states)\n";
+  int written = 0;
+  for (plan::Candidate& c : candidates) {
+    const bool write = c.judgement.feasible || o.all;
+    std::ostringstream verdict_text;
+    verdict_text << std::setprecision(3)
+                 << (c.judgement.feasible ? "feasible"
+                                          : "infeasible: " + plan::FirstFailure(c.judgement));
+    if (c.tries > 1)
+      verdict_text << " (try " << c.tries << ": "
+                   << (c.held ? "the held end's poses" : "the hand's") << " at "
+                   << c.peak_speed_m_per_s * 1e3 << " mm/s)";
+    verdict_text << "; peak operator force " << c.judgement.peak_force_N << " N";
+    const std::string verdict = verdict_text.str();
+    std::string name = "(not written)";
+    if (write) {
+      name = b.scene.name + "-candidate-" + std::to_string(++written);
+      c.plan.name = name;
+      c.plan.trajectory = name + ".csv";
+      std::ostringstream comment;
+      comment << "Candidate " << written << " made by `tubeplan plans " << o.graph.scene_path
+              << "` (seed " << o.graph.seed << "), cost " << c.path->cost
+              << ": the hand moves by minimum jerk through the witnesses of its states. Replayed "
+                 "when made: "
+              << verdict << ".";
+      c.plan.comment = comment.str();
+      for (const auto& [file, text] :
+           {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(c.plan)},
+            std::pair{out_dir / c.plan.trajectory, io::FormatTrajectoryCsv(c.trajectory)}}) {
+        if (const std::string e = io::WriteTextFileAtomically(file, text); !e.empty()) {
+          io.err << file.string() << ": error: " << e << "\n";
+          return kExitBadInput;
+        }
+      }
+    }
+    t << "  " << name << ": cost " << c.path->cost << ", " << c.path->nodes.size() - 1
+      << (c.path->nodes.size() == 2 ? " transition, " : " transitions, ") << c.duration_s << " s:";
+    for (const std::string& state : c.plan.states)
+      t << " " << state << (&state == &c.plan.states.back() ? "" : " ->");
+    t << "; " << verdict << "\n";
+  }
+  if (feasible == 0)
+    t << "  no candidate replays feasible, each also tried at 1/2 and 1/4 of --speed: a larger "
+         "--budget or a larger --tolerance may give one; --all writes them for inspection\n";
+  io.out << t.str();
+  return feasible > 0 ? kExitOk : kExitNegative;
+}
+
+}  // namespace
+
+Command AddPlansCommand(CLI::App& app, Streams streams) {
+  auto options = std::make_shared<PlansOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "plans",
+      "Build and prune the scene's contact-state graph, then take the k best start -> goal paths, "
+      "each with a synthesized (minimum-jerk) operator trajectory, replay each as `evaluate` "
+      "would, and write the feasible ones as plan files.");
+  sub->add_option("scene", options->graph.scene_path, "scene file (.yaml)")->required();
+  sub->add_option("--k", options->k, "how many plans")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  sub->add_option("--out-dir", options->out_dir,
+                  "where to write NAME-candidate-I.yaml and .csv (default: SCENE_NAME-plans)");
+  sub->add_flag("--all", options->all,
+                "also write the candidates whose replay is infeasible (after the feasible ones, "
+                "their comment saying why)");
+  sub->add_option("--speed", options->speed, "peak hand speed, e.g. \"80 mm/s\"")
+      ->capture_default_str();
+  sub->add_option("--tremor", options->tremor,
+                  "amplitude of 8-12 Hz tremor added to the hand, e.g. \"0.1 mm\" (default none)");
+  sub->add_option("--quantum", options->quantum,
+                  "round positions to this device resolution, e.g. \"0.03 mm\" (default none)");
+  AddGraphOptions(sub, options->graph);
+  return {sub, [options, streams] { return RunPlans(*options, streams); }};
+}
+
+}  // namespace tubeplan::cli
