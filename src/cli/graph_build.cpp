@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/graph/completeness.hpp>
@@ -47,8 +48,8 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   std::vector<graph::ReplayedPlan> plans;
   bool ok = text && !report.is_discarded() && report.is_object() &&
             report.value("tubeplan_evaluate", 0) >= 1 &&
-            report.value("tubeplan_evaluate", 0) <= 3 && report.contains("plans") &&
-            report["plans"].is_array();
+            report.value("tubeplan_evaluate", 0) <= batch::kEvaluateJsonVersion &&
+            report.contains("plans") && report["plans"].is_array();
   for (std::size_t i = 0; ok && i < report["plans"].size(); ++i) {
     const nlohmann::json& p = report["plans"][i];
     graph::ReplayedPlan r;
@@ -81,7 +82,8 @@ std::optional<std::vector<graph::ReplayedPlan>> ReadVerdicts(const std::string& 
   if (!ok) {
     err << path
         << ": error: not a readable tubeplan evaluate report, expected the JSON that "
-           "`tubeplan evaluate --report` writes (version 1 or 2)\n";
+           "`tubeplan evaluate --report` writes (version 1 to "
+        << batch::kEvaluateJsonVersion << ")\n";
     return std::nullopt;
   }
   return plans;

@@ -248,3 +248,16 @@ TEST_CASE("check: plans naming missing files, directories and devices", "[cli][l
   }
   std::filesystem::remove_all(Scratch());
 }
+
+TEST_CASE("graph --verdicts: a report it cannot read says which versions it reads",
+          "[cli][limits]") {
+  // A report of a later format: refused before the exploration, naming the versions graph reads
+  // (1 to the version evaluate writes now).
+  const std::string path = Write("later.json", "{\"tubeplan_evaluate\": 99, \"plans\": []}");
+  const Outcome r =
+      RunTool({"graph", SourcePath("scenes/shelf.yaml"), "--verdicts", path, "--budget", "1"});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err == path +
+                     ": error: not a readable tubeplan evaluate report, expected the JSON that "
+                     "`tubeplan evaluate --report` writes (version 1 to 3)\n");
+}
