@@ -64,43 +64,30 @@ void Match(const Model& model, Data& data) {
   }
 }
 
-// The normal force of every contact point's part element (its PC's share rule, friction.hpp).
-double GroupNormal(const Model& model, const Data& data, const Sample& of) {
-  double n = 0.0;
-  for (int k = 0; k < data.scratch.sample_count; ++k) {
-    const Sample& smp = data.scratch.samples[std::size_t(k)];
-    if (smp.part == of.part && smp.face_mask == of.face_mask &&
-        smp.distance_m < model.contact.threshold_m)
-      n += smp.normal_force_N;
-  }
-  return n;
-}
-
 struct Limits {
   double static_N = 0.0, kinetic_N = 0.0;
 };
 
-// A contact point's part of its part element's normal force for friction: its own, or for one of
-// the side's sections that press as one contact (Assemble) the contact's force shared by their
-// depths eps - d. The smooth minimum puts the force on the deepest section, which changes with
-// every small tilt of a side lying flat; shared by depth, the friction limits do not jump.
-double FrictionLoad(const Model& model, const Data& data, const Sample& of) {
-  if (!IsSideSection(of)) return of.normal_force_N;
+// A contact point's friction limits: its share of its part element's limit (its PC's share rule,
+// friction.hpp) in proportion to its load. Its load is its own normal force, or for one of the
+// side's sections that press as one contact (Assemble) the contact's force shared by their depths
+// eps - d: the smooth minimum puts the force on the deepest section, which changes with every
+// small tilt of a side lying flat; shared by depth, the friction limits do not jump.
+Limits LimitsOf(const Model& model, const Data& data, const Sample& of) {
   const double eps = model.contact.threshold_m;
-  double force_N = 0.0, depth_m = 0.0;
+  double group_N = 0.0, side_N = 0.0, side_depth_m = 0.0;
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     const Sample& smp = data.scratch.samples[std::size_t(k)];
-    if (!IsSideSection(smp) || smp.part != of.part || smp.face_mask != of.face_mask) continue;
-    force_N += smp.normal_force_N;
-    depth_m += std::max(0.0, eps - smp.distance_m);
+    if (smp.part != of.part || smp.face_mask != of.face_mask) continue;
+    if (smp.distance_m < eps) group_N += smp.normal_force_N;
+    if (!IsSideSection(smp)) continue;
+    side_N += smp.normal_force_N;
+    side_depth_m += std::max(0.0, eps - smp.distance_m);
   }
-  return depth_m > 0.0 ? force_N * std::max(0.0, eps - of.distance_m) / depth_m : 0.0;
-}
-
-Limits LimitsOf(const Model& model, const Data& data, const Sample& smp) {
-  const scene::Friction& fr = model.parts[std::size_t(smp.part)].friction;
-  const double group_N = GroupNormal(model, data, smp);
-  const double own_N = FrictionLoad(model, data, smp);
+  double own_N = of.normal_force_N;
+  if (IsSideSection(of))
+    own_N = side_depth_m > 0.0 ? side_N * std::max(0.0, eps - of.distance_m) / side_depth_m : 0.0;
+  const scene::Friction& fr = model.parts[std::size_t(of.part)].friction;
   return {FrictionShare(fr, fr.static_coefficient, own_N, group_N),
           FrictionShare(fr, fr.kinetic_coefficient, own_N, group_N)};
 }
