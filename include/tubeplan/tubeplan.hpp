@@ -2,8 +2,9 @@
 // tubeplan as a library: everything a program calls to do what the commands do. Load a scene
 // and a plan (io), step the core with a hand pose (core), judge a plan's replay (plan), judge a
 // set of plans (batch), explore and prune the contact-state graph and make candidate plans
-// (graph, plan), run the 1 kHz servo against a device (device). Each header says what it holds;
-// README.md, "Layout", says which library each folder is.
+// (graph, plan), run the 1 kHz servo against a device (device), write the reports of judged
+// plans and of the graph (report). Each header says what it holds; docs/layout.md says which
+// library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/merge.hpp>
@@ -23,5 +24,8 @@
 #include <tubeplan/plan/candidates.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/report/graph_json.hpp>
+#include <tubeplan/report/html_report.hpp>
+#include <tubeplan/report/text_report.hpp>
 #include <tubeplan/scene/scene.hpp>
 #include <tubeplan/states/contact_formation.hpp>

@@ -19,6 +19,7 @@
 
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/merge.hpp>
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
@@ -27,12 +28,11 @@
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/report/graphviz.hpp>
+#include <tubeplan/report/html_report.hpp>
+#include <tubeplan/report/text_report.hpp>
 
 #include "commands.hpp"
-#include "graphviz.hpp"
-#include "html_report.hpp"
-#include "report.hpp"
-#include "report_assets.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -52,9 +52,9 @@ struct EvaluateOptions {
 // The graph section of the HTML report: each scene's pruned contact-state graph, explored with the
 // core as `tubeplan graph SCENE` does (same defaults), coloured by this run's verdicts, drawn by
 // Graphviz's dot. On failure returns false after saying why on `err`.
-bool GraphSections(const std::vector<Evaluated>& results,
-                   const std::vector<io::PlanLoadResult>& loaded, int jobs, HtmlOptions& html,
-                   std::ostream& err) {
+bool GraphSections(const std::vector<batch::Evaluated>& results,
+                   const std::vector<io::PlanLoadResult>& loaded, int jobs,
+                   report::HtmlOptions& html, std::ostream& err) {
   std::map<std::string, std::vector<std::size_t>> by_scene;  // scene path -> plans
   for (std::size_t i = 0; i < results.size(); ++i) {
     std::error_code ec;
@@ -84,7 +84,7 @@ bool GraphSections(const std::vector<Evaluated>& results,
     graph::DotOptions dot;
     dot.dropped_arcs = false;
     dot.title = "tubeplan: contact-state graph of " + s.name + " with this run's verdicts";
-    const SvgFromDot svg = RenderDot(graph::FormatDot(g, dot));
+    const report::SvgFromDot svg = report::RenderDot(graph::FormatDot(g, dot));
     if (!svg.error.empty()) {
       err << "tubeplan evaluate: error: --html-graph: " << svg.error << "\n";
       return false;
@@ -112,7 +112,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     }
   }
   const std::vector<std::string>& files = set.files;
-  ReportScope scope;
+  batch::ReportScope scope;
   scope.plan_set_id = set.id;
   scope.plan_set_plans = set.size;
   scope.shard_index = set.shard_index;
@@ -138,7 +138,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
                     io.err))
     return kExitBadInput;
 
-  if (!o.html_path.empty() && !assets::Available()) {
+  if (!o.html_path.empty() && !report::HtmlReportAvailable()) {
     io.err << "tubeplan evaluate: error: --html: this tubeplan was built without the HTML report "
               "(node was not found when it was configured, or TUBEPLAN_HTML_REPORT was off); "
               "install nodejs and npm (tools/setup does) and build again\n";
@@ -150,7 +150,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       io.err << "tubeplan evaluate: error: --html-graph needs --html FILE\n";
       return kExitBadInput;
     }
-    if (const SvgFromDot probe = RenderDot("digraph{}"); !probe.error.empty()) {
+    if (const report::SvgFromDot probe = report::RenderDot("digraph{}"); !probe.error.empty()) {
       io.err << "tubeplan evaluate: error: --html-graph: " << probe.error << "\n";
       return kExitBadInput;
     }
@@ -164,7 +164,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   std::optional<io::DeferInterrupts> defer_interrupts;
   defer_interrupts.emplace();
   // With --html each judged replay is recorded as it runs (no second replay).
-  std::vector<ReplayRecorder> recorders(o.html_path.empty() ? 0 : files.size());
+  std::vector<report::ReplayRecorder> recorders(o.html_path.empty() ? 0 : files.size());
   batch::BatchOptions batch_options;
   batch_options.jobs = jobs;
   batch_options.monte_carlo = o.monte_carlo;
@@ -179,7 +179,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     };
   batch::BatchResult judged = batch::JudgeBatch(files, loaded, batch_options);
   if (progress) io.err << "\r";
-  std::vector<Evaluated>& results = judged.results;
+  std::vector<batch::Evaluated>& results = judged.results;
   const double wall_s = judged.wall_s;
   const std::vector<std::string>& changed_errors = judged.changed;
 
@@ -212,7 +212,7 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   const nlohmann::json report = batch::ToJson(results, scope);
   std::string html_text;
   if (!o.html_path.empty()) {
-    HtmlOptions html;
+    report::HtmlOptions html;
     html.command = "tubeplan evaluate";
     for (const std::string& f : o.inputs) html.command += " " + f;
     html.command += " --html " + o.html_path + (o.html_graph ? " --html-graph" : "");
@@ -224,11 +224,11 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
           "core (its default exploration: minutes a scene) and draw it here with this run's "
           "verdicts.";
     }
-    std::vector<HtmlPlan> pages;
+    std::vector<report::HtmlPlan> pages;
     for (std::size_t i = 0; i < results.size(); ++i)
       pages.push_back(
           {&results[i], &*loaded[i].scene, loaded[i].plan->scene, recorders[i].Finish()});
-    html_text = FormatHtmlReport(pages, html);
+    html_text = report::FormatHtmlReport(pages, html);
   }
   // Both files in their temporaries, then renamed one after the other: a signal while they are
   // written ends the process with neither; one while they are renamed comes too late to stop
@@ -256,8 +256,9 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
       }
     }
   }
-  const bool all_feasible = std::all_of(results.begin(), results.end(),
-                                        [](const Evaluated& e) { return e.judgement.feasible; });
+  const bool all_feasible =
+      std::all_of(results.begin(), results.end(),
+                  [](const batch::Evaluated& e) { return e.judgement.feasible; });
   if (o.json) {
     io.out << report.dump(2) << "\n";
     return all_feasible ? kExitOk : kExitNegative;
@@ -267,12 +268,12 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   t << std::setprecision(3);
   double replayed_s = 0.0, run_s = 0.0;
   long feasible = 0, not_judged = 0;
-  for (const Evaluated& e : results) {
+  for (const batch::Evaluated& e : results) {
     replayed_s += e.replayed_s;
     run_s += e.run_s;
     feasible += e.judgement.feasible;
     not_judged += plan::Overall(e.judgement) == plan::Verdict::kNotJudged;
-    PrintVerdicts(t, e, colour);
+    report::PrintVerdicts(t, e, colour);
   }
   t << "summary: " << results.size() << " plan" << (results.size() == 1 ? "" : "s") << ", "
     << feasible << " feasible, " << long(results.size()) - feasible - not_judged << " infeasible"

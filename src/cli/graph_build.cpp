@@ -33,8 +33,6 @@
 #include <tubeplan/plan/candidates.hpp>
 
 #include "commands.hpp"
-#include "graph_json.hpp"
-#include "graphviz.hpp"
 
 namespace tubeplan::cli {
 namespace {

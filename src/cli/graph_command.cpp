@@ -32,11 +32,11 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/candidates.hpp>
+#include <tubeplan/report/graph_json.hpp>
+#include <tubeplan/report/graphviz.hpp>
 
 #include "commands.hpp"
 #include "graph_build.hpp"
-#include "graph_json.hpp"
-#include "graphviz.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -48,7 +48,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
     return kExitBadInput;
   // Graphviz is checked before the exploration: a missing `dot` should not cost one.
   if (!o.svg_path.empty()) {
-    if (const SvgFromDot probe = RenderDot("digraph{}"); !probe.error.empty()) {
+    if (const report::SvgFromDot probe = report::RenderDot("digraph{}"); !probe.error.empty()) {
       io.err << "tubeplan graph: error: --svg: " << probe.error << "\n";
       return kExitBadInput;
     }
@@ -73,7 +73,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
     }
   }
   if (!o.svg_path.empty()) {
-    const SvgFromDot svg = RenderDot(dot_text);
+    const report::SvgFromDot svg = report::RenderDot(dot_text);
     if (!svg.error.empty()) {
       io.err << "tubeplan graph: error: " << svg.error << "\n";
       return kExitBadInput;
@@ -85,7 +85,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
     }
   }
   if (!o.json_path.empty()) {
-    const nlohmann::json j = GraphToJson(g, s, o.scene_path, explore, weights);
+    const nlohmann::json j = report::GraphToJson(g, s, o.scene_path, explore, weights);
     if (const std::string e = io::WriteTextFileAtomically(o.json_path, j.dump(1) + "\n");
         !e.empty()) {
       io.err << o.json_path << ": error: " << e << "\n";

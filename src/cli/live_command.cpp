@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/batch/report.hpp>
 #include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/device_choice.hpp>
@@ -28,9 +29,9 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/report/text_report.hpp>
 
 #include "commands.hpp"
-#include "report.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -263,10 +264,10 @@ std::string StoppedEarly(const device::ServoStats& stats, double t_last_s) {
 }
 
 // evaluate's report of the run's one plan, with the servo's figures.
-nlohmann::json LiveReport(const Evaluated& e, const device::ServoStats& stats,
+nlohmann::json LiveReport(const batch::Evaluated& e, const device::ServoStats& stats,
                           const std::string& device_name, bool stepped) {
   // A live run's report covers its one plan: the plan set of that file, shard 1 of 1.
-  ReportScope scope;
+  batch::ReportScope scope;
   scope.plan_set_id = batch::PlanSetId({batch::CanonicalPlanPath(e.file)});
   scope.plan_set_plans = 1;
   nlohmann::json report = batch::ToJson({e}, scope);
@@ -290,10 +291,10 @@ nlohmann::json LiveReport(const Evaluated& e, const device::ServoStats& stats,
 }
 
 // The run's verdicts and the servo's figures as text.
-void PrintLiveText(std::ostream& out, const Evaluated& e, const device::ServoStats& stats,
+void PrintLiveText(std::ostream& out, const batch::Evaluated& e, const device::ServoStats& stats,
                    bool stepped, bool colour, const std::string& recording_written) {
   std::ostringstream t;
-  PrintVerdicts(t, e, colour);
+  report::PrintVerdicts(t, e, colour);
   t << std::fixed << std::setprecision(1) << "servo: " << stats.ticks << " ticks at "
     << stats.rate_hz << " Hz (" << (stepped ? "stepped clock" : "real time") << "), "
     << stats.overruns << " overruns; tick median " << stats.median_us << " us, p99.9 "
@@ -460,7 +461,7 @@ int RunLive(const LiveOptions& o, Streams io) {
     if (!record_error.empty()) io.err << o.record << ": error: " << record_error << "\n";
   }
 
-  Evaluated e;
+  batch::Evaluated e;
   e.file = o.plan;
   e.plan = plan;
   e.judgement = judging.Finish(stopped_early);

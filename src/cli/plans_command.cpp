@@ -35,8 +35,6 @@
 
 #include "commands.hpp"
 #include "graph_build.hpp"
-#include "graph_json.hpp"
-#include "graphviz.hpp"
 
 namespace tubeplan::cli {
 namespace {

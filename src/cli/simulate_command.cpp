@@ -20,9 +20,9 @@
 #include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/report/series_format.hpp>
 
 #include "commands.hpp"
-#include "series_format.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -50,13 +50,13 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   // hour's recording is never held (docs/hardening.md).
   io::TrajectoryScanResult trajectory = io::ScanTrajectoryFile(o.trajectory_path);
   io.err << scene.diagnostics.FormatAll() << trajectory.diagnostics.FormatAll();
-  SeriesFormat format = SeriesFormat::kNone;
+  report::SeriesFormat format = report::SeriesFormat::kNone;
   if (!o.out_path.empty()) {
     const std::string ext = std::filesystem::path(o.out_path).extension().string();
     if (ext == ".csv") {
-      format = SeriesFormat::kCsv;
+      format = report::SeriesFormat::kCsv;
     } else if (ext == ".jsonl") {
-      format = SeriesFormat::kJsonLines;
+      format = report::SeriesFormat::kJsonLines;
     } else {
       io.err << o.out_path << ": error: unknown output format \"" << ext
              << "\", expected a file name ending in .csv or .jsonl\n";
@@ -70,7 +70,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   // temporary file renamed at the end; a directory that cannot be written to is said before the
   // replay, not after it.
   std::optional<io::AtomicFile> series_file;
-  if (format != SeriesFormat::kNone) {
+  if (format != report::SeriesFormat::kNone) {
     series_file.emplace(o.out_path);
     if (!series_file->error().empty()) {
       io.err << o.out_path << ": error: " << series_file->Commit() << "\n";
@@ -98,7 +98,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   }
   core.Reset(X_W_hand0);
 
-  SeriesWriter writer(format, o.mesh);
+  report::SeriesWriter writer(format, o.mesh);
   std::vector<Visit> visits;
   std::string cf_text;
   double peak_force_N = 0.0, peak_force_t = 0.0, peak_strain = 0.0, peak_strain_t = 0.0;
@@ -173,7 +173,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
         strain_warning.empty() ? nlohmann::json::array() : nlohmann::json::array({strain_warning});
     nlohmann::json flags;
     for (int b = 0; b < core::kStepFlagCount; ++b)
-      flags[std::string(FlagName(1u << b))] = flag_ticks[std::size_t(b)];
+      flags[std::string(report::FlagName(1u << b))] = flag_ticks[std::size_t(b)];
     j["flag_ticks"] = flags;
     j["run_time_s"] = core_s;
     j["mean_tick_us"] = 1e6 * core_s / static_cast<double>(tick_count);
@@ -205,7 +205,7 @@ int RunSimulate(const SimulateOptions& o, Streams io) {
   bool any = false;
   for (int b = 0; b < core::kStepFlagCount; ++b)
     if (flag_ticks[std::size_t(b)] > 0) {
-      text << " " << FlagName(1u << b) << " " << flag_ticks[std::size_t(b)];
+      text << " " << report::FlagName(1u << b) << " " << flag_ticks[std::size_t(b)];
       any = true;
     }
   text << (any ? "" : " none") << "\n";

@@ -1,12 +1,12 @@
 // Graphviz through its `dot` program (graph --svg, the HTML report's graph): the SVG it draws,
 // and clear errors when the program is missing or fails.
-#include "cli/graphviz.hpp"
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include <catch2/catch.hpp>
+
+#include <tubeplan/report/graphviz.hpp>
 
 #include "run_tool.hpp"
 
@@ -21,18 +21,19 @@ using testing::SourcePath;
 
 TEST_CASE("Graphviz: SVG from dot, and clear errors when dot is missing or fails",
           "[cli][graphviz]") {
-  const cli::SvgFromDot ok = cli::RenderDot("digraph { a -> b }");
+  const report::SvgFromDot ok = report::RenderDot("digraph { a -> b }");
   INFO(ok.error);
   CHECK(ok.error.empty());
   CHECK(ok.svg.find("<svg") != std::string::npos);
   CHECK(ok.svg.find("</svg>") != std::string::npos);
 
-  const cli::SvgFromDot missing = cli::RenderDot("digraph { a -> b }", "tubeplan-no-such-dot");
+  const report::SvgFromDot missing =
+      report::RenderDot("digraph { a -> b }", "tubeplan-no-such-dot");
   CHECK(missing.svg.empty());
   CHECK(missing.error.find("`tubeplan-no-such-dot` program was not found on PATH") !=
         std::string::npos);
 
-  const cli::SvgFromDot bad = cli::RenderDot("digraph { a -> ");
+  const report::SvgFromDot bad = report::RenderDot("digraph { a -> ");
   CHECK(bad.svg.empty());
   CHECK(bad.error.find("Graphviz's `dot` failed (exit 1)") != std::string::npos);
   CHECK(bad.error.find("syntax error") != std::string::npos);
@@ -53,6 +54,6 @@ TEST_CASE("graph --svg writes the picture Graphviz draws of the DOT", "[cli][gra
   const std::string picture = Slurp(svg);
   CHECK(picture.find("<svg") != std::string::npos);
   // The same DOT through dot here gives the same picture.
-  CHECK(picture == cli::RenderDot(Slurp(dot)).svg);
+  CHECK(picture == report::RenderDot(Slurp(dot)).svg);
   std::filesystem::remove_all(dir);
 }

@@ -1,8 +1,6 @@
 // The HTML report (evaluate --html): the page's series are the judged replay's own ticks,
 // decimated without losing a peak; the page is self-contained. (The page in a browser:
 // tools/report-web/browser-test.mjs, registered with ctest as html_report_browser.)
-#include "cli/html_report.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -17,6 +15,7 @@
 
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/report/html_report.hpp>
 
 #include "run_tool.hpp"
 
@@ -44,7 +43,7 @@ TEST_CASE("The report's series are the judged replay's ticks, each bin's extreme
   std::vector<double> t_s, force_N, energy_J;
   const plan::Judgement plain =
       plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits);
-  cli::ReplayRecorder recorder;
+  report::ReplayRecorder recorder;
   const plan::Judgement watched =
       plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits,
                   [&](double t, const core::Core& core) {
@@ -53,7 +52,7 @@ TEST_CASE("The report's series are the judged replay's ticks, each bin's extreme
                     force_N.push_back(core.last().force_W_N.norm());
                     energy_J.push_back(core.last().energy_J);
                   });
-  const cli::ReplayRecording r = recorder.Finish();
+  const report::ReplayRecording r = recorder.Finish();
 
   // Watching changes nothing the judge decides.
   REQUIRE(plain.transitions.size() == watched.transitions.size());
@@ -115,7 +114,7 @@ TEST_CASE("A long replay's recording stays bounded, each bin's extremes kept", "
   const io::PlanLoadResult l = io::LoadPlanFile(SourcePath("plans/groove-gentle.yaml"));
   REQUIRE(l.plan);
   std::vector<double> t_s, force_N, strain;
-  cli::ReplayRecorder recorder(0.02, 16);
+  report::ReplayRecorder recorder(0.02, 16);
   plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits,
               [&](double t, const core::Core& core) {
                 recorder(t, core);
@@ -123,7 +122,7 @@ TEST_CASE("A long replay's recording stays bounded, each bin's extremes kept", "
                 force_N.push_back(core.last().force_W_N.norm());
                 strain.push_back(core.last().max_strain);
               });
-  const cli::ReplayRecording r = recorder.Finish();
+  const report::ReplayRecording r = recorder.Finish();
   CHECK(r.bin_s == Approx(0.64));
   REQUIRE(r.bins.size() == 9);
   std::vector<double> lo(r.bins.size(), 1e300), hi(r.bins.size(), -1e300), s_hi = hi;
@@ -177,8 +176,8 @@ TEST_CASE("evaluate --html of a long recording: a bounded page", "[cli][html]") 
   const nlohmann::json data =
       nlohmann::json::parse(page.substr(body, page.find("</script>", body) - body));
   const nlohmann::json& frames = data["plans"][0]["frames"];
-  CHECK(frames["t_s"].size() <= cli::ReplayRecording::kMaxBins + 1);
-  CHECK(frames["t_s"].size() > cli::ReplayRecording::kMaxBins / 2);
+  CHECK(frames["t_s"].size() <= report::ReplayRecording::kMaxBins + 1);
+  CHECK(frames["t_s"].size() > report::ReplayRecording::kMaxBins / 2);
   CHECK(data["plans"][0]["bin_s"] == 0.08);
   // The page: three.js (0.6 MB), the frames and the plots; 2.4 MB before the bins were bounded.
   CHECK(page.size() < 2'000'000);
@@ -208,12 +207,12 @@ TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cl
   const nlohmann::json data =
       nlohmann::json::parse(page.substr(body, page.find("</script>", body) - body));
   REQUIRE(data["plans"].size() == 2);
-  CHECK(data["tube_colour"] == cli::kTubeColour);
+  CHECK(data["tube_colour"] == report::kTubeColour);
   for (const nlohmann::json& p : data["plans"]) {
     const std::size_t frames = p["frames"]["t_s"].size();
     CHECK(frames > 200);  // 5.5 s at 50 Hz
     CHECK(p["frames"]["centreline_mm"].size() == frames);
-    CHECK(p["frames"]["centreline_mm"][0].size() == 3 * cli::ReplayRecording::kCentrelinePoints);
+    CHECK(p["frames"]["centreline_mm"][0].size() == 3 * report::ReplayRecording::kCentrelinePoints);
     CHECK(p["parts"].size() == 3);
     // The summary's peak force is the replay's peak, the frame the 3D view opens at.
     const std::size_t peak = p["peak_frame"];

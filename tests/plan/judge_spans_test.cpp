@@ -11,8 +11,7 @@
 #include <tubeplan/batch/report.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/judge.hpp>
-
-#include "cli/report.hpp"
+#include <tubeplan/report/text_report.hpp>
 
 namespace {
 
@@ -60,18 +59,18 @@ void Add(std::vector<SyntheticTick>& ticks, int state, int count) {
 }
 
 std::string Text(const plan::Judgement& j, const std::vector<std::string>& states) {
-  cli::Evaluated e;
+  batch::Evaluated e;
   e.file = "synthetic.yaml";
   e.plan.name = "synthetic";
   e.plan.states = states;
   e.judgement = j;
   std::ostringstream text;
-  cli::PrintVerdicts(text, e, false);
+  report::PrintVerdicts(text, e, false);
   return text.str();
 }
 
 nlohmann::json Json(const plan::Judgement& j, const std::vector<std::string>& states) {
-  cli::Evaluated e;
+  batch::Evaluated e;
   e.file = "synthetic.yaml";
   e.plan.name = "synthetic";
   e.plan.states = states;
@@ -278,7 +277,7 @@ TEST_CASE("A run that stopped early judges only what it finished", "[plan]") {
     CHECK(json["outcome"] == "not judged");
     CHECK(json["stopped_early"] == stop);
     CHECK(json["transitions"][1]["verdict"] == "not judged");
-    cli::Evaluated e;
+    batch::Evaluated e;
     e.judgement = j;
     const nlohmann::json summary = batch::ToJson({e}, {})["summary"];
     CHECK(summary["not_judged"] == 1);

@@ -1,5 +1,5 @@
 #pragma once
-// The contact-state graph as JSON (schema in docs/graph.md), private to the cli library.
+// The contact-state graph as JSON (schema in docs/graph.md): what `graph --json` writes.
 
 #include <string>
 
@@ -9,7 +9,7 @@
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/scene/scene.hpp>
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 
 inline constexpr int kGraphJsonVersion = 1;
 
@@ -17,4 +17,4 @@ nlohmann::json GraphToJson(const graph::ContactGraph& graph, const scene::Scene&
                            const std::string& scene_path, const graph::ExploreOptions& explore,
                            const graph::PruneWeights& weights);
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

@@ -1,5 +1,3 @@
-#include "graphviz.hpp"
-
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -12,9 +10,11 @@
 #include <unistd.h>
 #include <vector>
 
+#include <tubeplan/report/graphviz.hpp>
+
 extern char** environ;
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 namespace {
 
 // A temporary file that is removed when it goes out of scope.
@@ -130,4 +130,4 @@ SvgFromDot RenderDot(const std::string& dot_text, const std::string& program) {
   return result;
 }
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

@@ -1,13 +1,13 @@
 #pragma once
-// Private to the cli library: the per-tick series of `simulate` (and of later replays) as CSV or
-// JSON Lines. The columns are documented in docs/simulate-output.md; keep the two in step.
+// The per-tick series of `simulate` (and of later replays) as CSV or JSON Lines. The columns are
+// documented in docs/simulate-output.md; keep the two in step.
 
 #include <string>
 #include <string_view>
 
 #include <tubeplan/core/core.hpp>
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 
 enum class SeriesFormat { kNone, kCsv, kJsonLines };
 
@@ -33,4 +33,4 @@ class SeriesWriter {
   std::string text_;
 };
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

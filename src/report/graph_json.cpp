@@ -1,8 +1,8 @@
-#include "graph_json.hpp"
-
 #include <cmath>
 
-namespace tubeplan::cli {
+#include <tubeplan/report/graph_json.hpp>
+
+namespace tubeplan::report {
 namespace {
 
 nlohmann::json Pose(const Eigen::Isometry3d& X) {
@@ -117,4 +117,4 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   return j;
 }
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

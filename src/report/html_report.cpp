@@ -1,5 +1,3 @@
-#include "html_report.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -8,14 +6,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/report/html_report.hpp>
 #include <tubeplan/report/svg_plot.hpp>
+#include <tubeplan/report/text_report.hpp>
 
 #include "report_assets.hpp"
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 namespace {
 
-using report::EscapeXml;
+using batch::Evaluated;
 
 void Take(ReplayRecording::Extremes& e, double t_s, double v, bool first) {
   if (first || v < e.min) e.min = v, e.t_min_s = t_s;
@@ -72,8 +72,8 @@ std::string Badge(const plan::Judgement& j) {
 // Plot points of a bin series: each bin's minimum and maximum in the order they happened, so the
 // polyline passes through every peak.
 template <typename Member>
-std::vector<report::PlotPoint> Envelope(const ReplayRecording& r, Member member) {
-  std::vector<report::PlotPoint> points;
+std::vector<PlotPoint> Envelope(const ReplayRecording& r, Member member) {
+  std::vector<PlotPoint> points;
   points.reserve(r.bins.size() * 2);
   for (const ReplayRecording::Bin& b : r.bins) {
     if (b.ticks == 0) continue;
@@ -93,14 +93,14 @@ std::vector<report::PlotPoint> Envelope(const ReplayRecording& r, Member member)
 // run's highest value.
 template <typename Member>
 void MarkExceeded(const ReplayRecording& r, Member member, double limit, const std::string& unit,
-                  const std::string& what, report::LinePlot& plot) {
+                  const std::string& what, LinePlot& plot) {
   for (std::size_t i = 0; i < r.bins.size();) {
     if (r.bins[i].ticks == 0 || !((r.bins[i].*member).max > limit)) {
       ++i;
       continue;
     }
-    report::Span span{(r.bins[i].*member).t_max_s, 0.0, ""};
-    report::PlotPoint peak{0.0, -1e300, ""};
+    Span span{(r.bins[i].*member).t_max_s, 0.0, ""};
+    PlotPoint peak{0.0, -1e300, ""};
     for (; i < r.bins.size() && r.bins[i].ticks > 0 && (r.bins[i].*member).max > limit; ++i) {
       const ReplayRecording::Extremes& e = r.bins[i].*member;
       span.x0 = std::min(span.x0, std::min(e.t_min_s, e.t_max_s));
@@ -165,10 +165,9 @@ std::string VerdictTable(const Evaluated& e) {
 }
 
 // The observed CFs (counted after the dwell) in lanes against the planned transitions' windows.
-std::string Timeline(const Evaluated& e, const ReplayRecording& r,
-                     const std::vector<report::Span>& spans) {
+std::string Timeline(const Evaluated& e, const ReplayRecording& r, const std::vector<Span>& spans) {
   const plan::Judgement& j = e.judgement;
-  report::TimelinePlot plot;
+  TimelinePlot plot;
   plot.title = "Contact formations: planned windows and observed states";
   plot.x_label = "time [s]";
   plot.x_min = r.t_first_s;
@@ -204,13 +203,13 @@ std::string Timeline(const Evaluated& e, const ReplayRecording& r,
                          ob.cf + (is_planned ? " (planned)" : " (not planned)") +
                              ", t = " + Fixed(ob.t_s, 3) + " .. " + Fixed(t1, 3) + " s"});
   }
-  return report::RenderSvg(plot);
+  return RenderSvg(plot);
 }
 
-std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<report::Span>& spans) {
+std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<Span>& spans) {
   const plan::Limits& limits = e.plan.limits;
   const auto base = [&](const std::string& title, const std::string& y_label) {
-    report::LinePlot p;
+    LinePlot p;
     p.title = title;
     p.x_label = "time [s]";
     p.y_label = y_label;
@@ -219,23 +218,23 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
     return p;
   };
   using Bin = ReplayRecording::Bin;
-  report::LinePlot force = base("Operator force |F|", "N");
+  LinePlot force = base("Operator force |F|", "N");
   force.series = {
       {"|F| (min/max per " + Duration(r.bin_s) + ")", "#0072B2", Envelope(r, &Bin::force_N)}};
   force.limits = {{limits.max_force_N, "limit " + Fixed(limits.max_force_N, 3) + " N"}};
   MarkExceeded(r, &Bin::force_N, limits.max_force_N, "N", "operator force", force);
 
-  report::LinePlot friction = base("Friction force (sum over the contacts)", "N");
+  LinePlot friction = base("Friction force (sum over the contacts)", "N");
   friction.series = {
       {"|friction|", "#CC79A7", Envelope(r, &Bin::friction_N)},
       {"capacity f_max (slip above)", "#999999", Envelope(r, &Bin::friction_limit_N)}};
 
-  report::LinePlot energy = base("Bending energy", "\u00b5J");
-  std::vector<report::PlotPoint> energy_uJ = Envelope(r, &Bin::energy_J);
-  for (report::PlotPoint& p : energy_uJ) p.y *= 1e6;
+  LinePlot energy = base("Bending energy", "\u00b5J");
+  std::vector<PlotPoint> energy_uJ = Envelope(r, &Bin::energy_J);
+  for (PlotPoint& p : energy_uJ) p.y *= 1e6;
   energy.series = {{"bending energy", "#009E73", energy_uJ}};
 
-  report::LinePlot strain = base("Largest bending strain", "-");
+  LinePlot strain = base("Largest bending strain", "-");
   strain.series = {{"strain", "#E69F00", Envelope(r, &Bin::strain)}};
   strain.limits = {{limits.max_strain, "limit " + Fixed(limits.max_strain, 3)}};
   MarkExceeded(r, &Bin::strain, limits.max_strain, "", "strain", strain);
@@ -248,18 +247,17 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<repo
     if (!v.started || v.verdict != plan::Verdict::kInfeasible ||
         v.reason.find("limit exceeded") != std::string::npos)
       return;
-    const report::Span moment{
-        v.t_failed_s, v.t_failed_s,
-        what + " infeasible at t = " + Fixed(v.t_failed_s, 3) + " s: " + v.reason};
+    const Span moment{v.t_failed_s, v.t_failed_s,
+                      what + " infeasible at t = " + Fixed(v.t_failed_s, 3) + " s: " + v.reason};
     spans.push_back(moment);
-    for (report::LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
+    for (LinePlot* p : {&force, &friction, &energy, &strain}) p->spans.push_back(moment);
   };
   for (std::size_t k = 0; k < e.judgement.transitions.size(); ++k)
     mark(e.judgement.transitions[k], "transition " + std::to_string(k + 1));
   mark(e.judgement.after_goal, "after the goal: the plan");
   std::string svg;
-  for (const report::LinePlot* p : {&force, &friction, &energy, &strain})
-    svg += "<div class=\"plot\">" + report::RenderSvg(*p) + "</div>\n";
+  for (const LinePlot* p : {&force, &friction, &energy, &strain})
+    svg += "<div class=\"plot\">" + RenderSvg(*p) + "</div>\n";
   return svg;
 }
 
@@ -463,6 +461,8 @@ ReplayRecording ReplayRecorder::Finish() {
   return std::move(rec_);
 }
 
+bool HtmlReportAvailable() { return assets::Available(); }
+
 std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options) {
   std::ostringstream o;
   long feasible = 0;
@@ -534,7 +534,7 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
     if (!e.judgement.strain_warning.empty())
       o << "<p class=\"warning\">warning: " << EscapeXml(e.judgement.strain_warning) << "</p>\n";
     o << VerdictTable(e);
-    std::vector<report::Span> spans;
+    std::vector<Span> spans;
     const std::string plots = Plots(e, p.recording, spans);
     o << "<div class=\"plot timeline\">" << Timeline(e, p.recording, spans) << "</div>\n"
       << plots << "</section>\n";
@@ -561,4 +561,4 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
   return o.str();
 }
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

@@ -1,12 +1,12 @@
 #pragma once
-// Private to the cli library: DOT to SVG with Graphviz's `dot` program (graph --svg, the HTML
-// report's graph). The program, not libgvc: `dot` is what tools/render-graph and the tests
-// already use, it isolates Graphviz's own crashes and global state from our process, and its
-// plugins (the SVG renderer) are configured by the Debian package.
+// DOT to SVG with Graphviz's `dot` program (graph --svg, the HTML report's graph). The program, not
+// libgvc: `dot` is what tools/render-graph and the tests already use, it isolates Graphviz's own
+// crashes and global state from our process, and its plugins (the SVG renderer) are configured by
+// the Debian package.
 
 #include <string>
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 
 struct SvgFromDot {
   std::string svg;       ///< the picture; empty on failure
@@ -19,4 +19,4 @@ struct SvgFromDot {
 /// non-zero exit or a signal is an error that names the program and quotes its stderr.
 SvgFromDot RenderDot(const std::string& dot_text, const std::string& program = "dot");
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

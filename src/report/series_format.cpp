@@ -1,11 +1,11 @@
-#include "series_format.hpp"
-
 #include <array>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
 
-namespace tubeplan::cli {
+#include <tubeplan/report/series_format.hpp>
+
+namespace tubeplan::report {
 namespace {
 
 // 17 significant digits: a double read back is the double written (the series is for analysis,
@@ -172,4 +172,4 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
   text_ += '\n';
 }
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

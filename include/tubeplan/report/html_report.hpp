@@ -1,9 +1,8 @@
 #pragma once
-// Private to the cli library: the HTML report of `evaluate --html` (docs/report.md). One
-// self-contained page: per plan the verdict table, a timeline of the observed CFs against the
-// planned ones, plots over time (SVG by report/svg_plot) and a 3D replay (three.js, embedded).
-// Everything it draws is recorded from the judged replay itself (plan::Judge's TickWatcher):
-// no second run of the core, no second physics.
+// The HTML report of `evaluate --html` (docs/report.md). One self-contained page: per plan the
+// verdict table, a timeline of the observed CFs against the planned ones, plots over time (SVG by
+// report/svg_plot) and a 3D replay (three.js, embedded). Everything it draws is recorded from the
+// judged replay itself (plan::Judge's TickWatcher): no second run of the core, no second physics.
 
 #include <array>
 #include <optional>
@@ -12,13 +11,12 @@
 
 #include <Eigen/Core>
 
+#include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/plan/plan.hpp>
 #include <tubeplan/scene/scene.hpp>
 
-#include "report.hpp"
-
-namespace tubeplan::cli {
+namespace tubeplan::report {
 
 /// The tube's colour in the 3D replay (the browser test counts pixels of it).
 inline constexpr const char* kTubeColour = "#f07814";
@@ -89,7 +87,7 @@ class ReplayRecorder {
 };
 
 struct HtmlPlan {
-  const Evaluated* evaluated = nullptr;
+  const batch::Evaluated* evaluated = nullptr;
   const scene::Scene* scene = nullptr;
   std::string scene_path;
   ReplayRecording recording;
@@ -103,7 +101,11 @@ struct HtmlOptions {
   std::string graph_note;
 };
 
+/// False in a build without the HTML report (TUBEPLAN_HTML_REPORT off, or node not found when
+/// it was configured): the page cannot be written, and `evaluate --html` says so.
+bool HtmlReportAvailable();
+
 /// The page, complete (three.js, the page's script and style, the data inline).
 std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptions& options);
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report

@@ -1,5 +1,3 @@
-#include "report.hpp"
-
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -9,8 +7,9 @@
 #include <sstream>
 
 #include <tubeplan/plan/perturb.hpp>
+#include <tubeplan/report/text_report.hpp>
 
-namespace tubeplan::cli {
+namespace tubeplan::report {
 
 namespace {
 
@@ -46,7 +45,7 @@ std::string Headline(plan::Verdict overall) {
   return text;
 }
 
-void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
+void PrintVerdicts(std::ostream& t, const batch::Evaluated& e, bool colour) {
   auto paint = [&](plan::Verdict v, const std::string& text) {
     if (!colour) return text;
     const char* code = v == plan::Verdict::kFeasible             ? "\033[32m"
@@ -80,4 +79,4 @@ void PrintVerdicts(std::ostream& t, const Evaluated& e, bool colour) {
   t.precision(precision);
 }
 
-}  // namespace tubeplan::cli
+}  // namespace tubeplan::report
