@@ -4,7 +4,8 @@
 
 #include <tubeplan/batch/merge.hpp>
 #include <tubeplan/batch/report.hpp>
-#include <tubeplan/io/text_file.hpp>
+
+#include "io/text_file.hpp"
 
 namespace tubeplan::batch {
 namespace {

@@ -9,13 +9,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/report/svg_plot.hpp>
 #include <tubeplan/study/accuracy.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {

@@ -1,7 +1,8 @@
+#include "app.hpp"
+
 #include <algorithm>
 #include <exception>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 

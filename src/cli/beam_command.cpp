@@ -7,11 +7,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/model/elastica.hpp>
 #include <tubeplan/model/tip_response.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
 
 namespace tubeplan::cli {

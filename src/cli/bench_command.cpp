@@ -10,10 +10,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/model/linear_beam.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
 
 namespace tubeplan::cli {

@@ -7,15 +7,15 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/scene/elements.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {

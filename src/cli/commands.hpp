@@ -12,8 +12,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
+
+#include "io/text_file.hpp"
 
 namespace tubeplan::study {
 struct StabilityResult;

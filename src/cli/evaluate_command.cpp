@@ -20,19 +20,19 @@
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/merge.hpp>
 #include <tubeplan/batch/report.hpp>
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/plan_file.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/report/graphviz.hpp>
 #include <tubeplan/report/html_report.hpp>
 #include <tubeplan/report/text_report.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {

@@ -17,7 +17,6 @@
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/batch/report.hpp>
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/device_choice.hpp>
 #include <tubeplan/device/emulator.hpp>
@@ -26,12 +25,13 @@
 #include <tubeplan/device/openigtlink.hpp>
 #include <tubeplan/device/servo.hpp>
 #include <tubeplan/io/plan_file.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/report/text_report.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {

@@ -3,8 +3,9 @@
 #include <string>
 #include <vector>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/interrupt.hpp>
+
+#include "app.hpp"
 
 int main(int argc, char** argv) {
   // SIGINT and SIGTERM remove the temporaries of unfinished outputs and exit 130.

@@ -19,7 +19,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/graph/completeness.hpp>
 #include <tubeplan/graph/dot.hpp>
@@ -29,12 +28,13 @@
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/candidates.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
 #include "graph_build.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {

@@ -7,9 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/study/stability.hpp>
 
+#include "app.hpp"
 #include "commands.hpp"
 
 namespace tubeplan::cli {

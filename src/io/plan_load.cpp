@@ -2,9 +2,9 @@
 // scene and trajectory they name loaded and the planned CFs checked against the scene.
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
+#include "text_file.hpp"
 #include "yaml_reader.hpp"
 
 namespace tubeplan::io {

@@ -20,11 +20,11 @@
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/core/coupling.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
 #include <tubeplan/scene/geometry.hpp>
 
+#include "text_file.hpp"
 #include "yaml_reader.hpp"
 
 namespace tubeplan::io {

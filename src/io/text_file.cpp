@@ -1,3 +1,5 @@
+#include "text_file.hpp"
+
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -9,7 +11,6 @@
 #include <unistd.h>
 
 #include <tubeplan/io/interrupt.hpp>
-#include <tubeplan/io/text_file.hpp>
 
 namespace tubeplan::io {
 namespace {

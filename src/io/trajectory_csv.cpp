@@ -7,9 +7,10 @@
 #include <memory>
 #include <sstream>
 
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/io/units.hpp>
+
+#include "text_file.hpp"
 
 namespace tubeplan::io {
 namespace {

@@ -12,8 +12,9 @@
 #include <cmath>
 #include <numbers>
 
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
+
+#include "text_file.hpp"
 
 namespace tubeplan::io {
 namespace {

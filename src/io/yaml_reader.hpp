@@ -16,10 +16,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <tubeplan/io/diagnostics.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
 #include <tubeplan/states/contact_formation.hpp>
+
+#include "text_file.hpp"
 
 namespace tubeplan::io {
 

@@ -32,7 +32,8 @@
 #include <boost/math/special_functions/ellint_rf.hpp>
 
 #include <tubeplan/model/elastica.hpp>
-#include <tubeplan/model/gauss_legendre.hpp>
+
+#include "model/gauss_legendre.hpp"
 
 namespace tubeplan::model {
 namespace {

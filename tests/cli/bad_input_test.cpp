@@ -10,9 +10,8 @@
 
 #include <catch2/catch.hpp>
 
-#include <tubeplan/cli/app.hpp>
-
 #include "../scratch.hpp"
+#include "cli/app.hpp"
 #include "run_tool.hpp"
 
 namespace {

@@ -13,9 +13,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
-
 #include "../scratch.hpp"
+#include "cli/app.hpp"
 #include "run_tool.hpp"
 
 namespace {

@@ -18,9 +18,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
-
 #include "../device/live_replay.hpp"
+#include "cli/app.hpp"
 
 namespace {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include <tubeplan/cli/app.hpp>
+#include "cli/app.hpp"
 
 namespace tubeplan::testing {
 

@@ -9,11 +9,11 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/io/plan_file.hpp>
-#include <tubeplan/io/text_file.hpp>
 
 #include "../cli/run_tool.hpp"
+#include "cli/app.hpp"
+#include "io/text_file.hpp"
 
 namespace tubeplan::testing {
 

@@ -26,15 +26,15 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/openhaptics.hpp>
 #include <tubeplan/device/openigtlink.hpp>
 #include <tubeplan/device/servo.hpp>
 #include <tubeplan/io/plan_file.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
 #include "../alloc_count.hpp"
+#include "cli/app.hpp"
+#include "io/text_file.hpp"
 #include "live_replay.hpp"
 
 extern char** environ;

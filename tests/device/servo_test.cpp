@@ -13,14 +13,14 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/device/emulator.hpp>
 #include <tubeplan/device/handoff.hpp>
 #include <tubeplan/device/servo.hpp>
 #include <tubeplan/io/plan_file.hpp>
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 
+#include "cli/app.hpp"
+#include "io/text_file.hpp"
 #include "live_replay.hpp"
 
 namespace {

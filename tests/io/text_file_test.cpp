@@ -1,4 +1,6 @@
 // Whole-file reading and atomic writing.
+#include "io/text_file.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -6,8 +8,6 @@
 #include <vector>
 
 #include <catch2/catch.hpp>
-
-#include <tubeplan/io/text_file.hpp>
 
 namespace {
 std::filesystem::path ScratchDir() {

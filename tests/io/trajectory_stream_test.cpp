@@ -10,11 +10,11 @@
 
 #include <catch2/catch.hpp>
 
-#include <tubeplan/io/text_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/trajectory.hpp>
 
 #include "../scratch.hpp"
+#include "io/text_file.hpp"
 
 namespace {
 

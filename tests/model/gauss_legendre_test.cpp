@@ -1,9 +1,9 @@
 // The quadrature rule both the elastica and the flexure tests rely on.
+#include "model/gauss_legendre.hpp"
+
 #include <cmath>
 
 #include <catch2/catch.hpp>
-
-#include <tubeplan/model/gauss_legendre.hpp>
 
 namespace {
 

@@ -21,9 +21,10 @@
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
-#include <tubeplan/model/gauss_legendre.hpp>
 #include <tubeplan/model/linear_beam.hpp>
 #include <tubeplan/model/tube.hpp>
+
+#include "model/gauss_legendre.hpp"
 
 namespace {
 

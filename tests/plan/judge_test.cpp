@@ -10,12 +10,13 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
-#include <tubeplan/cli/app.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/perturb.hpp>
+
+#include "cli/app.hpp"
 
 namespace {
 

@@ -1,7 +1,7 @@
 #pragma once
-// Gauss-Legendre quadrature nodes and weights on [-1, 1], computed once by Newton's method on the
-// Legendre polynomial P_n. Header-only and allocation-free: callers keep the rule in arrays of
-// their own size.
+// Private to the model sources and their tests: Gauss-Legendre quadrature nodes and weights
+// on [-1, 1], computed once by Newton's method on the Legendre polynomial P_n. Header-only and
+// allocation-free: callers keep the rule in arrays of their own size.
 
 #include <array>
 #include <cmath>

@@ -1,7 +1,8 @@
 #pragma once
-// The tubeplan command line. Exit codes (documented in README): 0 success, 1 the job ran and
-// found a negative answer (e.g. an infeasible plan), 2 bad input or bad usage, 3 internal error,
-// 130 interrupted (SIGINT or SIGTERM; 128 + SIGINT as shells report it) with nothing written.
+// Private to the cli library (main.cpp and the tests): the tubeplan command line. Exit codes
+// (documented in README): 0 success, 1 the job ran and found a negative answer (e.g. an infeasible
+// plan), 2 bad input or bad usage, 3 internal error, 130 interrupted (SIGINT or SIGTERM; 128 +
+// SIGINT as shells report it) with nothing written.
 
 #include <ostream>
 #include <span>
