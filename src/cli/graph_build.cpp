@@ -2,33 +2,21 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
+#include <cstdlib>
 #include <functional>
-#include <iomanip>
-#include <map>
-#include <memory>
-#include <numbers>
 #include <optional>
-#include <sstream>
+#include <string>
 #include <thread>
-#include <tuple>
 #include <unistd.h>
 #include <variant>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/batch/report.hpp>
-#include <tubeplan/core/core.hpp>
-#include <tubeplan/graph/completeness.hpp>
-#include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
-#include <tubeplan/graph/motion.hpp>
-#include <tubeplan/graph/paths.hpp>
 #include <tubeplan/graph/verdicts.hpp>
-#include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
-#include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/candidates.hpp>
 
 #include "app.hpp"
 #include "commands.hpp"
@@ -113,8 +101,6 @@ bool ParseWeights(const std::string& text, graph::PruneWeights& w, std::string& 
   }
   return true;
 }
-
-// What `graph` and `plans` share: the scene, the explored and pruned graph, the settings used.
 
 }  // namespace
 

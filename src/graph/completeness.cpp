@@ -75,4 +75,11 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
   return c;
 }
 
+Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
+                               const ExploreOptions& explore, int count) {
+  const std::vector<Motion> motions =
+      RandomMotions(scene, explore.seed + 1000003, 0, count, explore);
+  return CheckCompleteness(scene, graph, motions, explore.dwell_s);
+}
+
 }  // namespace tubeplan::graph

@@ -81,6 +81,13 @@ std::vector<Move> Prefix(const Motion& motion, int move, int move_tick) {
 
 Eigen::Isometry3d MotionStart(const scene::Scene& scene) { return scene.X_WH_start; }
 
+std::string RestingFormation(const scene::Scene& scene) {
+  core::Core core(scene);
+  core.Reset(MotionStart(scene));
+  core.Step(scene.model.time_step_s, MotionStart(scene));
+  return core.FormationText();
+}
+
 void ReplaySubsteps(core::Core& core, const Motion& motion, int tick, int substeps,
                     const std::function<bool(int, const core::StepOutput&)>& on_substep,
                     const Checkpoint* from) {

@@ -74,6 +74,11 @@ void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s,
   out += '\n';
 }
 
+std::optional<plan::Trajectory> TrajectoryAsWritten(const plan::Trajectory& trajectory) {
+  TrajectoryLoadResult read = LoadTrajectoryText(FormatTrajectoryCsv(trajectory), "candidate");
+  return std::move(read.trajectory);
+}
+
 std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
   std::string out = TrajectoryCsvHeader(t.device, t.nominal_rate_Hz);
   char row[192];

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <tubeplan/graph/contact_graph.hpp>
+#include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/motion.hpp>
 #include <tubeplan/scene/scene.hpp>
 
@@ -33,5 +34,10 @@ struct Completeness {
 /// changes two PCs at once is in the graph when it records the change through a state between.
 Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
                                std::span<const Motion> motions, double dwell_s);
+
+/// The same over `count` random guarded motions of another seed than the explorer's
+/// (RandomMotions from explore.seed + 1000003): motions it did not make, counted after its dwell.
+Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
+                               const ExploreOptions& explore, int count);
 
 }  // namespace tubeplan::graph

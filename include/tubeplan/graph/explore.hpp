@@ -72,6 +72,10 @@ struct ExploreOptions {
   bool resume_runs = true;
 };
 
+/// The neighbour probes of a node: a step along and against each of three directions and a turn
+/// either way about two axes (ExploreOptions::probe_step_m, probe_turn_rad).
+inline constexpr int kProbesPerNode = 2 * 3 + 2 * 2;
+
 /// Number of PC changes between two CFs: a PC added, removed or re-marked counts one; a PC that
 /// keeps one of its elements and changes the other (Ee -> Fe on the same face, a rim sliding
 /// from a face onto its edge) counts one.

@@ -107,6 +107,10 @@ std::vector<Move> Prefix(const Motion& motion, int move, int move_tick);
 /// The held-end pose a motion's start puts the hand at (the scene's start pose).
 Eigen::Isometry3d MotionStart(const scene::Scene& scene);
 
+/// The CF's text the core gives after one tick at rest at MotionStart: the state a plan would
+/// start in.
+std::string RestingFormation(const scene::Scene& scene);
+
 /// Runs `motion` through `core` (reset to the scene's start) up to and including `ref`, and
 /// returns the last step's output. The core is left in that state.
 const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const TickRef& ref);

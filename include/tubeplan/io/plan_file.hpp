@@ -52,6 +52,11 @@ std::string FormatPlanYaml(const plan::Plan& plan);
 /// nanometre, quaternions to 1e-9), and the "# stopped:" line of a trajectory that has one.
 std::string FormatTrajectoryCsv(const plan::Trajectory& trajectory);
 
+/// The trajectory as its file reads back (FormatTrajectoryCsv, then LoadTrajectoryText: rounded
+/// as written), or nothing if it would not load; what a replay of the written plan sees
+/// (plan::AsWritten).
+std::optional<plan::Trajectory> TrajectoryAsWritten(const plan::Trajectory& trajectory);
+
 /// The '#' metadata lines and the header of a trajectory CSV, as FormatTrajectoryCsv writes them,
 /// with `extra_columns` after the pose columns.
 std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz,
