@@ -99,140 +99,155 @@ bool GraphSections(const std::vector<batch::Evaluated>& results,
   return true;
 }
 
-int RunEvaluate(const EvaluateOptions& o, Streams io) {
+// Reads every plan of the set `o.inputs` names (this shard of it), and checks that no output
+// replaces an input. False after printing every problem found (nothing is evaluated then).
+bool LoadPlans(const EvaluateOptions& o, std::ostream& err, batch::PlanSet& set,
+               std::vector<io::PlanLoadResult>& loaded) {
   std::vector<std::string> errors;
-  batch::PlanSet set = batch::CollectPlanSet(o.inputs, errors);
-  for (const std::string& e : errors) io.err << e << "\n";
+  set = batch::CollectPlanSet(o.inputs, errors);
+  for (const std::string& e : errors) err << e << "\n";
   bool ok = errors.empty();
   if (!o.shard.empty()) {
     std::string error;
     if (!batch::SelectShard(o.shard, set, error)) {
-      io.err << "tubeplan evaluate: error: " << error << "\n";
-      return kExitBadInput;
+      err << "tubeplan evaluate: error: " << error << "\n";
+      return false;
     }
   }
   const std::vector<std::string>& files = set.files;
-  batch::ReportScope scope;
-  scope.plan_set_id = set.id;
-  scope.plan_set_plans = set.size;
-  scope.shard_index = set.shard_index;
-  scope.shard_count = set.shard_count;
   // Every plan named is an input an output must not replace, in this shard or another.
   std::vector<io::RolePath> inputs;
   for (const std::string& f : files) inputs.push_back({"the plan", f});
-  std::vector<io::PlanLoadResult> loaded;
   for (const std::string& f : files) {
     // Monte Carlo perturbs the trajectory and needs its samples; otherwise the trajectory is
     // checked streamed and replayed from its file row by row (docs/hardening.md).
     loaded.push_back(io::LoadPlanFile(f, {.trajectory_in_memory = o.monte_carlo > 0}));
-    io.err << loaded.back().diagnostics.FormatAll();
+    err << loaded.back().diagnostics.FormatAll();
     ok = ok && loaded.back().plan.has_value();
   }
-  if (!ok) return kExitBadInput;
+  if (!ok) return false;
   for (std::size_t i = 0; i < files.size(); ++i) {
     const std::filesystem::path directory = std::filesystem::path(files[i]).parent_path();
     inputs.push_back({"the scene of " + files[i], directory / loaded[i].plan->scene});
     inputs.push_back({"the trajectory of " + files[i], directory / loaded[i].plan->trajectory});
   }
-  if (!OutputsApart("evaluate", {{"--report", o.report_path}, {"--html", o.html_path}}, inputs,
-                    io.err))
-    return kExitBadInput;
+  return OutputsApart("evaluate", {{"--report", o.report_path}, {"--html", o.html_path}}, inputs,
+                      err);
+}
 
+// The HTML report's tools, checked before the replays: a missing `dot` should not cost a batch.
+// False after saying what is missing.
+bool HtmlToolsPresent(const EvaluateOptions& o, std::ostream& err) {
   if (!o.html_path.empty() && !report::HtmlReportAvailable()) {
-    io.err << "tubeplan evaluate: error: --html: this tubeplan was built without the HTML report "
-              "(node was not found when it was configured, or TUBEPLAN_HTML_REPORT was off); "
-              "install nodejs and npm (tools/setup does) and build again\n";
-    return kExitBadInput;
+    err << "tubeplan evaluate: error: --html: this tubeplan was built without the HTML report "
+           "(node was not found when it was configured, or TUBEPLAN_HTML_REPORT was off); "
+           "install nodejs and npm (tools/setup does) and build again\n";
+    return false;
   }
-  // Graphviz is checked before the replays: a missing `dot` should not cost a batch.
   if (o.html_graph) {
     if (o.html_path.empty()) {
-      io.err << "tubeplan evaluate: error: --html-graph needs --html FILE\n";
-      return kExitBadInput;
+      err << "tubeplan evaluate: error: --html-graph needs --html FILE\n";
+      return false;
     }
     if (const report::SvgFromDot probe = report::RenderDot("digraph{}"); !probe.error.empty()) {
-      io.err << "tubeplan evaluate: error: --html-graph: " << probe.error << "\n";
-      return kExitBadInput;
+      err << "tubeplan evaluate: error: --html-graph: " << probe.error << "\n";
+      return false;
     }
   }
-  const int jobs = std::clamp(o.jobs > 0 ? o.jobs : int(std::thread::hardware_concurrency()), 1,
-                              std::max<int>(1, int(files.size())));
+  return true;
+}
+
+// Judges every plan on `jobs` threads, each judged replay into its recorder when there are
+// recorders (--html); one short line per plan on a terminal only (a log stays clean).
+batch::BatchResult JudgePlans(const EvaluateOptions& o, const std::vector<std::string>& files,
+                              const std::vector<io::PlanLoadResult>& loaded, int jobs,
+                              std::vector<report::ReplayRecorder>& recorders, std::ostream& err) {
   const bool progress = isatty(STDERR_FILENO) != 0 && !o.json;
-  // Ctrl-C (SIGINT) or SIGTERM during the batch: the plans being judged finish, no new one
-  // starts, and no report is written (a report is complete or absent, never half of a batch).
-  // A second signal ends the process at once (io/interrupt.hpp).
-  std::optional<io::DeferInterrupts> defer_interrupts;
-  defer_interrupts.emplace();
-  // With --html each judged replay is recorded as it runs (no second replay).
-  std::vector<report::ReplayRecorder> recorders(o.html_path.empty() ? 0 : files.size());
   batch::BatchOptions batch_options;
   batch_options.jobs = jobs;
   batch_options.monte_carlo = o.monte_carlo;
   batch_options.seed = o.seed;
   if (!recorders.empty())
     batch_options.watch = [&](std::size_t i) { return plan::TickWatcher(std::ref(recorders[i])); };
-  // One short line per plan, on a terminal only (a log stays clean).
   if (progress)
     batch_options.judged = [&](std::size_t done) {
-      io.err << "\r[" + std::to_string(done) + "/" + std::to_string(files.size()) + "]"
-             << std::flush;
+      err << "\r[" + std::to_string(done) + "/" + std::to_string(files.size()) + "]" << std::flush;
     };
   batch::BatchResult judged = batch::JudgeBatch(files, loaded, batch_options);
-  if (progress) io.err << "\r";
-  std::vector<batch::Evaluated>& results = judged.results;
-  const double wall_s = judged.wall_s;
-  const std::vector<std::string>& changed_errors = judged.changed;
+  if (progress) err << "\r";
+  return judged;
+}
 
-  if (!changed_errors.empty()) {
-    for (const std::string& e : changed_errors) io.err << e << "\n";
-    io.err << "tubeplan evaluate: no report written"
-           << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
-           << "\n";
+// kExitOk when every plan was judged; else, after saying why no report is written, the exit code.
+int CheckAllJudged(const EvaluateOptions& o, const batch::BatchResult& judged,
+                   std::size_t plan_count, std::ostream& err) {
+  if (!judged.changed.empty()) {
+    for (const std::string& e : judged.changed) err << e << "\n";
+    err << "tubeplan evaluate: no report written"
+        << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
+        << "\n";
     return kExitBadInput;
   }
-  if (judged.judged < files.size() || io::Interrupted()) {
-    io.err << "tubeplan evaluate: interrupted after " << judged.judged << " of " << files.size()
-           << " plans; no report written"
-           << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
-           << "\n";
+  if (judged.judged < plan_count || io::Interrupted()) {
+    err << "tubeplan evaluate: interrupted after " << judged.judged << " of " << plan_count
+        << " plans; no report written"
+        << (o.report_path.empty() ? std::string() : " (" + o.report_path + " is left as it was)")
+        << "\n";
     return kExitInterrupted;
   }
-  // From here a signal ends the process at once (the page and the graphs take seconds); the
-  // outputs are made in memory and written last, so an interruption leaves none of them.
-  std::string left_as_it_was;
-  if (!o.report_path.empty() || !o.html_path.empty())
-    left_as_it_was = " (" +
-                     (o.report_path.empty() ? o.html_path
-                      : o.html_path.empty() ? o.report_path
-                                            : o.report_path + " and " + o.html_path) +
-                     (o.report_path.empty() || o.html_path.empty() ? " is left as it was)"
-                                                                   : " are left as they were)");
-  io::SetInterruptMessage("tubeplan evaluate: interrupted; no report written" + left_as_it_was);
-  defer_interrupts.reset();
-  const nlohmann::json report = batch::ToJson(results, scope);
-  std::string html_text;
-  if (!o.html_path.empty()) {
-    report::HtmlOptions html;
-    html.command = "tubeplan evaluate";
-    for (const std::string& f : o.inputs) html.command += " " + f;
-    html.command += " --html " + o.html_path + (o.html_graph ? " --html-graph" : "");
-    if (o.html_graph) {
-      if (!GraphSections(results, loaded, jobs, html, io.err)) return kExitBadInput;
-    } else {
-      html.graph_note =
-          "Not included: add --html-graph to explore each scene's contact-state graph with the "
-          "core (its default exploration: minutes a scene) and draw it here with this run's "
-          "verdicts.";
-    }
-    std::vector<report::HtmlPlan> pages;
-    for (std::size_t i = 0; i < results.size(); ++i)
-      pages.push_back(
-          {&results[i], &*loaded[i].scene, loaded[i].plan->scene, recorders[i].Finish()});
-    html_text = report::FormatHtmlReport(pages, html);
+  return kExitOk;
+}
+
+// " (REPORT and HTML are left as they were)" for the outputs asked for, or empty.
+std::string OutputsLeftAsTheyWere(const EvaluateOptions& o) {
+  if (o.report_path.empty() && o.html_path.empty()) return std::string();
+  return " (" +
+         (o.report_path.empty() ? o.html_path
+          : o.html_path.empty() ? o.report_path
+                                : o.report_path + " and " + o.html_path) +
+         (o.report_path.empty() || o.html_path.empty() ? " is left as it was)"
+                                                       : " are left as they were)");
+}
+
+batch::ReportScope ScopeOf(const batch::PlanSet& set) {
+  batch::ReportScope scope;
+  scope.plan_set_id = set.id;
+  scope.plan_set_plans = set.size;
+  scope.shard_index = set.shard_index;
+  scope.shard_count = set.shard_count;
+  return scope;
+}
+
+// The HTML report's page in `html_text`. False after saying why (--html-graph: dot failed).
+bool FormatHtml(const EvaluateOptions& o, const std::vector<batch::Evaluated>& results,
+                const std::vector<io::PlanLoadResult>& loaded, int jobs,
+                std::vector<report::ReplayRecorder>& recorders, std::string& html_text,
+                std::ostream& err) {
+  report::HtmlOptions html;
+  html.command = "tubeplan evaluate";
+  for (const std::string& f : o.inputs) html.command += " " + f;
+  html.command += " --html " + o.html_path + (o.html_graph ? " --html-graph" : "");
+  if (o.html_graph) {
+    if (!GraphSections(results, loaded, jobs, html, err)) return false;
+  } else {
+    html.graph_note =
+        "Not included: add --html-graph to explore each scene's contact-state graph with the "
+        "core (its default exploration: minutes a scene) and draw it here with this run's "
+        "verdicts.";
   }
-  // Both files in their temporaries, then renamed one after the other: a signal while they are
-  // written ends the process with neither; one while they are renamed comes too late to stop
-  // them (deferred, and then ignored), so there is never one without the other.
+  std::vector<report::HtmlPlan> pages;
+  for (std::size_t i = 0; i < results.size(); ++i)
+    pages.push_back({&results[i], &*loaded[i].scene, loaded[i].plan->scene, recorders[i].Finish()});
+  html_text = report::FormatHtmlReport(pages, html);
+  return true;
+}
+
+// Both files in their temporaries, then renamed one after the other: a signal while they are
+// written ends the process with neither; one while they are renamed comes too late to stop
+// them (deferred, and then ignored), so there is never one without the other. False after
+// saying which failed.
+bool WriteOutputs(const EvaluateOptions& o, const nlohmann::json& report,
+                  const std::string& html_text, std::ostream& err) {
   std::vector<std::pair<std::string, std::unique_ptr<io::AtomicFile>>> outputs;
   if (!o.report_path.empty()) {
     outputs.emplace_back(o.report_path, std::make_unique<io::AtomicFile>(o.report_path));
@@ -244,25 +259,22 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
   }
   for (const auto& [path, file] : outputs) {
     if (file->error().empty()) continue;
-    io.err << path << ": error: " << file->Commit() << "\n";
-    return kExitBadInput;
+    err << path << ": error: " << file->Commit() << "\n";
+    return false;
   }
-  {
-    const io::DeferInterrupts too_late;
-    for (const auto& [path, file] : outputs) {
-      if (const std::string e = file->Commit(); !e.empty()) {
-        io.err << path << ": error: " << e << "\n";
-        return kExitBadInput;
-      }
+  const io::DeferInterrupts too_late;
+  for (const auto& [path, file] : outputs) {
+    if (const std::string e = file->Commit(); !e.empty()) {
+      err << path << ": error: " << e << "\n";
+      return false;
     }
   }
-  const bool all_feasible =
-      std::all_of(results.begin(), results.end(),
-                  [](const batch::Evaluated& e) { return e.judgement.feasible; });
-  if (o.json) {
-    io.out << report.dump(2) << "\n";
-    return all_feasible ? kExitOk : kExitNegative;
-  }
+  return true;
+}
+
+// Each plan's verdicts, then a summary of the batch: counts, trajectory time and speed.
+void PrintText(const EvaluateOptions& o, const std::vector<batch::Evaluated>& results,
+               double wall_s, int jobs, std::ostream& out) {
   const bool colour = isatty(STDOUT_FILENO) != 0;
   std::ostringstream t;
   t << std::setprecision(3);
@@ -283,7 +295,45 @@ int RunEvaluate(const EvaluateOptions& o, Streams io) {
     << "x real time per core)\n";
   if (!o.report_path.empty()) t << "report written to " << o.report_path << "\n";
   if (!o.html_path.empty()) t << "HTML report written to " << o.html_path << "\n";
-  io.out << t.str();
+  out << t.str();
+}
+
+int RunEvaluate(const EvaluateOptions& o, Streams io) {
+  batch::PlanSet set;
+  std::vector<io::PlanLoadResult> loaded;
+  if (!LoadPlans(o, io.err, set, loaded)) return kExitBadInput;
+  if (!HtmlToolsPresent(o, io.err)) return kExitBadInput;
+  const std::vector<std::string>& files = set.files;
+  const int jobs = std::clamp(o.jobs > 0 ? o.jobs : int(std::thread::hardware_concurrency()), 1,
+                              std::max<int>(1, int(files.size())));
+  // Ctrl-C (SIGINT) or SIGTERM during the batch: the plans being judged finish, no new one
+  // starts, and no report is written (a report is complete or absent, never half of a batch).
+  // A second signal ends the process at once (io/interrupt.hpp).
+  std::optional<io::DeferInterrupts> defer_interrupts;
+  defer_interrupts.emplace();
+  // With --html each judged replay is recorded as it runs (no second replay).
+  std::vector<report::ReplayRecorder> recorders(o.html_path.empty() ? 0 : files.size());
+  const batch::BatchResult judged = JudgePlans(o, files, loaded, jobs, recorders, io.err);
+  if (const int exit = CheckAllJudged(o, judged, files.size(), io.err); exit != kExitOk)
+    return exit;
+  const std::vector<batch::Evaluated>& results = judged.results;
+  // From here a signal ends the process at once (the page and the graphs take seconds); the
+  // outputs are made in memory and written last, so an interruption leaves none of them.
+  io::SetInterruptMessage("tubeplan evaluate: interrupted; no report written" +
+                          OutputsLeftAsTheyWere(o));
+  defer_interrupts.reset();
+  const nlohmann::json report = batch::ToJson(results, ScopeOf(set));
+  std::string html_text;
+  if (!o.html_path.empty() && !FormatHtml(o, results, loaded, jobs, recorders, html_text, io.err))
+    return kExitBadInput;
+  if (!WriteOutputs(o, report, html_text, io.err)) return kExitBadInput;
+  const bool all_feasible =
+      std::all_of(results.begin(), results.end(),
+                  [](const batch::Evaluated& e) { return e.judgement.feasible; });
+  if (o.json)
+    io.out << report.dump(2) << "\n";
+  else
+    PrintText(o, results, judged.wall_s, jobs, io.out);
   return all_feasible ? kExitOk : kExitNegative;
 }
 
