@@ -385,16 +385,8 @@ void CheckStart(Reader& r, const scene::Scene& s, const YAML::Mark& at, bool bod
   }
 }
 
-void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
-  const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
-                                        "friction", "parts", "start",     "goal",
-                                        "device",   "model", "workspace", "heuristics"};
-  if (!root.IsMap()) {
-    r.Error(root, std::string("a scene file must be a map, found ") + KindName(root) +
-                      ", expected keys such as tubeplan, name, tube, parts");
-    return;
-  }
-  r.ExpectMap(root, "scene", top);
+// The format version and the scene's name.
+void ReadHeader(Reader& r, const YAML::Node& root, scene::Scene& s) {
   if (const YAML::Node n = r.Get(root, "tubeplan", "scene", true); n.IsDefined()) {
     if (!n.IsScalar() || n.Scalar() != "1") {
       r.Error(n, "unsupported format version " +
@@ -408,99 +400,87 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
       if (s.name.empty()) r.Error(n, "name must not be empty");
     }
   }
-  bool tube_ok = false;  // every tube key read and valid: its body can be placed
-  if (const YAML::Node t = r.Get(root, "tube", "scene", true); t.IsDefined()) {
-    const std::string w = "tube";
-    if (r.ExpectMap(
-            t, w, {"outer_radius", "inner_radius", "length", "youngs_modulus", "poisson_ratio"})) {
-      model::TubeSpec& spec = s.tube;
-      // Keys read cleanly; the model's rules are checked only on those, so that a value that
-      // failed to parse is not reported a second time as "must be greater than zero".
-      std::set<std::string> read;
-      auto field = [&](const char* key, Dimension dimension, double& target) {
-        if (r.Field(t, key, w, dimension, true, target) && r.Get(t, key, w, false).IsDefined())
-          read.insert(key);
-      };
-      field("outer_radius", dim::kLength, spec.outer_radius_m);
-      field("inner_radius", dim::kLength, spec.inner_radius_m);
-      field("length", dim::kLength, spec.length_m);
-      field("youngs_modulus", dim::kPressure, spec.youngs_modulus_Pa);
-      field("poisson_ratio", dim::kNone, spec.poisson_ratio);
-      // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
-      const std::vector<std::string> problems = model::ValidateTubeSpec(spec);
-      tube_ok = read.size() == 5 && problems.empty();
-      for (const std::string& problem : problems) {
-        const std::string key = problem.substr(0, problem.find(' '));
-        const YAML::Node at = r.Get(t, key, w, false);
-        if (at.IsDefined()) {
-          if (read.count(key) == 0) continue;
-          // r2 >= r1 is only meaningful when r1 itself was read.
-          if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
-          r.Error(at, "tube." + TubeValuesAsWritten(r, t, problem));
-        } else if (read.size() == 5) {
-          r.Error(t, "tube " + problem);  // about the section as a whole
-        }
-      }
+}
+
+// The tube's section; true when every tube key was read and valid: its body can be placed.
+bool ReadTube(Reader& r, const YAML::Node& t, model::TubeSpec& spec) {
+  const std::string w = "tube";
+  if (!r.ExpectMap(t, w,
+                   {"outer_radius", "inner_radius", "length", "youngs_modulus", "poisson_ratio"}))
+    return false;
+  // Keys read cleanly; the model's rules are checked only on those, so that a value that
+  // failed to parse is not reported a second time as "must be greater than zero".
+  std::set<std::string> read;
+  auto field = [&](const char* key, Dimension dimension, double& target) {
+    if (r.Field(t, key, w, dimension, true, target) && r.Get(t, key, w, false).IsDefined())
+      read.insert(key);
+  };
+  field("outer_radius", dim::kLength, spec.outer_radius_m);
+  field("inner_radius", dim::kLength, spec.inner_radius_m);
+  field("length", dim::kLength, spec.length_m);
+  field("youngs_modulus", dim::kPressure, spec.youngs_modulus_Pa);
+  field("poisson_ratio", dim::kNone, spec.poisson_ratio);
+  // The model's own rules, each reported at the key it names ("inner_radius (...) ...").
+  const std::vector<std::string> problems = model::ValidateTubeSpec(spec);
+  for (const std::string& problem : problems) {
+    const std::string key = problem.substr(0, problem.find(' '));
+    const YAML::Node at = r.Get(t, key, w, false);
+    if (at.IsDefined()) {
+      if (read.count(key) == 0) continue;
+      // r2 >= r1 is only meaningful when r1 itself was read.
+      if (key == "inner_radius" && read.count("outer_radius") == 0) continue;
+      r.Error(at, "tube." + TubeValuesAsWritten(r, t, problem));
+    } else if (read.size() == 5) {
+      r.Error(t, "tube " + problem);  // about the section as a whole
     }
   }
-  if (const YAML::Node c = r.Get(root, "contact", "scene", false); c.IsDefined()) {
-    const std::string w = "contact";
-    if (r.ExpectMap(c, w, {"stiffness", "threshold", "bend_threshold"})) {
-      auto positive = [&](const std::string& key, Dimension dimension, double& target) {
-        if (r.Field(c, key, w, dimension, false, target) && target <= 0.0)
-          r.Error(r.Get(c, key, w, false), w + "." + key + " must be greater than zero");
-      };
-      positive("stiffness", dim::kStiffness, s.contact.stiffness_N_per_m);
-      positive("threshold", dim::kLength, s.contact.threshold_m);
-      positive("bend_threshold", dim::kLength, s.contact.bend_threshold_m);
-    }
+  return read.size() == 5 && problems.empty();
+}
+
+void ReadContact(Reader& r, const YAML::Node& c, scene::Contact& contact) {
+  const std::string w = "contact";
+  if (!r.ExpectMap(c, w, {"stiffness", "threshold", "bend_threshold"})) return;
+  auto positive = [&](const std::string& key, Dimension dimension, double& target) {
+    if (r.Field(c, key, w, dimension, false, target) && target <= 0.0)
+      r.Error(r.Get(c, key, w, false), w + "." + key + " must be greater than zero");
+  };
+  positive("stiffness", dim::kStiffness, contact.stiffness_N_per_m);
+  positive("threshold", dim::kLength, contact.threshold_m);
+  positive("bend_threshold", dim::kLength, contact.bend_threshold_m);
+}
+
+// The held end's start pose. `start_mark`: where its position is written, once it and its turn
+// were read cleanly; `held_end_inside`: per part, whether the held end starts inside it
+// (reported here).
+void ReadStart(Reader& r, const YAML::Node& st, scene::Scene& s, bool parts_ok,
+               std::optional<YAML::Mark>& start_mark, std::vector<bool>& held_end_inside) {
+  const std::string w = "start";
+  if (!r.ExpectMap(st, w, {"position", "rpy"})) return;
+  Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
+  bool rpy_ok = true;
+  if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined()) {
+    const auto a = ReadRpy(r, n, "start.rpy");
+    if (a) rpy = *a;
+    rpy_ok = a.has_value();
   }
-  if (const YAML::Node f = r.Get(root, "friction", "scene", false); f.IsDefined()) {
-    if (const auto friction = ReadFriction(r, f, "friction")) s.friction = *friction;
+  const YAML::Node n = r.Get(st, "position", w, true);
+  if (!n.IsDefined()) return;
+  const auto p = r.Vector(n, "start.position", dim::kLength);
+  if (!p) return;
+  s.X_WH_start = Pose(*p, rpy);
+  if (rpy_ok) start_mark = n.Mark();
+  if (!parts_ok) return;
+  for (std::size_t i = 0; i < s.parts.size(); ++i) {
+    if (!PointInside(s.parts[i], *p, kGeometryTolerance_m)) continue;
+    held_end_inside[i] = true;
+    r.Error(n, "start.position is inside part '" + s.parts[i].name +
+                   "', expected the held end outside every part");
   }
-  bool parts_ok = true;
-  if (const YAML::Node p = r.Get(root, "parts", "scene", true); p.IsDefined()) {
-    ReadParts(r, p, s, parts_ok);
-  } else {
-    parts_ok = false;
-  }
-  // Where the start's position is written, once it and the start's turn were read cleanly.
-  std::optional<YAML::Mark> start_mark;
-  std::vector<bool> held_end_inside(s.parts.size(), false);
-  if (const YAML::Node st = r.Get(root, "start", "scene", true); st.IsDefined()) {
-    const std::string w = "start";
-    if (r.ExpectMap(st, w, {"position", "rpy"})) {
-      Eigen::Vector3d rpy = Eigen::Vector3d::Zero();
-      bool rpy_ok = true;
-      if (const YAML::Node n = r.Get(st, "rpy", w, false); n.IsDefined()) {
-        const auto a = ReadRpy(r, n, "start.rpy");
-        if (a) rpy = *a;
-        rpy_ok = a.has_value();
-      }
-      if (const YAML::Node n = r.Get(st, "position", w, true); n.IsDefined()) {
-        if (const auto p = r.Vector(n, "start.position", dim::kLength)) {
-          s.X_WH_start = Pose(*p, rpy);
-          if (rpy_ok) start_mark = n.Mark();
-          if (parts_ok) {
-            for (std::size_t i = 0; i < s.parts.size(); ++i) {
-              if (!PointInside(s.parts[i], *p, kGeometryTolerance_m)) continue;
-              held_end_inside[i] = true;
-              r.Error(n, "start.position is inside part '" + s.parts[i].name +
-                             "', expected the held end outside every part");
-            }
-          }
-        }
-      }
-    }
-  }
-  if (const YAML::Node g = r.Get(root, "goal", "scene", true); g.IsDefined())
-    ReadGoal(r, g, s, parts_ok);
-  if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsDefined())
-    ReadDevice(r, d, s.device);
-  if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
-    ReadModel(r, m, s.model);
-  // The core keeps its elements at least r1 long (docs/core.md, "Contact points"): a count
-  // beyond that is said, with the count it uses.
+}
+
+// The core keeps its elements at least r1 long (docs/core.md, "Contact points"): a count
+// beyond that is said, with the count it uses.
+void WarnElementCount(Reader& r, const YAML::Node& root, const scene::Scene& s) {
   if (s.model.elements > 0 && s.model.elements != core::ElementCount(s) && s.tube.length_m > 0.0 &&
       s.tube.outer_radius_m > 0.0) {
     const YAML::Node n = r.Get(r.Get(root, "model", "scene", false), "elements", "model", false);
@@ -510,7 +490,10 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
                      " (at most length / outer_radius, so that a side's contact stays off the "
                      "end face)");
   }
-  // A contact band as wide as the tube makes every element near a part a PC of it.
+}
+
+// A contact band as wide as the tube makes every element near a part a PC of it.
+void WarnContactBand(Reader& r, const YAML::Node& root, const scene::Scene& s) {
   if (s.tube.outer_radius_m > 0.0 && s.contact.threshold_m >= s.tube.outer_radius_m) {
     std::ostringstream m;
     m << "contact.threshold " << s.contact.threshold_m * 1e3
@@ -519,8 +502,11 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
          "does not touch; expected a threshold well below the radius (the paper's 1 mm)";
     r.Warning(r.Get(root, "contact", "scene", false), m.str());
   }
-  // The penalty's force at a part's middle, K (eps + half its thickness): below the device's
-  // force, a full push can carry the tube out the part's far side.
+}
+
+// The penalty's force at a part's middle, K (eps + half its thickness): below the device's
+// force, a full push can carry the tube out the part's far side. Said for the first such part.
+void WarnThinParts(Reader& r, const YAML::Node& root, const scene::Scene& s) {
   for (const scene::BoxPart& part : s.parts) {
     const double hold_N = scene::ContactHoldAtMiddle_N(s, part);
     if (!(hold_N < s.device.max_force_N) || part.size_m.minCoeff() <= 0.0) continue;
@@ -533,41 +519,86 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
     r.Warning(r.Get(root, "contact", "scene", false), m.str());
     break;
   }
+}
+
+// The coupling a scene asks for must be passive on its device at its step (docs/scene-format.md,
+// "Device"): an active coupling makes the device oscillate in the operator's hand.
+void CheckCouplingPassive(Reader& r, const YAML::Node& root, const scene::Scene& s) {
+  const YAML::Node d = r.Get(root, "device", "scene", false);
+  if (!d.IsMap()) return;
+  const YAML::Node coupling = r.Get(d, "coupling", "device", false);
+  const core::Coupling c = core::ResolveCoupling(s.device, s.model.time_step_s);
+  if (coupling.IsDefined() && c.stiffness_N_per_m > 0.0 &&
+      !core::IsPassive(s.device.damping_Ns_per_m, c, s.model.time_step_s)) {
+    std::ostringstream m;
+    m << "device.coupling (" << c.stiffness_N_per_m << " N/m, " << c.damping_Ns_per_m
+      << " N s/m) is not passive at a " << s.model.time_step_s * 1e3
+      << " ms step: the device's damping " << s.device.damping_Ns_per_m
+      << " N s/m must exceed K T / 2 + |B| = "
+      << c.stiffness_N_per_m * s.model.time_step_s / 2.0 + std::abs(c.damping_Ns_per_m)
+      << " N s/m, expected a softer spring or less coupling damping";
+    r.Error(coupling, m.str());
+  }
+}
+
+void ReadWorkspace(Reader& r, const YAML::Node& ws, scene::Scene& s) {
+  if (!r.ExpectMap(ws, "workspace", {"min", "max"})) return;
+  const YAML::Node lo = r.Get(ws, "min", "workspace", true);
+  const YAML::Node hi = r.Get(ws, "max", "workspace", true);
+  std::optional<Eigen::Vector3d> min, max;
+  if (lo.IsDefined()) min = r.Vector(lo, "workspace.min", dim::kLength);
+  if (hi.IsDefined()) max = r.Vector(hi, "workspace.max", dim::kLength);
+  if (!min || !max) return;
+  if (((*max - *min).array() <= 0.0).any()) {
+    r.Error(hi, "workspace.max must exceed workspace.min along every axis");
+  } else {
+    s.workspace = scene::Workspace{*min, *max};
+  }
+}
+
+void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
+  const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
+                                        "friction", "parts", "start",     "goal",
+                                        "device",   "model", "workspace", "heuristics"};
+  if (!root.IsMap()) {
+    r.Error(root, std::string("a scene file must be a map, found ") + KindName(root) +
+                      ", expected keys such as tubeplan, name, tube, parts");
+    return;
+  }
+  r.ExpectMap(root, "scene", top);
+  ReadHeader(r, root, s);
+  bool tube_ok = false;  // every tube key read and valid: its body can be placed
+  if (const YAML::Node t = r.Get(root, "tube", "scene", true); t.IsDefined())
+    tube_ok = ReadTube(r, t, s.tube);
+  if (const YAML::Node c = r.Get(root, "contact", "scene", false); c.IsDefined())
+    ReadContact(r, c, s.contact);
+  if (const YAML::Node f = r.Get(root, "friction", "scene", false); f.IsDefined()) {
+    if (const auto friction = ReadFriction(r, f, "friction")) s.friction = *friction;
+  }
+  bool parts_ok = true;
+  if (const YAML::Node p = r.Get(root, "parts", "scene", true); p.IsDefined()) {
+    ReadParts(r, p, s, parts_ok);
+  } else {
+    parts_ok = false;
+  }
+  std::optional<YAML::Mark> start_mark;
+  std::vector<bool> held_end_inside(s.parts.size(), false);
+  if (const YAML::Node st = r.Get(root, "start", "scene", true); st.IsDefined())
+    ReadStart(r, st, s, parts_ok, start_mark, held_end_inside);
+  if (const YAML::Node g = r.Get(root, "goal", "scene", true); g.IsDefined())
+    ReadGoal(r, g, s, parts_ok);
+  if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsDefined())
+    ReadDevice(r, d, s.device);
+  if (const YAML::Node m = r.Get(root, "model", "scene", false); m.IsDefined())
+    ReadModel(r, m, s.model);
+  WarnElementCount(r, root, s);
+  WarnContactBand(r, root, s);
+  WarnThinParts(r, root, s);
   if (const YAML::Node h = r.Get(root, "heuristics", "scene", false); h.IsDefined())
     ReadHeuristics(r, h, s.heuristics);
-  // The coupling a scene asks for must be passive on its device at its step (docs/scene-format.md,
-  // "Device"): an active coupling makes the device oscillate in the operator's hand.
-  if (const YAML::Node d = r.Get(root, "device", "scene", false); d.IsMap()) {
-    const YAML::Node coupling = r.Get(d, "coupling", "device", false);
-    const core::Coupling c = core::ResolveCoupling(s.device, s.model.time_step_s);
-    if (coupling.IsDefined() && c.stiffness_N_per_m > 0.0 &&
-        !core::IsPassive(s.device.damping_Ns_per_m, c, s.model.time_step_s)) {
-      std::ostringstream m;
-      m << "device.coupling (" << c.stiffness_N_per_m << " N/m, " << c.damping_Ns_per_m
-        << " N s/m) is not passive at a " << s.model.time_step_s * 1e3
-        << " ms step: the device's damping " << s.device.damping_Ns_per_m
-        << " N s/m must exceed K T / 2 + |B| = "
-        << c.stiffness_N_per_m * s.model.time_step_s / 2.0 + std::abs(c.damping_Ns_per_m)
-        << " N s/m, expected a softer spring or less coupling damping";
-      r.Error(coupling, m.str());
-    }
-  }
-  if (const YAML::Node ws = r.Get(root, "workspace", "scene", false); ws.IsDefined()) {
-    if (r.ExpectMap(ws, "workspace", {"min", "max"})) {
-      const YAML::Node lo = r.Get(ws, "min", "workspace", true);
-      const YAML::Node hi = r.Get(ws, "max", "workspace", true);
-      std::optional<Eigen::Vector3d> min, max;
-      if (lo.IsDefined()) min = r.Vector(lo, "workspace.min", dim::kLength);
-      if (hi.IsDefined()) max = r.Vector(hi, "workspace.max", dim::kLength);
-      if (min && max) {
-        if (((*max - *min).array() <= 0.0).any()) {
-          r.Error(hi, "workspace.max must exceed workspace.min along every axis");
-        } else {
-          s.workspace = scene::Workspace{*min, *max};
-        }
-      }
-    }
-  }
+  CheckCouplingPassive(r, root, s);
+  if (const YAML::Node ws = r.Get(root, "workspace", "scene", false); ws.IsDefined())
+    ReadWorkspace(r, ws, s);
   if (start_mark) CheckStart(r, s, *start_mark, tube_ok && parts_ok, held_end_inside);
 }
 
