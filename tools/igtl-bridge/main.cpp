@@ -114,12 +114,8 @@ double Percentile(std::vector<double> values, double fraction) {
   return values[std::min(values.size() - 1, rank == 0 ? 0 : rank - 1)];
 }
 
-int Run(const Options& o) {
-  const tubeplan::io::TrajectoryLoadResult loaded = tubeplan::io::LoadTrajectoryFile(o.trajectory);
-  std::cerr << loaded.diagnostics.FormatAll();
-  if (!loaded.trajectory) return 2;
-  const tubeplan::plan::Trajectory& trajectory = *loaded.trajectory;
-
+// A socket listening on --bind:--port, its port said on stdout's first line; -1 after saying why.
+int Listen(const Options& o) {
   const int listener = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   const int one = 1;
   setsockopt(listener, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
@@ -128,201 +124,248 @@ int Run(const Options& o) {
   address.sin_port = htons(std::uint16_t(o.port));
   if (inet_pton(AF_INET, o.bind.c_str(), &address.sin_addr) != 1) {
     std::cerr << "igtl-bridge: error: --bind \"" << o.bind << "\" is not an IPv4 address\n";
-    return 2;
+    return -1;
   }
   if (bind(listener, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 ||
       listen(listener, 1) != 0) {
     std::cerr << "igtl-bridge: error: cannot listen on " << o.bind << ":" << o.port << ": "
               << std::strerror(errno) << "\n";
-    return 2;
+    return -1;
   }
   socklen_t length = sizeof address;
   getsockname(listener, reinterpret_cast<sockaddr*>(&address), &length);
   // The first line of stdout: the port (a test asks for port 0 and reads which it got).
   std::cout << "igtl-bridge: listening on " << o.bind << ":" << ntohs(address.sin_port)
             << std::endl;
+  return listener;
+}
 
+// The one client, within --accept-timeout, sent to without Nagle's delay; -1 after saying why.
+int AcceptOne(const Options& o, int listener) {
   pollfd wait{listener, POLLIN, 0};
   if (poll(&wait, 1, int(o.accept_timeout_s * 1000)) <= 0) {
     std::cerr << "igtl-bridge: error: no client within " << o.accept_timeout_s << " s\n";
-    return 1;
+    return -1;
   }
   const int fd = accept4(listener, nullptr, nullptr, SOCK_CLOEXEC);
   close(listener);
   if (fd < 0) {
     std::cerr << "igtl-bridge: error: accept: " << std::strerror(errno) << "\n";
-    return 1;
+    return -1;
   }
+  const int one = 1;
   setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &one, sizeof one);
+  return fd;
+}
 
+// The link's state: the messages reused, the bytes waiting, what was sent and received.
+struct Link {
+  int fd = -1;
   igtl::TransformMessage::Pointer transform = igtl::TransformMessage::New();
-  transform->SetDeviceName("igtl-bridge");
   igtl::MessageHeader::Pointer header = igtl::MessageHeader::New();
   igtl::SensorMessage::Pointer sensor = igtl::SensorMessage::New();
-  std::vector<unsigned char> in;
+  std::vector<unsigned char> in;    // received, not yet a whole message
+  std::vector<unsigned char> held;  // poses held back in a pause
   std::vector<Wrench> wrenches;
   long poses = 0, bad_crc = 0, other = 0;
   // Poses sampled (the trajectory's index), dropped, held back in a pause, pauses begun.
   long samples = 0, dropped = 0, delayed = 0, pauses = 0;
+  std::int64_t start_ns = 0, start_realtime_ns = 0;  // the first pose's clocks
+};
+
+// Packs pose `s` into the link's TRANSFORM message, stamped `stamp_ns` (wall clock).
+void PackPose(Link& link, const tubeplan::plan::HandSample& s, std::int64_t stamp_ns) {
+  igtl::Matrix4x4 m;
+  const Eigen::Matrix3d R = s.q_WH.normalized().toRotationMatrix();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m[i][j] = float(R(i, j));
+    m[i][3] = float(s.p_WH_m[i] * 1e3);  // mm, as OpenIGTLink has it
+    m[3][i] = 0.0f;
+  }
+  m[3][3] = 1.0f;
+  link.transform->SetMatrix(m);
+  unsigned seconds = 0, fraction = 0;
+  SplitNs(stamp_ns, seconds, fraction);
+  link.transform->SetTimeStamp(seconds, fraction);
+  link.transform->Pack();
+}
+
+// Sends the next sample's pose, or drops it, or holds it back in a pause (the faults asked
+// for). False, with `ended` said, when the connection fails.
+bool SendPose(const Options& o, const tubeplan::plan::Trajectory& trajectory, double t0,
+              std::size_t& cursor, Link& link, std::string& ended) {
+  const std::int64_t period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
   const long hold_count = std::lround(o.delay_ms * 1e-3 * o.rate_hz);
-  std::vector<unsigned char> held;
+  // The pose of the trajectory at this tick's time; held at its last pose after its end.
+  const tubeplan::plan::HandSample s =
+      tubeplan::plan::PoseAt(trajectory, t0 + double(link.samples) / o.rate_hz, cursor);
+  // Stamped with its sample time, start + n / rate, as a device stamps its samples: the
+  // client's finite-difference velocity then sees the trajectory's, not this process's
+  // scheduling; the round trip counts from it, so any lateness of this send is in it.
+  PackPose(link, s, link.start_realtime_ns + link.samples * period_ns);
+  const auto* packed = static_cast<const unsigned char*>(link.transform->GetPackPointer());
+  const auto packed_size = std::size_t(link.transform->GetPackSize());
+  // Faults: a pose lost, or held back in a pause and sent with the pose after it.
+  const long in_pause = link.samples % o.delay_every;
+  const bool hold = hold_count > 0 && link.samples >= o.delay_every && in_pause < hold_count;
+  link.pauses += hold && in_pause == 0;
+  if (o.drop_probability > 0.0 &&
+      Uniform(o.seed, std::uint64_t(link.samples)) < o.drop_probability) {
+    ++link.dropped;
+  } else if (hold) {
+    link.held.insert(link.held.end(), packed, packed + packed_size);
+    ++link.delayed;
+  } else {
+    if (!link.held.empty() && !SendAll(link.fd, link.held.data(), link.held.size())) {
+      ended = std::string("sending: ") + std::strerror(errno);
+      return false;
+    }
+    link.poses += long(link.held.size() / packed_size);
+    link.held.clear();
+    if (!SendAll(link.fd, packed, packed_size)) {
+      ended = std::string("sending: ") + std::strerror(errno);
+      return false;
+    }
+    ++link.poses;
+  }
+  ++link.samples;
+  return true;
+}
+
+// Unpacks the whole messages in `link.in` (arrived at `arrived_ns`, wall clock), keeping the
+// wrenches and counting the others, and leaves the rest of a message for the next bytes.
+void TakeMessages(Link& link, std::int64_t arrived_ns) {
+  std::vector<unsigned char>& in = link.in;
+  std::size_t used = 0;
+  while (in.size() - used >= IGTL_HEADER_SIZE) {
+    igtl_header raw;
+    std::memcpy(&raw, in.data() + used, IGTL_HEADER_SIZE);
+    igtl_header_convert_byte_order(&raw);
+    if (in.size() - used < IGTL_HEADER_SIZE + raw.body_size) break;
+    link.header->InitPack();
+    std::memcpy(link.header->GetPackPointer(), in.data() + used, IGTL_HEADER_SIZE);
+    link.header->Unpack();
+    if (std::strcmp(link.header->GetDeviceType(), "SENSOR") == 0) {
+      igtl::SensorMessage::Pointer& sensor = link.sensor;
+      sensor->SetMessageHeader(link.header);
+      sensor->AllocatePack();
+      std::memcpy(sensor->GetPackBodyPointer(), in.data() + used + IGTL_HEADER_SIZE,
+                  std::size_t(raw.body_size));
+      if (!(sensor->Unpack(1) & igtl::MessageHeader::UNPACK_BODY) || sensor->GetLength() != 3) {
+        ++link.bad_crc;
+      } else {
+        const std::string name = sensor->GetDeviceName();
+        unsigned seconds = 0, fraction = 0;
+        sensor->GetTimeStamp(&seconds, &fraction);
+        const std::int64_t echoed_ns =
+            std::int64_t(seconds) * 1'000'000'000 + igtl_frac_to_nanosec(fraction);
+        link.wrenches.push_back({double(NowNs(CLOCK_MONOTONIC) - link.start_ns) * 1e-9,
+                                 name == "tubeplan_force", sensor->GetValue(0), sensor->GetValue(1),
+                                 sensor->GetValue(2),
+                                 seconds != 0 ? double(arrived_ns - echoed_ns) * 1e-3 : -1.0});
+      }
+    } else {
+      ++link.other;
+    }
+    used += IGTL_HEADER_SIZE + std::size_t(raw.body_size);
+  }
+  in.erase(in.begin(), in.begin() + std::ptrdiff_t(used));
+}
+
+// Streams the poses on absolute deadlines and takes the wrenches between them, until the client
+// closes, a fault option or a signal ends it, or the link fails; returns what ended it.
+std::string Stream(const Options& o, const tubeplan::plan::Trajectory& trajectory, Link& link) {
   const auto period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
-  const std::int64_t start_ns = NowNs(CLOCK_MONOTONIC);
-  const std::int64_t start_realtime_ns = NowNs(CLOCK_REALTIME);
-  std::int64_t next_ns = start_ns;
+  link.start_ns = NowNs(CLOCK_MONOTONIC);
+  link.start_realtime_ns = NowNs(CLOCK_REALTIME);
+  std::int64_t next_ns = link.start_ns;
   std::size_t cursor = 0;
   const double t0 = trajectory.samples.front().t_s;
-  std::string ended = "the client closed the connection";
   for (;;) {
-    if (g_signal.load() != 0) {
-      ended = "a signal";
-      break;
-    }
+    if (g_signal.load() != 0) return "a signal";
     const std::int64_t now_ns = NowNs(CLOCK_MONOTONIC);
-    const double elapsed_s = double(now_ns - start_ns) * 1e-9;
-    if (o.close_after_s > 0.0 && elapsed_s >= o.close_after_s) {
-      ended = "--close-after";
-      break;
-    }
-    if (elapsed_s >= o.max_time_s) {
-      ended = "--max-time";
-      break;
-    }
+    const double elapsed_s = double(now_ns - link.start_ns) * 1e-9;
+    if (o.close_after_s > 0.0 && elapsed_s >= o.close_after_s) return "--close-after";
+    if (elapsed_s >= o.max_time_s) return "--max-time";
     if (now_ns >= next_ns) {
       const bool streaming = !(o.stop_after_s > 0.0 && elapsed_s >= o.stop_after_s);
       if (streaming) {
-        // The pose of the trajectory at this tick's time; held at its last pose after its end.
-        const tubeplan::plan::HandSample s =
-            tubeplan::plan::PoseAt(trajectory, t0 + double(samples) / o.rate_hz, cursor);
-        igtl::Matrix4x4 m;
-        const Eigen::Matrix3d R = s.q_WH.normalized().toRotationMatrix();
-        for (int i = 0; i < 3; ++i) {
-          for (int j = 0; j < 3; ++j) m[i][j] = float(R(i, j));
-          m[i][3] = float(s.p_WH_m[i] * 1e3);  // mm, as OpenIGTLink has it
-          m[3][i] = 0.0f;
-        }
-        m[3][3] = 1.0f;
-        transform->SetMatrix(m);
-        // Stamped with its sample time, start + n / rate, as a device stamps its samples: the
-        // client's finite-difference velocity then sees the trajectory's, not this process's
-        // scheduling; the round trip counts from it, so any lateness of this send is in it.
-        unsigned seconds = 0, fraction = 0;
-        SplitNs(start_realtime_ns + samples * period_ns, seconds, fraction);
-        transform->SetTimeStamp(seconds, fraction);
-        transform->Pack();
-        const auto* packed = static_cast<const unsigned char*>(transform->GetPackPointer());
-        const auto packed_size = std::size_t(transform->GetPackSize());
-        // Faults: a pose lost, or held back in a pause and sent with the pose after it.
-        const long in_pause = samples % o.delay_every;
-        const bool hold = hold_count > 0 && samples >= o.delay_every && in_pause < hold_count;
-        pauses += hold && in_pause == 0;
-        if (o.drop_probability > 0.0 &&
-            Uniform(o.seed, std::uint64_t(samples)) < o.drop_probability) {
-          ++dropped;
-        } else if (hold) {
-          held.insert(held.end(), packed, packed + packed_size);
-          ++delayed;
-        } else {
-          if (!held.empty() && !SendAll(fd, held.data(), held.size())) {
-            ended = std::string("sending: ") + std::strerror(errno);
-            break;
-          }
-          poses += long(held.size() / packed_size);
-          held.clear();
-          if (!SendAll(fd, packed, packed_size)) {
-            ended = std::string("sending: ") + std::strerror(errno);
-            break;
-          }
-          ++poses;
-        }
-        ++samples;
+        std::string failed;
+        if (!SendPose(o, trajectory, t0, cursor, link, failed)) return failed;
       }
       next_ns += period_ns;
       // Absolute deadlines; after a stall of more than 100 ms start afresh instead of bursting.
       if (now_ns - next_ns > 100'000'000) next_ns = now_ns + period_ns;
     }
     // Wait for a wrench until the next deadline.
-    pollfd p{fd, POLLIN, 0};
+    pollfd p{link.fd, POLLIN, 0};
     const std::int64_t wait_ns = std::max<std::int64_t>(0, next_ns - NowNs(CLOCK_MONOTONIC));
     timespec timeout{time_t(wait_ns / 1'000'000'000), long(wait_ns % 1'000'000'000)};
     if (ppoll(&p, 1, &timeout, nullptr) <= 0) continue;
     unsigned char chunk[4096];
-    const ssize_t got = recv(fd, chunk, sizeof chunk, 0);
-    if (got == 0) break;
+    const ssize_t got = recv(link.fd, chunk, sizeof chunk, 0);
+    if (got == 0) return "the client closed the connection";
     if (got < 0) {
       if (errno == EINTR || errno == EAGAIN) continue;
-      ended = std::string("receiving: ") + std::strerror(errno);
-      break;
+      return std::string("receiving: ") + std::strerror(errno);
     }
     const std::int64_t arrived_ns = NowNs(CLOCK_REALTIME);
-    in.insert(in.end(), chunk, chunk + got);
-    std::size_t used = 0;
-    while (in.size() - used >= IGTL_HEADER_SIZE) {
-      igtl_header raw;
-      std::memcpy(&raw, in.data() + used, IGTL_HEADER_SIZE);
-      igtl_header_convert_byte_order(&raw);
-      if (in.size() - used < IGTL_HEADER_SIZE + raw.body_size) break;
-      header->InitPack();
-      std::memcpy(header->GetPackPointer(), in.data() + used, IGTL_HEADER_SIZE);
-      header->Unpack();
-      if (std::strcmp(header->GetDeviceType(), "SENSOR") == 0) {
-        sensor->SetMessageHeader(header);
-        sensor->AllocatePack();
-        std::memcpy(sensor->GetPackBodyPointer(), in.data() + used + IGTL_HEADER_SIZE,
-                    std::size_t(raw.body_size));
-        if (!(sensor->Unpack(1) & igtl::MessageHeader::UNPACK_BODY) || sensor->GetLength() != 3) {
-          ++bad_crc;
-        } else {
-          const std::string name = sensor->GetDeviceName();
-          unsigned seconds = 0, fraction = 0;
-          sensor->GetTimeStamp(&seconds, &fraction);
-          const std::int64_t echoed_ns =
-              std::int64_t(seconds) * 1'000'000'000 + igtl_frac_to_nanosec(fraction);
-          wrenches.push_back({double(NowNs(CLOCK_MONOTONIC) - start_ns) * 1e-9,
-                              name == "tubeplan_force", sensor->GetValue(0), sensor->GetValue(1),
-                              sensor->GetValue(2),
-                              seconds != 0 ? double(arrived_ns - echoed_ns) * 1e-3 : -1.0});
-        }
-      } else {
-        ++other;
-      }
-      used += IGTL_HEADER_SIZE + std::size_t(raw.body_size);
-    }
-    in.erase(in.begin(), in.begin() + std::ptrdiff_t(used));
+    link.in.insert(link.in.end(), chunk, chunk + got);
+    TakeMessages(link, arrived_ns);
   }
-  close(fd);
+}
 
+// --wrenches: every wrench received, one CSV row each.
+void WriteWrenches(const std::string& path, const std::vector<Wrench>& wrenches) {
+  std::ofstream out(path);
+  out << "t_s,kind,x,y,z,round_trip_us\n";
+  char row[256];
+  for (const Wrench& w : wrenches) {
+    std::snprintf(row, sizeof row, "%.6f,%s,%.17g,%.17g,%.17g,%.1f\n", w.t_s,
+                  w.force ? "force" : "torque", w.x, w.y, w.z, w.round_trip_us);
+    out << row;
+  }
+  if (!out) std::cerr << "igtl-bridge: error: cannot write " << path << "\n";
+}
+
+// The summary line: poses and faults, wrenches, the largest and last force, round trips.
+void PrintSummary(const std::string& ended, const Link& link) {
   std::vector<double> round_trips;
   double max_force_N = 0.0;
   const Wrench* last_force = nullptr;
   long forces = 0;
-  for (const Wrench& w : wrenches) {
+  for (const Wrench& w : link.wrenches) {
     if (!w.force) continue;
     ++forces;
     last_force = &w;
     max_force_N = std::max(max_force_N, std::sqrt(w.x * w.x + w.y * w.y + w.z * w.z));
     if (w.round_trip_us >= 0.0) round_trips.push_back(w.round_trip_us);
   }
-  if (!o.wrenches.empty()) {
-    std::ofstream out(o.wrenches);
-    out << "t_s,kind,x,y,z,round_trip_us\n";
-    char row[256];
-    for (const Wrench& w : wrenches) {
-      std::snprintf(row, sizeof row, "%.6f,%s,%.17g,%.17g,%.17g,%.1f\n", w.t_s,
-                    w.force ? "force" : "torque", w.x, w.y, w.z, w.round_trip_us);
-      out << row;
-    }
-    if (!out) std::cerr << "igtl-bridge: error: cannot write " << o.wrenches << "\n";
-  }
   std::printf(
       "igtl-bridge: ended (%s): sent %ld poses, dropped %ld, delayed %ld in %ld pauses; received "
       "%ld wrenches (%ld bad, %ld other messages); max |force| %.3f N, last force (%g, %g, %g) N; "
       "round trip pose to wrench: median %.0f us, p99 %.0f us, max %.0f us\n",
-      ended.c_str(), poses, dropped, delayed, pauses, forces, bad_crc, other, max_force_N,
-      last_force ? last_force->x : 0.0, last_force ? last_force->y : 0.0,
+      ended.c_str(), link.poses, link.dropped, link.delayed, link.pauses, forces, link.bad_crc,
+      link.other, max_force_N, last_force ? last_force->x : 0.0, last_force ? last_force->y : 0.0,
       last_force ? last_force->z : 0.0, Percentile(round_trips, 0.5), Percentile(round_trips, 0.99),
       Percentile(round_trips, 1.0));
-  return bad_crc == 0 ? 0 : 1;
+}
+
+int Run(const Options& o) {
+  const tubeplan::io::TrajectoryLoadResult loaded = tubeplan::io::LoadTrajectoryFile(o.trajectory);
+  std::cerr << loaded.diagnostics.FormatAll();
+  if (!loaded.trajectory) return 2;
+  const int listener = Listen(o);
+  if (listener < 0) return 2;
+  Link link;
+  link.fd = AcceptOne(o, listener);
+  if (link.fd < 0) return 1;
+  link.transform->SetDeviceName("igtl-bridge");
+  const std::string ended = Stream(o, *loaded.trajectory, link);
+  close(link.fd);
+  if (!o.wrenches.empty()) WriteWrenches(o.wrenches, link.wrenches);
+  PrintSummary(ended, link);
+  return link.bad_crc == 0 ? 0 : 1;
 }
 
 }  // namespace
