@@ -36,6 +36,55 @@ void ReadLimits(Reader& r, const YAML::Node& node, plan::Limits& l) {
         "a time from 1 ms to 3600 s, e.g. \"1 s\"");
 }
 
+// The format version, the plan's name and its limits.
+void ReadHeader(Reader& r, const YAML::Node& root, plan::Plan& p) {
+  if (const YAML::Node n = r.Get(root, "tubeplan", "plan file", true); n.IsDefined()) {
+    if (!n.IsScalar() || n.Scalar() != "1")
+      r.Error(n, "unsupported format version " +
+                     (n.IsScalar() ? Abbreviate(n.Scalar()) : std::string(KindName(n))) +
+                     ", expected 1");
+  }
+  if (const YAML::Node n = r.Get(root, "plan", "plan file", true); n.IsDefined())
+    if (auto name = r.String(n, "plan")) p.name = *name;
+  if (const YAML::Node n = r.Get(root, "limits", "plan file", false); n.IsDefined())
+    ReadLimits(r, n, p.limits);
+}
+
+// The planned states, start first and goal last, each checked against the scene's elements when
+// the scene was read: their text into the plan, the formations into `formations`.
+void ReadStates(Reader& r, const YAML::Node& n, const std::optional<scene::Scene>& scene,
+                plan::Plan& p, std::vector<states::ContactFormation>& formations) {
+  if (!n.IsSequence() || n.size() < 2) {
+    r.Error(n,
+            "states must be a sequence of at least two contact formations (start first, "
+            "goal last), found " +
+                (n.IsSequence() ? std::to_string(n.size()) + " items" : std::string(KindName(n))));
+    return;
+  }
+  const std::vector<scene::PartElement> elements =
+      scene ? scene::EnumerateElements(*scene) : std::vector<scene::PartElement>{};
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const std::string what = "states[" + std::to_string(i) + "]";
+    if (n[i].IsScalar() && n[i].Scalar() == "goal" && n[i].Tag() != "!") {
+      if (scene) {
+        formations.push_back(scene->goal);
+        p.states.push_back(states::ToString(scene->goal));
+      }
+      continue;
+    }
+    if (auto cf = r.Formation(n[i], what, scene ? &elements : nullptr)) {
+      p.states.push_back(states::ToString(*cf));
+      formations.push_back(std::move(*cf));
+    }
+  }
+  for (std::size_t i = 1; i < p.states.size(); ++i) {
+    if (p.states[i] == p.states[i - 1] && i < n.size())
+      r.Error(n[i], "states[" + std::to_string(i) +
+                        "] repeats the state before it, expected "
+                        "each planned state to differ from the one before");
+  }
+}
+
 }  // namespace
 
 PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& display_name,
@@ -72,16 +121,7 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
     return result;
   }
   r.ExpectMap(root, "plan file", {"tubeplan", "plan", "scene", "trajectory", "states", "limits"});
-  if (const YAML::Node n = r.Get(root, "tubeplan", "plan file", true); n.IsDefined()) {
-    if (!n.IsScalar() || n.Scalar() != "1")
-      r.Error(n, "unsupported format version " +
-                     (n.IsScalar() ? Abbreviate(n.Scalar()) : std::string(KindName(n))) +
-                     ", expected 1");
-  }
-  if (const YAML::Node n = r.Get(root, "plan", "plan file", true); n.IsDefined())
-    if (auto name = r.String(n, "plan")) p.name = *name;
-  if (const YAML::Node n = r.Get(root, "limits", "plan file", false); n.IsDefined())
-    ReadLimits(r, n, p.limits);
+  ReadHeader(r, root, p);
 
   // A file the plan names, read once, relative to the plan's directory: (node, path, text), or
   // nothing after reporting why.
@@ -150,38 +190,8 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
       result.trajectory_file = std::move(scanned.info);
     }
   }
-  if (const YAML::Node n = r.Get(root, "states", "plan file", true); n.IsDefined()) {
-    if (!n.IsSequence() || n.size() < 2) {
-      r.Error(
-          n,
-          "states must be a sequence of at least two contact formations (start first, "
-          "goal last), found " +
-              (n.IsSequence() ? std::to_string(n.size()) + " items" : std::string(KindName(n))));
-    } else {
-      const std::vector<scene::PartElement> elements =
-          scene ? scene::EnumerateElements(*scene) : std::vector<scene::PartElement>{};
-      for (std::size_t i = 0; i < n.size(); ++i) {
-        const std::string what = "states[" + std::to_string(i) + "]";
-        if (n[i].IsScalar() && n[i].Scalar() == "goal" && n[i].Tag() != "!") {
-          if (scene) {
-            result.states.push_back(scene->goal);
-            p.states.push_back(states::ToString(scene->goal));
-          }
-          continue;
-        }
-        if (auto cf = r.Formation(n[i], what, scene ? &elements : nullptr)) {
-          p.states.push_back(states::ToString(*cf));
-          result.states.push_back(std::move(*cf));
-        }
-      }
-      for (std::size_t i = 1; i < p.states.size(); ++i) {
-        if (p.states[i] == p.states[i - 1] && i < n.size())
-          r.Error(n[i], "states[" + std::to_string(i) +
-                            "] repeats the state before it, expected "
-                            "each planned state to differ from the one before");
-      }
-    }
-  }
+  if (const YAML::Node n = r.Get(root, "states", "plan file", true); n.IsDefined())
+    ReadStates(r, n, scene, p, result.states);
   if (!result.diagnostics.HasErrors()) {
     result.plan = std::move(p);
     result.scene = std::move(scene);
