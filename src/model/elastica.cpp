@@ -823,6 +823,160 @@ struct FromRoot {
   double cos_psi, sin_psi, along0, across0, error_x = 0.0, error_z = 0.0;
 };
 
+// The arc length of sample j of n spread over [first, last]. (Over [0, 1]: 0 + 1 * (j / last),
+// the same bits as j / last.)
+struct SampleArcs {
+  SampleArcs(double s_first, double s_last, std::size_t n)
+      : first(s_first), last(s_last), count(n), span(s_last - s_first), last_index(double(n - 1)) {}
+  double operator()(std::size_t j) const {
+    return j + 1 == count ? last : first + span * (double(j) / last_index);
+  }
+  double first, last;
+  std::size_t count;
+  double span, last_index;
+};
+
+// D(K) = (k^2 / 3) R_D(0, k'^2, 1), formed when a reflection first needs it: an R_D, and the
+// three-PC tick's samples (a whole segment whose root lies within K/2 of its tip) reflect none
+// (~0.12 k instructions).
+class CompleteDefect {
+ public:
+  CompleteDefect(double k_sq, double kc) : k_sq_(k_sq), kc_(kc) {}
+  double operator()() {
+    if (kept_ < 0.0) kept_ = k_sq_ * Rd(0.0, kc_ * kc_, 1.0) / 3.0;
+    return kept_;
+  }
+
+ private:
+  double k_sq_, kc_;
+  double kept_ = -1.0;  // D(K) >= 0: negative while not formed
+};
+
+// The step's functions, at delta <= K (beyond K/2 by reflection, n = 2 only); big_k = K.
+Stepped StepFunctions(double delta, double big_k, double k, double kc, const LandenChain& chain,
+                      CompleteDefect& d_complete) {
+  Stepped step;
+  if (delta <= 0.5 * big_k) {
+    step.j = JacobiFunctions(delta, chain);
+    step.big_d = EpsilonDefect(k, step.j);
+  } else {
+    Stepped other;
+    other.j = JacobiFunctions(big_k - delta, chain);
+    other.big_d = EpsilonDefect(k, other.j);
+    const Reflected r = Reflect(k, kc, other.j, other.big_d, d_complete());
+    step.j = r.at_w;
+    step.big_d = r.big_d;
+  }
+  return step;
+}
+
+// The root's figures from the tip: the first sample's when it is the root (`first_sample`).
+// A root past the first sample is made as the walk would make it: on the root side of K/2 by
+// reflection with the same D(K), whose rounding then cancels between the root and the samples
+// there (ShapeFromTip's direct R_D left it in: 1.1e-12 of l at alpha = 0.002, found in review).
+FromTip RootFromTip(const ElasticaSolution& solution, const LandenChain& chain, double sqrt_alpha,
+                    double tau0, double s_first, const Eigen::Vector2d& first_sample,
+                    CompleteDefect& d_complete) {
+  const double k = solution.modulus_k, kc = solution.modulus_kc;
+  if (s_first == 0.0) return FromTip{first_sample.x(), first_sample.y()};
+  if (sqrt_alpha > tau0) {
+    Stepped at_root;
+    at_root.j = JacobiFunctions(tau0, chain);
+    at_root.big_d = EpsilonDefect(k, at_root.j);
+    const Reflected r = Reflect(k, kc, at_root.j, at_root.big_d, d_complete());
+    return FromJacobi(k, kc, sqrt_alpha, 0.0, r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d);
+  }
+  return ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
+}
+
+// The elliptic shape's samples: the figures from the tip, (along, across) into xz_out and
+// (gap_x, gap_y) into tangent_out, then turned into positions and tangents.
+void EllipticSamples(const ElasticaSolution& solution, const Loading& load, const SampleArcs& s_of,
+                     std::span<Eigen::Vector2d> xz_out, std::span<Eigen::Vector2d> tangent_out) {
+  const std::size_t n = s_of.count;
+  const double sqrt_alpha = std::sqrt(solution.alpha);
+  const double tau0 = RootArgument(solution, load);
+  const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
+  const auto store = [&](std::size_t j, const FromTip& f) {
+    xz_out[j] = Eigen::Vector2d(f.along, f.across);
+    tangent_out[j] = Eigen::Vector2d(f.gap_x, f.gap_y);
+  };
+  // The arguments w = sqrt(alpha) (1 - s) (from the tip) and tau = tau0 + sqrt(alpha) s (from the
+  // root) both step by sqrt(alpha) / (n - 1) from sample to sample: the addition theorems carry
+  // sn, cn, dn and D from one sample to the next, so a segment costs two Landen evaluations and
+  // three R_D instead of one of each per sample. Samples with w <= tau step w up from the tip
+  // (w = 0: sn 0, cn 1, dn 1, D 0), the others tau up from the root and are reflected, as in
+  // ShapeFromTip.
+  const double delta = sqrt_alpha * s_of.span / s_of.last_index;
+  const double k = solution.modulus_k, kc = solution.modulus_kc, k_sq = k * k;
+  CompleteDefect d_complete(k_sq, kc);
+  const Stepped step = StepFunctions(delta, tau0 + sqrt_alpha, k, kc, chain, d_complete);
+  // One step forward from `at`, or afresh at `argument()` (<= K/2) when the walk since the last
+  // fresh evaluation has reached the anchor spacing (always, for steps longer than it). The
+  // argument is formed only then (a sample's s with its division, a product and a sum: ~70
+  // instructions a tick, whose 16 steps re-anchor once or never).
+  // Also afresh after kAnchorSteps steps: the step's own functions carry a relative error (~5e-14
+  // in cn and dn near k = 1) that each step adds again, and a short range of many points (a
+  // segment's mesh) walks hundreds of steps within one anchor spacing (2.6e-12 of the tangent
+  // at 64 steps, found in review). 16 steps: a walk over the whole length (n = 17 samples, the
+  // tick's) never reaches it, so the tick keeps its bits.
+  constexpr int kAnchorSteps = 16;
+  double walked = 0.0;
+  int steps = 0;
+  const auto advance = [&](const Stepped& at, const auto& argument) {
+    Stepped next = AddArgument(k_sq, at, step);
+    walked += delta;
+    if (walked >= kJacobiAnchor || ++steps > kAnchorSteps) {
+      next.j = JacobiFunctions(argument(), chain);
+      walked = 0.0;
+      steps = 0;
+    }
+    return next;
+  };
+  std::size_t first_tip_side = 0;
+  const double tau_first = tau0 + sqrt_alpha * s_of(0);
+  if (sqrt_alpha * (1.0 - s_of(0)) > tau_first) {  // the first sample lies beyond K/2 from the tip
+    Stepped at_tau;
+    at_tau.j = JacobiFunctions(tau_first, chain);  // tau < K/2 here, as w + tau = K
+    at_tau.big_d = EpsilonDefect(k, at_tau.j);
+    std::size_t& i = first_tip_side;
+    for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
+      if (i > 0) at_tau = advance(at_tau, [&] { return tau0 + sqrt_alpha * s_of(i); });
+      const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete());
+      store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d));
+    }
+  }
+  walked = 0.0;
+  steps = 0;
+  Stepped at_w;  // w = 0 at the tip: sn 0, cn 1, dn 1, D 0
+  if (s_of.last < 1.0 && first_tip_side < n) {
+    // The last sample short of the tip, on the tip side (w <= K/2): evaluated afresh.
+    at_w.j = JacobiFunctions(sqrt_alpha * (1.0 - s_of.last), chain);
+    at_w.big_d = EpsilonDefect(k, at_w.j);
+  }
+  for (std::size_t i = n; i-- > first_tip_side;) {
+    if (i + 1 < n) at_w = advance(at_w, [&] { return sqrt_alpha * (1.0 - s_of(i)); });
+    store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
+  }
+  // As in ElasticaCentreline: positions from the root.
+  const FromTip root =
+      RootFromTip(solution, chain, sqrt_alpha, tau0, s_of.first, xz_out[0], d_complete);
+  const FromRoot from_root(solution, load, root.along, root.across);
+  // The tip angle's sine and cosine as the caller kept them (the core's chain), else formed.
+  const ElasticaTip& tip = solution.tip;
+  double sin_tip = solution.tip_sin, cos_tip = solution.tip_cos;
+  if (!(solution.tip_trig_angle_rad == tip.tip_angle_rad)) {
+    sin_tip = std::sin(tip.tip_angle_rad);
+    cos_tip = std::cos(tip.tip_angle_rad);
+  }
+  for (std::size_t j = 0; j < n; ++j) {
+    const double s = s_of(j);
+    xz_out[j] = from_root.At(s, xz_out[j].x(), xz_out[j].y());
+    tangent_out[j] = s == 0.0 ? Eigen::Vector2d(0.0, 1.0)
+                              : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
+  }
+}
+
 }  // namespace
 
 ElasticaSolution SolveElastica(double alpha, double psi_rad) {
@@ -917,12 +1071,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
                   s_first, s_last);
     throw std::invalid_argument(buffer);
   }
-  const double last = double(n - 1);
-  const double span = s_last - s_first;
-  // (Over [0, 1]: 0 + 1 * (j / last), the same bits as j / last.)
-  const auto s_of = [&](std::size_t j) {
-    return j + 1 == n ? s_last : s_first + span * (double(j) / last);
-  };
+  const SampleArcs s_of(s_first, s_last, n);
   const ElasticaTip& tip = solution.tip;
   if (tip.tip_angle_rad == 0.0 && tip.deflection == 0.0) {
     for (std::size_t j = 0; j < n; ++j) {
@@ -942,120 +1091,7 @@ void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_
     }
     return;
   }
-  // The samples' figures from the tip, (along, across) into xz_out and (gap_x, gap_y) into
-  // tangent_out, then turned into positions and tangents below.
-  const double sqrt_alpha = std::sqrt(solution.alpha);
-  const double tau0 = RootArgument(solution, load);
-  const LandenChain chain = MakeLandenChain(solution.modulus_k, solution.modulus_kc);
-  const auto store = [&](std::size_t j, const FromTip& f) {
-    xz_out[j] = Eigen::Vector2d(f.along, f.across);
-    tangent_out[j] = Eigen::Vector2d(f.gap_x, f.gap_y);
-  };
-  // The arguments w = sqrt(alpha) (1 - s) (from the tip) and tau = tau0 + sqrt(alpha) s (from the
-  // root) both step by sqrt(alpha) / (n - 1) from sample to sample: the addition theorems carry
-  // sn, cn, dn and D from one sample to the next, so a segment costs two Landen evaluations and
-  // three R_D instead of one of each per sample. Samples with w <= tau step w up from the tip
-  // (w = 0: sn 0, cn 1, dn 1, D 0), the others tau up from the root and are reflected, as in
-  // ShapeFromTip.
-  const double delta = sqrt_alpha * span / last;
-  const double k = solution.modulus_k, kc = solution.modulus_kc, k_sq = k * k;
-  // D(K), formed when a reflection first needs it: an R_D, and the three-PC tick's samples (a
-  // whole segment whose root lies within K/2 of its tip) reflect none (~0.12 k instructions).
-  double d_complete_kept = -1.0;  // D(K) >= 0: negative while not formed
-  const auto d_complete = [&] {
-    if (d_complete_kept < 0.0) d_complete_kept = k_sq * Rd(0.0, kc * kc, 1.0) / 3.0;
-    return d_complete_kept;
-  };
-  const double big_k = tau0 + sqrt_alpha;
-  Stepped step;  // the step's functions, at delta <= K (beyond K/2 by reflection, n = 2 only)
-  if (delta <= 0.5 * big_k) {
-    step.j = JacobiFunctions(delta, chain);
-    step.big_d = EpsilonDefect(k, step.j);
-  } else {
-    Stepped other;
-    other.j = JacobiFunctions(big_k - delta, chain);
-    other.big_d = EpsilonDefect(k, other.j);
-    const Reflected r = Reflect(k, kc, other.j, other.big_d, d_complete());
-    step.j = r.at_w;
-    step.big_d = r.big_d;
-  }
-  // One step forward from `at`, or afresh at `argument()` (<= K/2) when the walk since the last
-  // fresh evaluation has reached the anchor spacing (always, for steps longer than it). The
-  // argument is formed only then (a sample's s with its division, a product and a sum: ~70
-  // instructions a tick, whose 16 steps re-anchor once or never).
-  // Also afresh after kAnchorSteps steps: the step's own functions carry a relative error (~5e-14
-  // in cn and dn near k = 1) that each step adds again, and a short range of many points (a
-  // segment's mesh) walks hundreds of steps within one anchor spacing (2.6e-12 of the tangent
-  // at 64 steps, found in review). 16 steps: a walk over the whole length (n = 17 samples, the
-  // tick's) never reaches it, so the tick keeps its bits.
-  constexpr int kAnchorSteps = 16;
-  double walked = 0.0;
-  int steps = 0;
-  const auto advance = [&](const Stepped& at, const auto& argument) {
-    Stepped next = AddArgument(k_sq, at, step);
-    walked += delta;
-    if (walked >= kJacobiAnchor || ++steps > kAnchorSteps) {
-      next.j = JacobiFunctions(argument(), chain);
-      walked = 0.0;
-      steps = 0;
-    }
-    return next;
-  };
-  std::size_t first_tip_side = 0;
-  const double tau_first = tau0 + sqrt_alpha * s_of(0);
-  if (sqrt_alpha * (1.0 - s_of(0)) > tau_first) {  // the first sample lies beyond K/2 from the tip
-    Stepped at_tau;
-    at_tau.j = JacobiFunctions(tau_first, chain);  // tau < K/2 here, as w + tau = K
-    at_tau.big_d = EpsilonDefect(k, at_tau.j);
-    std::size_t& i = first_tip_side;
-    for (; i < n && sqrt_alpha * (1.0 - s_of(i)) > tau0 + sqrt_alpha * s_of(i); ++i) {
-      if (i > 0) at_tau = advance(at_tau, [&] { return tau0 + sqrt_alpha * s_of(i); });
-      const Reflected r = Reflect(k, kc, at_tau.j, at_tau.big_d, d_complete());
-      store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d));
-    }
-  }
-  walked = 0.0;
-  steps = 0;
-  Stepped at_w;  // w = 0 at the tip: sn 0, cn 1, dn 1, D 0
-  if (s_last < 1.0 && first_tip_side < n) {
-    // The last sample short of the tip, on the tip side (w <= K/2): evaluated afresh.
-    at_w.j = JacobiFunctions(sqrt_alpha * (1.0 - s_last), chain);
-    at_w.big_d = EpsilonDefect(k, at_w.j);
-  }
-  for (std::size_t i = n; i-- > first_tip_side;) {
-    if (i + 1 < n) at_w = advance(at_w, [&] { return sqrt_alpha * (1.0 - s_of(i)); });
-    store(i, FromJacobi(k, kc, sqrt_alpha, s_of(i), at_w.j.sn, at_w.j.cn, at_w.j.dn, at_w.big_d));
-  }
-  // As in ElasticaCentreline: positions from the root, the first sample's figures when it is
-  // the root.
-  // A root past the first sample is made as the walk would make it: on the root side of K/2 by
-  // reflection with the same D(K), whose rounding then cancels between the root and the samples
-  // there (ShapeFromTip's direct R_D left it in: 1.1e-12 of l at alpha = 0.002, found in review).
-  FromTip root;
-  if (s_first == 0.0) {
-    root = FromTip{xz_out[0].x(), xz_out[0].y()};
-  } else if (sqrt_alpha > tau0) {
-    Stepped at_root;
-    at_root.j = JacobiFunctions(tau0, chain);
-    at_root.big_d = EpsilonDefect(k, at_root.j);
-    const Reflected r = Reflect(k, kc, at_root.j, at_root.big_d, d_complete());
-    root = FromJacobi(k, kc, sqrt_alpha, 0.0, r.at_w.sn, r.at_w.cn, r.at_w.dn, r.big_d);
-  } else {
-    root = ShapeFromTip(solution, chain, sqrt_alpha, tau0, 0.0);
-  }
-  const FromRoot from_root(solution, load, root.along, root.across);
-  // The tip angle's sine and cosine as the caller kept them (the core's chain), else formed.
-  double sin_tip = solution.tip_sin, cos_tip = solution.tip_cos;
-  if (!(solution.tip_trig_angle_rad == tip.tip_angle_rad)) {
-    sin_tip = std::sin(tip.tip_angle_rad);
-    cos_tip = std::cos(tip.tip_angle_rad);
-  }
-  for (std::size_t j = 0; j < n; ++j) {
-    const double s = s_of(j);
-    xz_out[j] = from_root.At(s, xz_out[j].x(), xz_out[j].y());
-    tangent_out[j] = s == 0.0 ? Eigen::Vector2d(0.0, 1.0)
-                              : Tangent(sin_tip, cos_tip, tangent_out[j].x(), tangent_out[j].y());
-  }
+  EllipticSamples(solution, load, s_of, xz_out, tangent_out);
 }
 
 }  // namespace tubeplan::model
