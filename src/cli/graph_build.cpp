@@ -129,6 +129,7 @@ std::variant<Built, int> BuildGraph(
   graph::ExploreOptions explore;
   explore.seed = o.seed;
   explore.random_motions = o.random;
+  explore.closing_motions = o.closing;
   explore.max_motions = o.budget;
   explore.time_limit_s = o.time_limit_s;
   explore.jobs = o.jobs > 0 ? o.jobs : std::max(1u, std::thread::hardware_concurrency());
@@ -164,6 +165,12 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
   sub->add_option("--random", o.random,
                   "random motions after the sweeps and aims, before every state found is "
                   "probed with small motions until no new one appears (saturation)")
+      ->check(CLI::Range(0, 10000))
+      ->capture_default_str();
+  sub->add_option("--closing", o.closing,
+                  "once every state is probed, rounds of this many more random motions, each "
+                  "followed by probing what it found, until a round adds no state and no "
+                  "transition (0: none; docs/graph.md)")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,

@@ -25,6 +25,7 @@ struct GraphOptions {
   bool unpruned = false;
   std::uint64_t seed = 1;
   int random = 120;
+  int closing = 30;  // random motions per closing round (plans: none; see plans_command.cpp)
   int budget = 3000;
   double time_limit_s = 0.0;  // 0: none
   int jobs = 0;               // 0: the machine's cores

@@ -1,7 +1,8 @@
 // `tubeplan graph SCENE [--dot FILE] [--json FILE] [--unpruned] [--seed N] [--random N]
-// [--jobs N] [--weights friction=1,energy=1,distance=1] [--tolerance T]`: explores the scene with
-// the core, prunes the contact-state graph with the paper's heuristics and writes it as DOT and
-// JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time taken.
+// [--closing N] [--jobs N] [--weights friction=1,energy=1,distance=1] [--tolerance T]`: explores
+// the scene with the core, prunes the contact-state graph with the paper's heuristics and writes it
+// as DOT and JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time
+// taken.
 #include <algorithm>
 #include <iomanip>
 #include <numbers>
@@ -98,14 +99,21 @@ void PrintSaturation(std::ostream& t, const Built& b) {
     t << "  (saturated: every one of the " << g.probed << " states probed from a stay with "
       << graph::kProbesPerNode << " small motions (" << explore.probe_step_m * 1e3
       << " mm along and against 3 directions, " << explore.probe_turn_rad * 180.0 / std::numbers::pi
-      << " deg about 2 axes), the last round found no new state)\n";
+      << " deg about 2 axes); ";
+    if (explore.closing_motions > 0)
+      t << "then " << g.closing_rounds << " closing round" << (g.closing_rounds == 1 ? "" : "s")
+        << " of " << explore.closing_motions
+        << " random motions, the last adding no state and no transition)\n";
+    else
+      t << "the last round found no new state; no closing rounds)\n";
   } else if (g.end == graph::ExploreEnd::kTimeLimit) {
     t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
       << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
-      << " states probed)\n";
+      << " states probed, " << g.closing_rounds << " closing rounds)\n";
   } else {
     t << "  (NOT saturated: stopped by the budget of " << explore.max_motions << " motions, with "
-      << g.probed << " of " << g.nodes.size() << " states probed)\n";
+      << g.probed << " of " << g.nodes.size() << " states probed, " << g.closing_rounds
+      << " closing rounds)\n";
   }
 }
 

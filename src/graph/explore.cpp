@@ -148,6 +148,7 @@ std::vector<std::pair<RawRun, Sample>> Refine(core::Core& refine_core, const Mot
 // whether a stay (CF, refined, tick) could become the place its CF's probe starts from: those
 // keep a run point.
 using MayEnter = std::function<bool(const std::string&, bool, int)>;
+// Kept whole: its steps share the debouncing state (stable, raw, brief) and the run points.
 MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& motion, int index,
                        const ExploreOptions& options, const RunPointPtr& resume,
                        const MayEnter& may_enter, const Deadline& deadline) {
@@ -863,6 +864,31 @@ std::vector<Motion> RandomMotions(const scene::Scene& scene, std::uint64_t seed,
                          options);
 }
 
+namespace {
+
+// Marks the start and goal nodes, each node's distance to the goal and the part elements reached.
+void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
+                           ContactGraph& graph) {
+  graph.goal = graph.FindNode(states::ToString(scene.goal));
+  if (graph.start >= 0) graph.nodes[std::size_t(graph.start)].start = true;
+  if (graph.goal >= 0) {
+    Node& goal = graph.nodes[std::size_t(graph.goal)];
+    goal.goal = true;
+    const double half_length = 0.5 * scene.tube.length_m;
+    for (Node& n : graph.nodes) {
+      n.distance_m =
+          (n.X_WH.translation() - goal.X_WH.translation()).norm() +
+          half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() * n.X_WH.linear()).angle();
+    }
+  }
+  const std::set<std::string> reached = ReachedElements(graph);
+  graph.reached_elements.assign(reached.begin(), reached.end());
+  for (const scene::PartElement& e : probe.elements())
+    if (!reached.contains(e.name)) graph.unreached_elements.push_back(e.name);
+}
+
+}  // namespace
+
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
                      const std::function<void(const SaturationPoint&)>& progress) {
   const auto clock_start = Clock::now();
@@ -956,47 +982,46 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     run(RandomMotionsIn(scene, box, o.seed, 0, o.random_motions, o), {});
   }
   // Neighbour probing in rounds, each probing the nodes found since the last, until a round finds
-  // no new node: saturated. Every node has then been probed, and probing one again from the same
-  // stay replays the same motion (the core is deterministic), which finds nothing new; the
-  // effort is stated by the probe set (Probes) and the random motions before it.
-  phase = "probes";
-  while (!stopped && probed < graph.nodes.size()) {
-    const int wanted = static_cast<int>(graph.nodes.size() - probed);
-    const int count = std::min(wanted, room());
-    if (count < wanted) stop(ExploreEnd::kBudget);
-    if (count <= 0) break;
-    // Each goes on from the run point kept at its start stay, if there is one: the same bits as
-    // replaying its prefix.
-    std::vector<Motion> group;
-    std::vector<RunPointPtr> resumes;
-    for (int i = 0; i < count; ++i) {
-      group.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
-      resumes.push_back(merger.TakeProbePoint(static_cast<int>(probed) + i));
+  // no new node. Every node has then been probed, and probing one again from the same stay
+  // replays the same motion (the core is deterministic), which finds nothing new.
+  const auto probe_new_nodes = [&] {
+    phase = "probes";
+    while (!stopped && probed < graph.nodes.size()) {
+      const int wanted = static_cast<int>(graph.nodes.size() - probed);
+      const int count = std::min(wanted, room());
+      if (count < wanted) stop(ExploreEnd::kBudget);
+      if (count <= 0) break;
+      // Each goes on from the run point kept at its start stay, if there is one: the same bits
+      // as replaying its prefix.
+      std::vector<Motion> group;
+      std::vector<RunPointPtr> resumes;
+      for (int i = 0; i < count; ++i) {
+        group.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
+        resumes.push_back(merger.TakeProbePoint(static_cast<int>(probed) + i));
+      }
+      probed += std::size_t(count);
+      const int merged = run(std::move(group), resumes);
+      probed -= std::size_t(count - merged);
     }
-    probed += std::size_t(count);
-    const int merged = run(std::move(group), resumes);
-    probed -= std::size_t(count - merged);
+  };
+  probe_new_nodes();
+  // Closing rounds: more random motions of the same seed, each round merged and its new nodes
+  // probed, until a round adds no node and no arc (saturated), or a limit ends it.
+  int next_random = o.random_motions;
+  while (!stopped && o.closing_motions > 0) {
+    const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();
+    phase = "closing rounds";
+    run(RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o), {});
+    next_random += o.closing_motions;
+    ++graph.closing_rounds;
+    probe_new_nodes();
+    if (graph.nodes.size() == nodes_before && graph.arcs.size() == arcs_before) break;
   }
   graph.probed = static_cast<int>(probed);
   graph.end = stopped.value_or(ExploreEnd::kSaturated);
   graph.saturated = !stopped && probed == graph.nodes.size();
 
-  graph.goal = graph.FindNode(states::ToString(scene.goal));
-  if (graph.start >= 0) graph.nodes[std::size_t(graph.start)].start = true;
-  if (graph.goal >= 0) {
-    Node& goal = graph.nodes[std::size_t(graph.goal)];
-    goal.goal = true;
-    const double half_length = 0.5 * scene.tube.length_m;
-    for (Node& n : graph.nodes) {
-      n.distance_m =
-          (n.X_WH.translation() - goal.X_WH.translation()).norm() +
-          half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() * n.X_WH.linear()).angle();
-    }
-  }
-  const std::set<std::string> reached = ReachedElements(graph);
-  graph.reached_elements.assign(reached.begin(), reached.end());
-  for (const scene::PartElement& e : probe.elements())
-    if (!reached.contains(e.name)) graph.unreached_elements.push_back(e.name);
+  MarkStartGoalAndReach(scene, probe, graph);
   graph.seconds = std::chrono::duration<double>(Clock::now() - clock_start).count();
   return graph;
 }

@@ -30,6 +30,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
   j["parameters"] = {
       {"seed", explore.seed},
       {"random_motions", explore.random_motions},
+      {"closing_motions", explore.closing_motions},
       {"budget", explore.max_motions},
       {"time_limit_s",
        explore.time_limit_s > 0.0 ? nlohmann::json(explore.time_limit_s) : nlohmann::json(nullptr)},
@@ -108,6 +109,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                 {"refinements", g.refinements},
                 {"held_back", g.held_back},
                 {"probed", g.probed},
+                {"closing_rounds", g.closing_rounds},
                 {"saturated", g.saturated},
                 {"ended_by", g.end == graph::ExploreEnd::kSaturated ? "saturation"
                              : g.end == graph::ExploreEnd::kBudget  ? "budget"

@@ -441,6 +441,25 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
   CHECK(one.ticks == two.ticks);
 }
 
+TEST_CASE("Closing rounds go on until one adds no state and no transition", "[graph][explore]") {
+  const ContactGraph& g = DefaultGraph(1);
+  const int round = graph::ExploreOptions{}.closing_motions;
+  REQUIRE(g.saturated);
+  REQUIRE(g.closing_rounds >= 1);
+  // The last round's motions (nothing new: no probes after them) are the graph's last ones.
+  const std::size_t last = g.saturation.size();
+  REQUIRE(last > std::size_t(round));
+  const graph::SaturationPoint& before = g.saturation[last - 1 - std::size_t(round)];
+  CHECK(before.nodes == static_cast<int>(g.nodes.size()));
+  CHECK(before.arcs == static_cast<int>(g.arcs.size()));
+  for (std::size_t i = last - std::size_t(round); i < last; ++i)
+    CHECK(g.motions[i].kind == "random");
+  // The random motions are the exploration's own and `round` per closing round, each round whole.
+  int random = 0;
+  for (const graph::Motion& m : g.motions) random += m.kind == "random";
+  CHECK(random == graph::ExploreOptions{}.random_motions + round * g.closing_rounds);
+}
+
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph][explore]") {
   // Motions from another seed, run through the core by the completeness check (a CF counts
   // after the same 20 ms dwell), against the graph explored with the default options.

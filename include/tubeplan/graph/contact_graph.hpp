@@ -62,7 +62,7 @@ struct SaturationPoint {
 
 /// Why an exploration ended.
 enum class ExploreEnd : unsigned char {
-  kSaturated,  ///< every node probed, the last round found no new one
+  kSaturated,  ///< every node probed, the last closing round found no new node or arc
   kBudget,     ///< the budget of motions ran out first
   kTimeLimit,  ///< the time limit passed first
 };
@@ -83,6 +83,7 @@ struct ContactGraph {
   int held_back = 0;
   double seconds = 0.0;    ///< wall time of the exploration
   int probed = 0;          ///< nodes whose neighbour probes ran (the first `probed` nodes)
+  int closing_rounds = 0;  ///< rounds of random motions after probing (the last found nothing new)
   bool saturated = false;  ///< every node probed, nothing cut by the budget or the time limit
   ExploreEnd end = ExploreEnd::kSaturated;
 

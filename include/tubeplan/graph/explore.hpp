@@ -8,8 +8,10 @@
 //  3. `random_motions` random guarded motions from a seed;
 //  4. neighbour probes: from a stay of each node (its motion resumed there), small moves
 //     of the hand along and against three directions and small turns, each held and undone;
-//     every node found is probed in turn until all have been (saturated), or until the budget of
-//     motions or the time limit is spent.
+//     every node found is probed in turn until all have been;
+//  5. closing rounds: more random motions, each round's new nodes probed as in 4, until a round
+//     adds no node and no arc (saturated), or until the budget of motions or the time limit is
+//     spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
 // into sub-ticks; what the sub-ticks produce is recorded, and a change that stays multiple is
 // flagged simultaneous. Motions run in parallel on `jobs` threads, each with its own core, and
@@ -37,6 +39,10 @@ struct ExploreOptions {
   std::uint64_t seed = 1;
   /// Random guarded motions from `seed` run after the sweeps and aims, before probing.
   int random_motions = 120;
+  /// Once every node is probed, closing rounds of this many more random motions (the same seed's
+  /// sequence, continued) run, each followed by probing the nodes it found, until a round adds
+  /// no node and no arc (0: none).
+  int closing_motions = 30;
   /// At most this many motions run, whatever happens (sweeps, aims, random and probe motions
   /// together, in that order: a group is cut where the budget ends). A motion is one entry of
   /// ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
