@@ -21,6 +21,7 @@
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
+#include <tubeplan/live/live_run.hpp>
 #include <tubeplan/plan/candidates.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/synthesize.hpp>
