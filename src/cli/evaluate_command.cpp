@@ -66,6 +66,8 @@ bool GraphSections(const std::vector<batch::Evaluated>& results,
     const scene::Scene& s = *loaded[members.front()].scene;
     graph::ExploreOptions explore;
     explore.jobs = jobs;
+    // The picture of the states, as `plans` explores: probing, without the closing rounds.
+    explore.closing_motions = 0;
     graph::ContactGraph g = graph::Explore(s, explore);
     graph::Prune(g, {s.heuristics.friction, s.heuristics.energy, s.heuristics.distance,
                      s.heuristics.tolerance});
