@@ -7,6 +7,7 @@
 // library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
+#include <tubeplan/batch/evaluation.hpp>
 #include <tubeplan/batch/merge.hpp>
 #include <tubeplan/batch/report.hpp>
 #include <tubeplan/core/core.hpp>

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fcntl.h>
+#include <memory>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -562,6 +563,22 @@ std::string StreamingTextFile::Commit() {
   ForgetTemporary(slot_);
   slot_ = -1;
   return error;
+}
+
+std::string WriteFilesTogether(const std::vector<std::pair<std::string, std::string>>& files) {
+  std::vector<std::pair<std::string, std::unique_ptr<AtomicFile>>> outputs;
+  for (const auto& [path, text] : files) {
+    outputs.emplace_back(path, std::make_unique<AtomicFile>(path));
+    outputs.back().second->Write(text);
+  }
+  for (const auto& [path, file] : outputs) {
+    if (file->error().empty()) continue;
+    return path + ": error: " + file->Commit();
+  }
+  const DeferInterrupts too_late;
+  for (const auto& [path, file] : outputs)
+    if (const std::string e = file->Commit(); !e.empty()) return path + ": error: " + e;
+  return std::string();
 }
 
 }  // namespace tubeplan::io

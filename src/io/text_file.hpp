@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <tubeplan/io/diagnostics.hpp>
@@ -223,5 +224,11 @@ class StreamingTextFile {
   int slot_ = -1;
   bool failed_ = false;
 };
+
+/// Writes `files` ({path, text}) each to its temporary, then renames them one after the other:
+/// a signal while they are written ends the process with none of them; one while they are
+/// renamed comes too late to stop them (deferred, and then ignored), so there is never one
+/// without the others. Empty on success, else "PATH: error: ..." of the first that failed.
+std::string WriteFilesTogether(const std::vector<std::pair<std::string, std::string>>& files);
 
 }  // namespace tubeplan::io
