@@ -1,15 +1,16 @@
 #pragma once
 // tubeplan as a library: everything a program calls to do what the commands do. Load a scene
-// and a plan (io), step the core with a hand pose (core), judge a plan's replay (plan), judge a
-// set of plans (batch), explore and prune the contact-state graph and make candidate plans
-// (graph, plan), run the 1 kHz servo against a device (device), write the reports of judged
-// plans and of the graph (report). Each header says what it holds; docs/layout.md says which
-// library each folder is.
+// and a plan (io), step the core with a hand pose (core), judge a plan's replay or sum up a
+// trajectory's (plan), judge a set of plans and replay a trajectory file (batch), explore and
+// prune the contact-state graph and make candidate plans (graph, plan), run the 1 kHz servo
+// against a device (device), write the reports of judged plans and of the graph (report). Each
+// header says what it holds; docs/layout.md says which library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/evaluation.hpp>
 #include <tubeplan/batch/merge.hpp>
 #include <tubeplan/batch/report.hpp>
+#include <tubeplan/batch/simulation.hpp>
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/device/device.hpp>
 #include <tubeplan/device/device_choice.hpp>
@@ -25,6 +26,7 @@
 #include <tubeplan/live/live_run.hpp>
 #include <tubeplan/plan/candidates.hpp>
 #include <tubeplan/plan/judge.hpp>
+#include <tubeplan/plan/simulate.hpp>
 #include <tubeplan/plan/synthesize.hpp>
 #include <tubeplan/report/graph_json.hpp>
 #include <tubeplan/report/html_report.hpp>

@@ -1,7 +1,7 @@
 #pragma once
-// Private to the libraries that read and write files (io, batch, cli) and their tests: text
-// input (whole files, or chunks and lines for files too long to hold) and output for the
-// loaders and writers, and the checks every text input passes before a parser sees it
+// Private to the libraries that read and write files (io, batch, live, report, cli) and their
+// tests: text input (whole files, or chunks and lines for files too long to hold) and output
+// for the loaders and writers, and the checks every text input passes before a parser sees it
 // (docs/hardening.md lists the limits and why).
 
 #include <cstdint>

@@ -5,8 +5,13 @@
 
 #include <tubeplan/report/series_format.hpp>
 
+#include "io/text_file.hpp"
+
 namespace tubeplan::report {
 namespace {
+
+// The series' text held before it is written to the file.
+constexpr std::size_t kSeriesChunkBytes = std::size_t{1} << 20;
 
 // 17 significant digits: a double read back is the double written (the series is for analysis,
 // and the determinism check compares bits).
@@ -41,6 +46,15 @@ void AppendPose(std::string& s, const Eigen::Isometry3d& X) {
 }
 
 }  // namespace
+
+std::optional<SeriesFormat> SeriesFormatOf(const std::string& path, std::string& error) {
+  if (path.empty()) return SeriesFormat::kNone;
+  const std::string ext = std::filesystem::path(path).extension().string();
+  if (ext == ".csv") return SeriesFormat::kCsv;
+  if (ext == ".jsonl") return SeriesFormat::kJsonLines;
+  error = "unknown output format \"" + ext + "\", expected a file name ending in .csv or .jsonl";
+  return std::nullopt;
+}
 
 std::string_view FlagName(std::uint32_t bit) {
   switch (bit) {
@@ -170,6 +184,28 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
   }
   text_ += j.dump();
   text_ += '\n';
+}
+
+SeriesFile::SeriesFile(const std::filesystem::path& path, SeriesFormat format, bool mesh)
+    : writer_(format, mesh), file_(std::make_unique<io::AtomicFile>(path)) {}
+
+SeriesFile::~SeriesFile() = default;
+
+std::string SeriesFile::OpenError() { return file_->error().empty() ? "" : file_->Commit(); }
+
+void SeriesFile::Add(const core::Core& core, const core::StepOutput& out,
+                     const std::string& cf_text) {
+  writer_.Add(core, out, cf_text);
+  if (writer_.text().size() >= kSeriesChunkBytes) {
+    file_->Write(writer_.text());
+    writer_.Clear();
+  }
+}
+
+std::string SeriesFile::Commit() {
+  file_->Write(writer_.text());
+  writer_.Clear();
+  return file_->Commit();
 }
 
 }  // namespace tubeplan::report
