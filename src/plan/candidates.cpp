@@ -1,5 +1,7 @@
 #include <algorithm>
 #include <array>
+#include <iomanip>
+#include <sstream>
 
 #include <tubeplan/plan/candidates.hpp>
 
@@ -67,6 +69,17 @@ std::string FirstFailure(const Judgement& j) {
   if (j.after_goal.started && j.after_goal.verdict == Verdict::kInfeasible)
     return j.after_goal.reason;
   return j.transitions.empty() ? "the trajectory did not load" : "no transition judged";
+}
+
+std::string VerdictText(const Candidate& c) {
+  std::ostringstream text;
+  text << std::setprecision(3)
+       << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
+  if (c.tries > 1)
+    text << " (try " << c.tries << ": " << (c.held ? "the held end's poses" : "the hand's")
+         << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";
+  text << "; peak operator force " << c.judgement.peak_force_N << " N";
+  return text.str();
 }
 
 }  // namespace tubeplan::plan

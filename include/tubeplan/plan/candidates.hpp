@@ -57,4 +57,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
 /// "FROM -> TO: reason" of the first infeasible transition, or what stopped the judgement.
 std::string FirstFailure(const Judgement& judgement);
 
+/// "feasible" or "infeasible: " and FirstFailure, the try kept when not the first, and the peak
+/// operator force: what `plans` says of a candidate and its plan file's comment repeats.
+std::string VerdictText(const Candidate& candidate);
+
 }  // namespace tubeplan::plan
