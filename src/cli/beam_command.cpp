@@ -1,15 +1,12 @@
-// `tubeplan beam`: what-if questions about the tube's bending under a tip load.
+// `tubeplan beam`: what-if questions about the tube's bending under a tip load (the answer's
+// text and JSON: report/beam_report.hpp).
 #include <cmath>
-#include <iomanip>
 #include <memory>
-#include <numbers>
-#include <sstream>
-
-#include <nlohmann/json.hpp>
 
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/model/elastica.hpp>
 #include <tubeplan/model/tip_response.hpp>
+#include <tubeplan/report/beam_report.hpp>
 
 #include "app.hpp"
 #include "commands.hpp"
@@ -26,29 +23,9 @@ struct BeamOptions {
   bool json = false;
 };
 
-// The linear model's tip deflection is 0.7 % too large at alpha = 0.25 (docs/models.md, "The load
-// parameter"): beyond that a user asking the linear model deserves a word.
-constexpr double kLinearAlphaLimit = 0.25;
-
-std::string Vec(const Eigen::Vector3d& v) {
-  std::ostringstream s;
-  s << std::setprecision(6) << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
-  return s.str();
-}
-
-int RunBeam(const BeamOptions& o, Streams io) {
-  model::TubeSpec spec;
-  model::BeamModel beam_model = model::BeamModel::kLinear;
-  if (!o.scene_path.empty()) {
-    const io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
-    io.err << loaded.diagnostics.FormatAll();
-    if (!loaded.scene) return kExitBadInput;
-    spec = loaded.scene->tube;
-    // The rod's large-deflection limit is the elastica.
-    beam_model = loaded.scene->model.tube == scene::TubeModel::kLinear
-                     ? model::BeamModel::kLinear
-                     : model::BeamModel::kElastica;
-  }
+// The tube, model, tip force and points the options give over the scene's; every problem, one
+// message each.
+std::vector<std::string> ReadLoad(const BeamOptions& o, report::BeamAnswer& a) {
   std::vector<std::string> errors;
   auto quantity = [&](const std::string& text, const char* option, io::Dimension dim,
                       double& target) {
@@ -60,24 +37,23 @@ int RunBeam(const BeamOptions& o, Streams io) {
       errors.push_back(error);
     }
   };
+  model::TubeSpec& spec = a.spec;
   quantity(o.outer_radius, "--outer-radius", io::dim::kLength, spec.outer_radius_m);
   quantity(o.inner_radius, "--inner-radius", io::dim::kLength, spec.inner_radius_m);
   quantity(o.length, "--length", io::dim::kLength, spec.length_m);
   quantity(o.youngs_modulus, "--youngs-modulus", io::dim::kPressure, spec.youngs_modulus_Pa);
   quantity(o.poisson_ratio, "--poisson-ratio", io::dim::kNone, spec.poisson_ratio);
-  if (o.model) beam_model = *o.model;
+  if (o.model) a.model = *o.model;
 
-  Eigen::Vector3d f_tip_O_N = Eigen::Vector3d::Zero();
   std::string error;
   if (auto f = ParseQuantityList("--tip-force", o.tip_force, 1, 3, io::dim::kForce, error)) {
-    for (std::size_t i = 0; i < f->size(); ++i) f_tip_O_N[static_cast<Eigen::Index>(i)] = (*f)[i];
+    for (std::size_t i = 0; i < f->size(); ++i) a.f_tip_O_N[static_cast<Eigen::Index>(i)] = (*f)[i];
   } else {
     errors.push_back(error);
   }
-  std::vector<Eigen::Vector3d> points;
   for (const std::string& at : o.at) {
     if (auto p = ParseQuantityList("--at", at, 3, 3, io::dim::kLength, error)) {
-      points.emplace_back((*p)[0], (*p)[1], (*p)[2]);
+      a.points_O_m.emplace_back((*p)[0], (*p)[1], (*p)[2]);
     } else {
       errors.push_back(error);
     }
@@ -92,89 +68,58 @@ int RunBeam(const BeamOptions& o, Streams io) {
     for (const std::string& problem : model::ValidateTubeSpec(spec))
       errors.push_back("the tube: " + problem);
   }
+  return errors;
+}
+
+// The response and the points' displacements; false when a figure overflows a double.
+bool Answer(report::BeamAnswer& a) {
+  a.section = model::ComputeSection(a.spec);
+  a.response = model::TipResponse(a.model, a.spec, a.f_tip_O_N);
+  const model::TipLoadResponse& r = a.response;
+  bool finite = std::isfinite(r.alpha) && r.tip_displacement_O_m.allFinite() &&
+                std::isfinite(r.tip_angle_rad) && std::isfinite(r.energy_J) &&
+                std::isfinite(r.root_strain);
+  for (const Eigen::Vector3d& p : a.points_O_m) {
+    a.displacements_O_m.push_back(model::PointDisplacement(a.model, a.spec, a.f_tip_O_N, p));
+    finite = finite && a.displacements_O_m.back().allFinite();
+  }
+  return finite;
+}
+
+int RunBeam(const BeamOptions& o, Streams io) {
+  report::BeamAnswer a;
+  if (!o.scene_path.empty()) {
+    const io::SceneLoadResult loaded = io::LoadSceneFile(o.scene_path);
+    io.err << loaded.diagnostics.FormatAll();
+    if (!loaded.scene) return kExitBadInput;
+    a.spec = loaded.scene->tube;
+    // The rod's large-deflection limit is the elastica.
+    a.model = loaded.scene->model.tube == scene::TubeModel::kLinear ? model::BeamModel::kLinear
+                                                                    : model::BeamModel::kElastica;
+  }
+  const std::vector<std::string> errors = ReadLoad(o, a);
   if (!errors.empty()) {
     for (const std::string& e : errors) io.err << "tubeplan beam: error: " << e << "\n";
     return kExitBadInput;
   }
-
-  const model::TubeSection section = model::ComputeSection(spec);
   // Loads the models cannot answer are bad input, not internal errors: say which limit.
-  const double alpha = model::LoadParameter(spec, f_tip_O_N.norm());
-  if (beam_model == model::BeamModel::kElastica && !(alpha <= model::kMaxElasticaAlpha)) {
+  const double alpha = model::LoadParameter(a.spec, a.f_tip_O_N.norm());
+  if (a.model == model::BeamModel::kElastica && !(alpha <= model::kMaxElasticaAlpha)) {
     io.err << "tubeplan beam: error: --tip-force: the load parameter alpha = F l^2 / (E I) = "
            << alpha << " is beyond the elastica's range (at most " << model::kMaxElasticaAlpha
            << "), expected a smaller force or a stiffer tube\n";
     return kExitBadInput;
   }
-  const model::TipLoadResponse r = model::TipResponse(beam_model, spec, f_tip_O_N);
-  std::vector<Eigen::Vector3d> displacements;
-  bool finite = std::isfinite(r.alpha) && r.tip_displacement_O_m.allFinite() &&
-                std::isfinite(r.tip_angle_rad) && std::isfinite(r.energy_J) &&
-                std::isfinite(r.root_strain);
-  for (const Eigen::Vector3d& p : points) {
-    displacements.push_back(model::PointDisplacement(beam_model, spec, f_tip_O_N, p));
-    finite = finite && displacements.back().allFinite();
-  }
-  if (!finite) {
+  if (!Answer(a)) {
     io.err << "tubeplan beam: error: --tip-force: the results overflow a double for this load "
               "(alpha = "
            << alpha << "), expected a smaller force\n";
     return kExitBadInput;
   }
-
-  if (o.json) {
-    nlohmann::json doc;
-    doc["model"] = std::string(model::ToString(beam_model));
-    doc["tube"] = {{"outer_radius", spec.outer_radius_m},
-                   {"inner_radius", spec.inner_radius_m},
-                   {"length", spec.length_m},
-                   {"youngs_modulus", spec.youngs_modulus_Pa},
-                   {"poisson_ratio", spec.poisson_ratio},
-                   {"second_moment", section.second_moment_m4},
-                   {"bending_stiffness", section.bending_stiffness_Nm2},
-                   {"tip_stiffness", section.tip_stiffness_N_per_m}};
-    doc["tip_force"] = {f_tip_O_N.x(), f_tip_O_N.y(), f_tip_O_N.z()};
-    doc["alpha"] = r.alpha;
-    doc["tip_displacement"] = {r.tip_displacement_O_m.x(), r.tip_displacement_O_m.y(),
-                               r.tip_displacement_O_m.z()};
-    doc["tip_deflection"] = r.tip_deflection_m;
-    doc["tip_shortening"] = r.tip_shortening_m;
-    doc["tip_angle"] = r.tip_angle_rad;
-    doc["energy"] = r.energy_J;
-    doc["strain"] = r.root_strain;
-    doc["points"] = nlohmann::json::array();
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      doc["points"].push_back(
-          {{"at", {points[i].x(), points[i].y(), points[i].z()}},
-           {"displacement", {displacements[i].x(), displacements[i].y(), displacements[i].z()}}});
-    }
-    io.out << doc.dump(2) << "\n";
-    return kExitOk;
-  }
-
-  std::ostream& out = io.out;
-  out << std::setprecision(6);
-  out << "tube:            r1 " << spec.outer_radius_m * 1e3 << " mm, r2 "
-      << spec.inner_radius_m * 1e3 << " mm, l " << spec.length_m * 1e3 << " mm, E "
-      << spec.youngs_modulus_Pa << " Pa, nu " << spec.poisson_ratio << "\n";
-  out << "section:         I " << section.second_moment_m4 << " m^4, EI "
-      << section.bending_stiffness_Nm2 << " N m^2, tip stiffness 3EI/l^3 "
-      << section.tip_stiffness_N_per_m << " N/m\n";
-  out << "model:           " << model::ToString(beam_model) << "\n";
-  out << "tip force:       " << Vec(f_tip_O_N) << " N (tube frame, z along the axis)\n";
-  out << "alpha:           " << r.alpha << "  (F l^2 / EI)\n";
-  out << "tip deflection:  " << r.tip_deflection_m << " m\n";
-  out << "tip shortening:  " << r.tip_shortening_m << " m\n";
-  out << "tip angle:       " << r.tip_angle_rad << " rad ("
-      << r.tip_angle_rad * 180.0 / std::numbers::pi << " deg)\n";
-  out << "bending energy:  " << r.energy_J << " J\n";
-  out << "root strain:     " << r.root_strain << "\n";
-  for (std::size_t i = 0; i < points.size(); ++i)
-    out << "point " << Vec(points[i]) << " m: displacement " << Vec(displacements[i]) << " m\n";
-  if (beam_model == model::BeamModel::kLinear && r.alpha > kLinearAlphaLimit)
-    out << "note: alpha " << r.alpha << " > " << kLinearAlphaLimit
-        << ": the linear model over-predicts the tip deflection here (0.7 % at 0.25, 10 % at 1); "
-           "try --model elastica\n";
+  if (o.json)
+    io.out << report::BeamJson(a).dump(2) << "\n";
+  else
+    report::PrintBeam(io.out, a);
   return kExitOk;
 }
 
