@@ -218,7 +218,7 @@ CorePoses PosesFor(const scene::Scene& scene) {
   const double y = scene.X_WH_start.translation().y();
   // The gap between the tube and the left wall when the tube lies along the groove's middle.
   double gap_m = 0.25 * r1;
-  for (const scene::BoxPart& part : scene.parts)
+  for (const scene::Part& part : scene.parts)
     if (part.name == "left") gap_m = -(part.X_WP.translation().x() + 0.5 * part.size_m.x()) - r1;
   constexpr double kTipDownDeg = 15.0;
   const double tip_down = kTipDownDeg * std::numbers::pi / 180.0;
@@ -280,7 +280,7 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   // The same stuck tip without friction, and with the shape asked for every tick.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
-  for (scene::BoxPart& part : frictionless.parts) part.friction.reset();
+  for (scene::Part& part : frictionless.parts) part.friction.reset();
   out.push_back(CoreScenario(frictionless, "core.end_pressed.frictionless",
                              "core.end_stuck on the scene without friction", end_pose, dither));
   out.push_back(CoreScenario(scene, "core.end_stuck.mesh",

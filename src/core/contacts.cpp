@@ -330,19 +330,19 @@ class Finder {
 
   // Records a side's contact (kSide, kCurve) with an edge (on_line) or the vertex it ends in (u 0
   // or 1), q on it: the axis point at theta is at w (length lw) from q. The distance is the
-  // axis's from the edge less r1: it does not change as the tube slides along its axis or along
-  // the edge, so it curves only across both (past a vertex, about the tube's `tangent`), not as a
-  // point's distance from the edge would; its change as the tube turns is left out. It moves with
-  // the axis point alone (the nearest point's own motion changes it only to second order); the
-  // surface point is r1 from it.
+  // axis's from the edge less r1 (and less a round side's radius): it does not change as the tube
+  // slides along its axis or along the edge, so it curves only across both (past a vertex, about
+  // the tube's `tangent`), not as a point's distance from the edge would; its change as the tube
+  // turns is left out. It moves with the axis point alone (the nearest point's own motion changes
+  // it only to second order); the surface point is r1 from it.
   Sample* RecordEdge(SampleKind kind, int p, int i, int e, double theta, double weight,
                      const PartEdge& edge, bool on_line, const Vec3& q, double u, const Vec3& w,
                      double lw, const Vec3& tangent) {
     const double r1 = m_.rod.outer_radius_m;
     PartDistance at;
-    at.distance_m = lw - r1;
+    at.distance_m = lw - r1 - edge.radius_m;
     at.normal_W = w / lw;
-    at.point_W = q;
+    at.point_W = q + edge.radius_m * at.normal_W;
     at.face_mask = on_line ? edge.face_mask : u == 0.0 ? edge.a_mask : edge.b_mask;
     if (on_line) {
       at.curvature_per_m.setZero();
@@ -380,6 +380,7 @@ class Finder {
         continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
+      if ((u == 0.0 && !edge.a_bears) || (u == 1.0 && !edge.b_bears)) continue;
       // The free end's half starts where the last curve piece ends, and bears a point there.
       if (!(theta > theta_lo || (theta == theta_lo && theta_lo > 0.0)) || !(theta < theta_hi))
         continue;
@@ -388,7 +389,7 @@ class Finder {
       const Vec3 q = edge.a_W + u * ab;
       const Vec3 w = c - q;
       const double lw = w.norm();
-      if (!(lw - r1 < eps) || lw == 0.0) continue;
+      if (!(lw - r1 - edge.radius_m < eps) || lw == 0.0) continue;
       // The edge bears where the axis point lies in front of both its faces' planes; its share
       // fades out over the ramp behind either plane, beside the face whose nodes' spheres bear.
       Vec3 d_above_dc;
@@ -468,7 +469,8 @@ class Finder {
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(m0, m1, edge.a_W, edge.b_W, theta, u);
       const Vec3 ab = edge.b_W - edge.a_W;
-      if ((m0 + theta * (m1 - m0) - edge.a_W - u * ab).norm() - bulge >= r1 + eps) continue;
+      if ((m0 + theta * (m1 - m0) - edge.a_W - u * ab).norm() - bulge >= r1 + edge.radius_m + eps)
+        continue;
       const Vec3 unit = ab.normalized();
       // The piece's point nearest the edge: nearest its line where that projects inside the
       // edge (u in [0, 1]), else nearest the vertex on the side it projects to.
@@ -481,6 +483,7 @@ class Finder {
         dir = Vec3::Zero();
         found = false;
         for (const double end : {0.0, 1.0}) {
+          if (!(end == 0.0 ? edge.a_bears : edge.b_bears)) continue;
           from = end == 0.0 ? edge.a_W : edge.b_W;
           u = end;
           if (InsidePiece(x0, x1, x2, from, dir, guess, theta, curvature) &&
@@ -497,7 +500,7 @@ class Finder {
       const Mat3 Q = Mat3::Identity() - dir * dir.transpose();
       const Vec3 r = Q * (c - from);
       const double lr = r.norm();
-      if (!(lr - r1 < eps) || lr == 0.0) continue;
+      if (!(lr - r1 - edge.radius_m < eps) || lr == 0.0) continue;
       Vec3 d_above_dc, d_across_dv = Vec3::Zero();
       const double above = InFrontOfFaces(edge, c, ramp_m, d_above_dc);
       const bool on_line = dir.squaredNorm() > 0.0;
@@ -610,7 +613,7 @@ void FindPartsNear(const Model& model, std::span<const Vec3> x_W, double reach_m
   // nearest box bounds how far the tube's surface is from them.
   double far = std::numeric_limits<double>::infinity();
   for (std::size_t p = 0; p < model.parts.size(); ++p) {
-    const BoxGeometry& g = model.parts[p].geometry;
+    const PartGeometry& g = model.parts[p].geometry;
     const Vec3 gap = (g.min_W() - hi).cwiseMax(lo - g.max_W()).cwiseMax(0.0);
     const bool near = !(gap.array() > grow).any();
     data.scratch.parts_near[p] = near;

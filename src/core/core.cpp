@@ -144,8 +144,8 @@ void BuildModel(const scene::Scene& scene, Model& m, std::vector<scene::PartElem
   std::size_t next_element = 0;
   for (std::uint32_t p = 0; p < scene.parts.size(); ++p) {
     PartModel part;
-    part.geometry = BoxGeometry(scene.parts[p]);
-    const BoxGeometry& g = part.geometry;
+    part.geometry = PartGeometry(scene.parts[p]);
+    const PartGeometry& g = part.geometry;
     // All elements of a part are consecutive in `all`, in part order.
     while (next_element < all.size() && all[next_element].part_index < p) ++next_element;
     if ((g.min_W().array() > hi.array()).any() || (g.max_W().array() < lo.array()).any()) continue;

@@ -45,7 +45,7 @@ struct SolverModel {
 };
 
 struct PartModel {
-  BoxGeometry geometry;
+  PartGeometry geometry;
   std::uint32_t scene_index = 0;
   scene::Friction friction;
   /// Element index (into Core::elements()) of each face mask; -1 where none.

@@ -19,8 +19,21 @@ std::uint8_t FaceOn(int axis, double sign) {
 
 }  // namespace
 
-BoxGeometry::BoxGeometry(const scene::BoxPart& box)
-    : R_WP_(box.X_WP.linear()), p_WP_(box.X_WP.translation()), half_m_(0.5 * box.size_m) {
+PartGeometry::PartGeometry(const scene::Part& part)
+    : shape_(part.shape),
+      R_WP_(part.X_WP.linear()),
+      p_WP_(part.X_WP.translation()),
+      half_m_(0.5 * part.size_m) {
+  if (shape_ == scene::PartShape::kCylinder)
+    BuildCylinder();
+  else
+    BuildBox();
+}
+
+void PartGeometry::BuildBox() {
+  vertices_W_.resize(8);
+  vertex_masks_.resize(8);
+  edges_.resize(12);
   min_W_.setConstant(std::numeric_limits<double>::infinity());
   max_W_ = -min_W_;
   for (int corner = 0; corner < 8; ++corner) {
@@ -56,8 +69,111 @@ BoxGeometry::BoxGeometry(const scene::BoxPart& box)
   }
 }
 
-PartDistance BoxGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask) const {
+void PartGeometry::BuildCylinder() {
+  const double radius_m = half_m_.x(), h = half_m_.z();
+  const Eigen::Vector3d z_W = R_WP_.col(2);
+  // The tight box of a turned cylinder: along world axis i its ends reach |z_i| h and its rims
+  // r sqrt(1 - z_i^2) beyond.
+  const Eigen::Vector3d reach =
+      z_W.cwiseAbs() * h + radius_m * (1.0 - z_W.array().square()).max(0.0).sqrt().matrix();
+  min_W_ = p_WP_ - reach;
+  max_W_ = p_WP_ + reach;
+  const auto side = FaceBit(scene::CylinderFace::kSide);
+  for (const auto end : {scene::CylinderFace::kTop, scene::CylinderFace::kBottom}) {
+    const double sz = end == scene::CylinderFace::kTop ? 1.0 : -1.0;
+    const auto mask = static_cast<std::uint8_t>(FaceBit(end) | side);
+    for (int k = 0; k < kRimSegments; ++k) {
+      const auto corner_P = [&](int j) {
+        const double phi = 2.0 * M_PI * double(j % kRimSegments) / kRimSegments;
+        return Eigen::Vector3d(radius_m * std::cos(phi), radius_m * std::sin(phi), sz * h);
+      };
+      const Eigen::Vector3d a_P = corner_P(k), b_P = corner_P(k + 1);
+      PartEdge edge;
+      edge.a_W = p_WP_ + R_WP_ * a_P;
+      edge.b_W = p_WP_ + R_WP_ * b_P;
+      edge.min_W = edge.a_W.cwiseMin(edge.b_W);
+      edge.max_W = edge.a_W.cwiseMax(edge.b_W);
+      edge.face_mask = edge.a_mask = edge.b_mask = mask;
+      edge.a_bears = false;
+      const Eigen::Vector3d mid_P = 0.5 * (a_P + b_P);
+      edge.face_normals_W = {sz * z_W,
+                             R_WP_ * Eigen::Vector3d(mid_P.x(), mid_P.y(), 0.0).normalized()};
+      edges_.push_back(edge);
+    }
+  }
+  // The round side: the axis, grown by the radius, bearing between the rims only.
+  PartEdge axis;
+  axis.a_W = p_WP_ - h * z_W;
+  axis.b_W = p_WP_ + h * z_W;
+  axis.radius_m = radius_m;
+  axis.min_W = axis.a_W.cwiseMin(axis.b_W).array() - radius_m;
+  axis.max_W = axis.a_W.cwiseMax(axis.b_W).array() + radius_m;
+  axis.face_mask = axis.a_mask = axis.b_mask = side;
+  axis.a_bears = axis.b_bears = false;
+  edges_.push_back(axis);
+}
+
+PartDistance PartGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask) const {
   const Eigen::Vector3d p_P = R_WP_.transpose() * (p_W - p_WP_);
+  PartDistance r = shape_ == scene::PartShape::kCylinder ? CylinderDistance(p_P, entry_mask)
+                                                         : BoxDistance(p_P, entry_mask);
+  r.point_W = p_W - r.distance_m * r.normal_W;
+  return r;
+}
+
+PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P,
+                                            std::uint8_t entry_mask) const {
+  using scene::CylinderFace;
+  const double radius_m = half_m_.x(), h = half_m_.z();
+  const double rho = std::hypot(p_P.x(), p_P.y());
+  // The radial direction (any one on the axis) and the rims' direction there.
+  const Eigen::Vector3d u_P =
+      rho > 0.0 ? Eigen::Vector3d(p_P.x() / rho, p_P.y() / rho, 0.0) : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d a_P(-u_P.y(), u_P.x(), 0.0);
+  const double sz = p_P.z() >= 0.0 ? 1.0 : -1.0;
+  const CylinderFace end = sz > 0.0 ? CylinderFace::kTop : CylinderFace::kBottom;
+  const double q_side = rho - radius_m, q_end = std::abs(p_P.z()) - h;
+  PartDistance r;
+  Eigen::Vector3d n_P;
+  Eigen::Matrix3d c_P = Eigen::Matrix3d::Zero();
+  if (q_side > 0.0 && q_end > 0.0) {
+    // Beyond a rim: the distance to a circle, curving as a line's across it and with the circle
+    // along it.
+    r.distance_m = std::hypot(q_side, q_end);
+    n_P = (q_side * u_P + q_end * sz * Eigen::Vector3d::UnitZ()) / r.distance_m;
+    r.face_mask = FaceBit(end) | FaceBit(CylinderFace::kSide);
+    c_P = (Eigen::Matrix3d::Identity() - n_P * n_P.transpose() - a_P * a_P.transpose()) /
+              r.distance_m +
+          a_P * a_P.transpose() * (q_side / (r.distance_m * rho));
+  } else if (q_side > 0.0) {
+    r.distance_m = q_side;
+    n_P = u_P;
+    r.face_mask = FaceBit(CylinderFace::kSide);
+    c_P = a_P * a_P.transpose() / rho;
+  } else if (q_end > 0.0) {
+    r.distance_m = q_end;
+    n_P = sz * Eigen::Vector3d::UnitZ();
+    r.face_mask = FaceBit(end);
+  } else {
+    // Inside: out through the face the point came in by, if it is known, else the nearest.
+    const std::array<double, 3> out = {p_P.z() - h, -p_P.z() - h, q_side};
+    int face = -1;
+    for (int f = 0; f < 3; ++f)
+      if (entry_mask & (1u << f) && (face < 0 || out[std::size_t(f)] > out[std::size_t(face)]))
+        face = f;
+    if (face < 0) face = q_side > q_end ? int(CylinderFace::kSide) : int(end);
+    r.distance_m = out[std::size_t(face)];
+    r.face_mask = static_cast<std::uint8_t>(1u << face);
+    n_P = face == int(CylinderFace::kSide)  ? u_P
+          : face == int(CylinderFace::kTop) ? Eigen::Vector3d::UnitZ()
+                                            : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
+  }
+  r.normal_W = R_WP_ * n_P;
+  r.curvature_per_m = R_WP_ * c_P * R_WP_.transpose();
+  return r;
+}
+
+PartDistance PartGeometry::BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const {
   const Eigen::Vector3d q = p_P.cwiseAbs() - half_m_;
   PartDistance r;
   const Eigen::Vector3d outside = q.cwiseMax(0.0);
@@ -73,7 +189,6 @@ PartDistance BoxGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entr
     }
     r.distance_m = out_m;
     r.normal_W = R_WP_ * g_P;
-    r.point_W = p_W - out_m * r.normal_W;
     // Beyond an edge or a vertex the distance is to a line or a point: it curves.
     const int beyond = (q[0] > 0.0) + (q[1] > 0.0) + (q[2] > 0.0);
     if (beyond >= 2) {
@@ -105,7 +220,6 @@ PartDistance BoxGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entr
   Eigen::Vector3d g_P = Eigen::Vector3d::Zero();
   g_P[axis] = sign;
   r.normal_W = R_WP_ * g_P;
-  r.point_W = p_W - r.distance_m * r.normal_W;
   r.face_mask = FaceOn(axis, sign);
   return r;
 }

@@ -1,11 +1,13 @@
 #pragma once
 // The rigid parts as the contact stage sees them: a signed distance with its gradient and the
 // element (face, edge, vertex) the nearest point lies on, and the sharp features (edges as
-// segments, vertices as points) that can poke into the tube between its sections. Boxes today;
-// any convex or meshed part offers the same three things.
+// segments, vertices as points) that can poke into the tube between its sections. Boxes and
+// cylinders; a cylinder's rims are polygons of short segments and its side bears on the tube
+// between sections as its axis does, grown by its radius.
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -20,9 +22,10 @@ struct PartDistance {
   /// Unit outward normal at the nearest point: the direction in which the distance grows.
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();  ///< nearest point on the part's surface
-  std::uint8_t face_mask = 0;  ///< faces the nearest point lies on (BoxFace bits)
+  std::uint8_t face_mask = 0;  ///< faces the nearest point lies on (BoxFace, CylinderFace bits)
   /// The distance's second derivative: (I - n n^T - a a^T) / distance near an edge (a its unit
-  /// direction), (I - n n^T) / distance near a vertex, zero near a face or inside.
+  /// direction), (I - n n^T) / distance near a vertex, zero near a flat face or inside; near a
+  /// cylinder's side, its curving about the axis.
   Eigen::Matrix3d curvature_per_m = Eigen::Matrix3d::Zero();
 };
 
@@ -31,35 +34,48 @@ struct PartEdge {
   Eigen::Vector3d min_W = Eigen::Vector3d::Zero(), max_W = Eigen::Vector3d::Zero();  ///< its box
   std::uint8_t face_mask = 0;
   std::uint8_t a_mask = 0, b_mask = 0;  ///< the vertices it ends in
-  /// The outward unit normals of the two faces that meet at it.
+  /// Whether a load at an end is this segment's: not where a rim's polygon goes on into its next
+  /// segment (that one bears the shared point), not at a round side's axis ends (the rims do).
+  bool a_bears = true, b_bears = true;
+  /// A round side is its axis as an edge with the side's radius: the surface lies this far from
+  /// the segment [m]; 0 for a sharp edge.
+  double radius_m = 0.0;
+  /// The outward unit normals of the two faces that meet at it (zero for a round side's axis:
+  /// it bears all round).
   std::array<Eigen::Vector3d, 2> face_normals_W{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
 };
 
-class BoxGeometry {
+class PartGeometry {
  public:
-  BoxGeometry() = default;
-  explicit BoxGeometry(const scene::BoxPart& box);
+  PartGeometry() = default;
+  explicit PartGeometry(const scene::Part& part);
 
-  /// Signed distance of p_W to the box. Inside, the distance is to the face given by
+  /// Signed distance of p_W to the part. Inside, the distance is to the face given by
   /// `entry_mask` when it names one (the face the point came in through: a thin part is not
   /// crossed by pushing a point past its middle), else to the nearest face.
   PartDistance Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask = 0) const;
 
-  const std::array<PartEdge, 12>& edges() const { return edges_; }
-  const std::array<Eigen::Vector3d, 8>& vertices_W() const { return vertices_W_; }
-  const std::array<std::uint8_t, 8>& vertex_masks() const { return vertex_masks_; }
+  const std::vector<PartEdge>& edges() const { return edges_; }
+  const std::vector<Eigen::Vector3d>& vertices_W() const { return vertices_W_; }
+  const std::vector<std::uint8_t>& vertex_masks() const { return vertex_masks_; }
   const Eigen::Vector3d& min_W() const { return min_W_; }
   const Eigen::Vector3d& max_W() const { return max_W_; }
-  /// The smallest of the box's three extents [m].
+  /// The smallest of the part's three extents [m].
   double thinnest_m() const { return 2.0 * half_m_.minCoeff(); }
 
  private:
+  void BuildBox();
+  void BuildCylinder();
+  PartDistance BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const;
+  PartDistance CylinderDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const;
+
+  scene::PartShape shape_ = scene::PartShape::kBox;
   Eigen::Matrix3d R_WP_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d p_WP_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d half_m_ = Eigen::Vector3d::Zero();
-  std::array<PartEdge, 12> edges_{};
-  std::array<Eigen::Vector3d, 8> vertices_W_{};
-  std::array<std::uint8_t, 8> vertex_masks_{};
+  Eigen::Vector3d half_m_ = Eigen::Vector3d::Zero();  ///< half extents in the part's frame
+  std::vector<PartEdge> edges_;
+  std::vector<Eigen::Vector3d> vertices_W_;
+  std::vector<std::uint8_t> vertex_masks_;
   Eigen::Vector3d min_W_ = Eigen::Vector3d::Zero(), max_W_ = Eigen::Vector3d::Zero();
 };
 
@@ -67,5 +83,14 @@ class BoxGeometry {
 constexpr std::uint8_t FaceBit(scene::BoxFace face) {
   return static_cast<std::uint8_t>(1u << static_cast<int>(face));
 }
+
+/// Bit of CylinderFace `face` in a face mask.
+constexpr std::uint8_t FaceBit(scene::CylinderFace face) {
+  return static_cast<std::uint8_t>(1u << static_cast<int>(face));
+}
+
+/// Segments of a cylinder's rim polygon: the polygon lies within R (1 - cos(pi / 64)), 0.12 % of
+/// the radius, of the circle.
+inline constexpr int kRimSegments = 64;
 
 }  // namespace tubeplan::core

@@ -16,6 +16,7 @@
 #include <utility>
 
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/scene/geometry.hpp>
 
 namespace tubeplan::graph {
 
@@ -322,7 +323,7 @@ struct Box {
 Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts) {
   Box box;
   for (std::uint32_t p : parts) {
-    const scene::BoxPart& part = scene.parts[p];
+    const scene::Part& part = scene.parts[p];
     for (int corner = 0; corner < 8; ++corner) {
       const Eigen::Vector3d c_P((corner & 1 ? 0.5 : -0.5) * part.size_m.x(),
                                 (corner & 2 ? 0.5 : -0.5) * part.size_m.y(),
@@ -334,18 +335,9 @@ Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts)
   return box;
 }
 
-// Outward normal of box face i (BoxFace order) in the part's frame.
-Eigen::Vector3d FaceNormal_P(int face) {
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  n[face / 2 == 0 ? 2 : face / 2 - 1] = face % 2 == 0 ? 1.0 : -1.0;
-  return n;
-}
-
 bool InsideAnyPart(const scene::Scene& scene, const Eigen::Vector3d& p_W) {
-  for (const scene::BoxPart& part : scene.parts) {
-    const Eigen::Vector3d p_P = part.X_WP.inverse() * p_W;
-    if ((p_P.cwiseAbs().array() < 0.5 * part.size_m.array()).all()) return true;
-  }
+  for (const scene::Part& part : scene.parts)
+    if (scene::Contains(part, p_W)) return true;
   return false;
 }
 
@@ -463,16 +455,12 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   std::vector<Motion> motions;
   for (int e : elements) {
     const scene::PartElement& element = probe.elements()[std::size_t(e)];
-    const scene::BoxPart& part = scene.parts[element.part_index];
-    Eigen::Vector3d c_P = Eigen::Vector3d::Zero(), n_P = Eigen::Vector3d::Zero();
-    for (int face = 0; face < 6; ++face) {
-      if ((element.face_mask & (1u << face)) == 0) continue;
-      const Eigen::Vector3d nf = FaceNormal_P(face);
-      n_P += nf;
-      c_P += 0.5 * part.size_m.cwiseProduct(nf);
-    }
-    const Eigen::Vector3d c_W = part.X_WP * c_P;
-    const Eigen::Vector3d n_W = (part.X_WP.linear() * n_P).normalized();
+    const scene::Part& part = scene.parts[element.part_index];
+    // A round element is aimed at where it faces the start.
+    const scene::ElementPoint at =
+        scene::PointOnElement(part, element.face_mask, f.p0 - part.X_WP.translation());
+    const Eigen::Vector3d& c_W = at.p_W;
+    const Eigen::Vector3d& n_W = at.n_W;
     // An element whose outside is inside another part (a wall's bottom on the floor) cannot be
     // touched: not aimed at.
     if (InsideAnyPart(scene, c_W + 0.5 * scene.contact.threshold_m * n_W)) continue;

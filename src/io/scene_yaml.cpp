@@ -103,7 +103,7 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   return ok ? std::optional(f) : std::nullopt;
 }
 
-bool PointInside(const scene::BoxPart& box, const Eigen::Vector3d& p_W, double tolerance_m) {
+bool PointInside(const scene::Part& box, const Eigen::Vector3d& p_W, double tolerance_m) {
   const Eigen::Vector3d p_P = box.X_WP.inverse() * p_W;
   return ((box.size_m / 2.0).array() - p_P.cwiseAbs().array() > tolerance_m).all();
 }
@@ -113,6 +113,58 @@ constexpr double kGeometryTolerance_m = 1e-9;
 // The most parts a scene may hold (docs/scene-format.md): the core compares the tube with every
 // part within its reach each tick, and a scene of a thousand parts is far beyond a task's fixture.
 constexpr std::size_t kMaxParts = 1000;
+
+// A part's shape: exactly one of `box: {size, position, rpy}` and `cylinder: {radius, length,
+// position, rpy}`. Returns the mark of its position, for messages about the part.
+YAML::Mark ReadShape(Reader& r, const YAML::Node& part_node, const std::string& where,
+                     scene::Part& part) {
+  const YAML::Node box = part_node["box"], cylinder = part_node["cylinder"];
+  if (box.IsDefined() == cylinder.IsDefined()) {
+    r.Error(box.IsDefined() ? cylinder : part_node,
+            where + (box.IsDefined() ? " has both a box and a cylinder" : " has no shape") +
+                ", expected exactly one of 'box' and 'cylinder'");
+    return part_node.Mark();
+  }
+  const bool is_box = box.IsDefined();
+  const YAML::Node shape = is_box ? box : cylinder;
+  const std::string sw = where + (is_box ? ".box" : ".cylinder");
+  part.shape = is_box ? scene::PartShape::kBox : scene::PartShape::kCylinder;
+  const std::span<const char* const> ids = scene::FaceIds(part.shape);
+  for (std::size_t f = 0; f < ids.size(); ++f) part.face_names[f] = ids[f];
+  if (!r.ExpectMap(shape, sw,
+                   is_box ? std::vector<std::string>{"size", "position", "rpy"}
+                          : std::vector<std::string>{"radius", "length", "position", "rpy"}))
+    return shape.Mark();
+  if (is_box) {
+    if (const YAML::Node n = r.Get(shape, "size", sw, true); n.IsDefined()) {
+      if (const auto size = r.Vector(n, sw + ".size", dim::kLength)) {
+        part.size_m = *size;
+        if ((part.size_m.array() <= 0.0).any())
+          r.Error(n, sw + ".size must be greater than zero along every axis");
+      }
+    }
+  } else {
+    double radius_m = 0.0, length_m = 0.0;
+    for (const auto& [key, target] : {std::pair<const char*, double*>{"radius", &radius_m},
+                                      std::pair<const char*, double*>{"length", &length_m}}) {
+      if (!r.Field(shape, key, sw, dim::kLength, true, *target)) continue;
+      if (!(*target > 0.0))
+        r.Error(r.Get(shape, key, sw, true),
+                sw + "." + key + " must be greater than zero, expected a length such as 10 mm");
+    }
+    part.size_m = Eigen::Vector3d(2.0 * radius_m, 2.0 * radius_m, length_m);
+  }
+  Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
+  YAML::Mark position_mark = shape.Mark();
+  if (const YAML::Node n = r.Get(shape, "position", sw, false); n.IsDefined()) {
+    position_mark = n.Mark();
+    if (const auto p = r.Vector(n, sw + ".position", dim::kLength)) position = *p;
+  }
+  if (const YAML::Node n = r.Get(shape, "rpy", sw, false); n.IsDefined())
+    if (const auto a = ReadRpy(r, n, sw + ".rpy")) rpy = *a;
+  part.X_WP = Pose(position, rpy);
+  return position_mark;
+}
 
 void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok) {
   if (!node.IsSequence() || node.size() == 0) {
@@ -136,11 +188,11 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
     const YAML::Node part_node = node[i];
     const std::string where = "parts[" + std::to_string(i) + "]";
     const std::size_t errors = r.error_count();
-    if (!r.ExpectMap(part_node, where, {"name", "box", "faces", "friction"})) {
+    if (!r.ExpectMap(part_node, where, {"name", "box", "cylinder", "faces", "friction"})) {
       parts_ok = false;
       continue;
     }
-    scene::BoxPart part;
+    scene::Part part;
     if (const YAML::Node n = r.Get(part_node, "name", where, true); n.IsDefined()) {
       if (const auto name = r.String(n, where + ".name")) {
         part.name = *name;
@@ -152,32 +204,11 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
       }
     }
-    YAML::Mark position_mark = YAML::Mark::null_mark();
-    if (const YAML::Node box = r.Get(part_node, "box", where, true); box.IsDefined()) {
-      const std::string bw = where + ".box";
-      if (r.ExpectMap(box, bw, {"size", "position", "rpy"})) {
-        if (const YAML::Node n = r.Get(box, "size", bw, true); n.IsDefined()) {
-          if (const auto size = r.Vector(n, bw + ".size", dim::kLength)) {
-            part.size_m = *size;
-            if ((part.size_m.array() <= 0.0).any())
-              r.Error(n, bw + ".size must be greater than zero along every axis");
-          }
-        }
-        Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
-        if (const YAML::Node n = r.Get(box, "position", bw, false); n.IsDefined()) {
-          position_mark = n.Mark();
-          if (const auto p = r.Vector(n, bw + ".position", dim::kLength)) position = *p;
-        } else {
-          position_mark = box.Mark();
-        }
-        if (const YAML::Node n = r.Get(box, "rpy", bw, false); n.IsDefined())
-          if (const auto a = ReadRpy(r, n, bw + ".rpy")) rpy = *a;
-        part.X_WP = Pose(position, rpy);
-      }
-    }
+    YAML::Mark position_mark = ReadShape(r, part_node, where, part);
     if (const YAML::Node faces = r.Get(part_node, "faces", where, false); faces.IsDefined()) {
       const std::string fw = where + ".faces";
-      const std::vector<std::string> ids(scene::kBoxFaceIds.begin(), scene::kBoxFaceIds.end());
+      const std::span<const char* const> shape_ids = scene::FaceIds(part.shape);
+      const std::vector<std::string> ids(shape_ids.begin(), shape_ids.end());
       if (r.ExpectMap(faces, fw, ids)) {
         for (const auto& entry : faces) {
           const auto it = std::find(ids.begin(), ids.end(), entry.first.Scalar());
@@ -193,8 +224,8 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           }
           part.face_names[static_cast<std::size_t>(it - ids.begin())] = *name;
         }
-        for (std::size_t a = 0; a < 6; ++a)
-          for (std::size_t b = a + 1; b < 6; ++b)
+        for (std::size_t a = 0; a < ids.size(); ++a)
+          for (std::size_t b = a + 1; b < ids.size(); ++b)
             if (part.face_names[a] == part.face_names[b])
               r.Error(faces, fw + ": two faces are named '" + part.face_names[a] +
                                  "', expected a distinct name for each face");
@@ -312,10 +343,10 @@ void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
 void ReadHeuristics(Reader& r, const YAML::Node& node, scene::Heuristics& h) {
   const std::string w = "heuristics";
   if (!r.ExpectMap(node, w, {"friction", "energy", "distance", "tolerance"})) return;
-  for (auto [key, target] : {std::pair<const char*, double*>{"friction", &h.friction},
-                             {"energy", &h.energy},
-                             {"distance", &h.distance},
-                             {"tolerance", &h.tolerance}}) {
+  for (const auto& [key, target] : {std::pair<const char*, double*>{"friction", &h.friction},
+                                    {"energy", &h.energy},
+                                    {"distance", &h.distance},
+                                    {"tolerance", &h.tolerance}}) {
     if (r.Field(node, key, w, dim::kNone, false, *target) && !(*target >= 0.0 && *target <= 1e6))
       r.Error(r.Get(node, key, w, false),
               w + "." + key + " must be a weight between 0 and 1e6, expected e.g. 1");
@@ -507,7 +538,7 @@ void WarnContactBand(Reader& r, const YAML::Node& root, const scene::Scene& s) {
 // The penalty's force at a part's middle, K (eps + half its thickness): below the device's
 // force, a full push can carry the tube out the part's far side. Said for the first such part.
 void WarnThinParts(Reader& r, const YAML::Node& root, const scene::Scene& s) {
-  for (const scene::BoxPart& part : s.parts) {
+  for (const scene::Part& part : s.parts) {
     const double hold_N = scene::ContactHoldAtMiddle_N(s, part);
     if (!(hold_N < s.device.max_force_N) || part.size_m.minCoeff() <= 0.0) continue;
     std::ostringstream m;

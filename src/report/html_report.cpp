@@ -265,10 +265,11 @@ nlohmann::json PlanJson(const HtmlPlan& p) {
   const ReplayRecording& r = p.recording;
   const scene::Scene& s = *p.scene;
   nlohmann::json parts = nlohmann::json::array();
-  for (const scene::BoxPart& b : s.parts) {
+  for (const scene::Part& b : s.parts) {
     const Eigen::Quaterniond q(b.X_WP.linear());
     parts.push_back(
         {{"name", b.name},
+         {"shape", b.shape == scene::PartShape::kCylinder ? "cylinder" : "box"},
          {"size_mm", Mm(b.size_m)},
          {"p_mm", Mm(b.X_WP.translation())},
          {"q_wxyz",

@@ -1,12 +1,31 @@
+#include <utility>
+
 #include <tubeplan/scene/scene.hpp>
 
 namespace tubeplan::scene {
 
 const char* ToString(TubeModel model) { return model == TubeModel::kLinear ? "linear" : "rod"; }
 
-double ContactHoldAtMiddle_N(const Scene& scene, const BoxPart& part) {
+double ContactHoldAtMiddle_N(const Scene& scene, const Part& part) {
   return scene.contact.stiffness_N_per_m *
          (scene.contact.threshold_m + 0.5 * part.size_m.minCoeff());
+}
+
+std::span<const char* const> FaceIds(PartShape shape) {
+  if (shape == PartShape::kCylinder) return kCylinderFaceIds;
+  return kBoxFaceIds;
+}
+
+Part MakeCylinder(std::string name, double radius_m, double length_m,
+                  const Eigen::Isometry3d& X_WP) {
+  Part part;
+  part.name = std::move(name);
+  part.shape = PartShape::kCylinder;
+  part.size_m = Eigen::Vector3d(2.0 * radius_m, 2.0 * radius_m, length_m);
+  part.X_WP = X_WP;
+  for (std::size_t f = 0; f < kCylinderFaceIds.size(); ++f)
+    part.face_names[f] = kCylinderFaceIds[f];
+  return part;
 }
 
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index) {

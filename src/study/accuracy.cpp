@@ -114,7 +114,7 @@ void TipLoadRows(const scene::Scene& base, const AccuracyOptions& options, Accur
 
 struct Scenario {
   std::string name;
-  std::vector<scene::BoxPart> parts;
+  std::vector<scene::Part> parts;
   std::vector<reference::Obstacle> obstacles;
   scene::Friction friction;     ///< for the core's scene
   std::vector<Vector2d> hands;  ///< load steps: hand (x, z) [m]
@@ -123,9 +123,9 @@ struct Scenario {
   double speed_m_per_s = 0.02;
 };
 
-scene::BoxPart Box(const std::string& name, const Eigen::Vector3d& size,
+scene::Part Box(const std::string& name, const Eigen::Vector3d& size,
                    const Eigen::Vector3d& centre, double turn_about_y_rad) {
-  scene::BoxPart b;
+  scene::Part b;
   b.name = name;
   b.size_m = size;
   b.X_WP = Eigen::Isometry3d::Identity();
@@ -136,7 +136,7 @@ scene::BoxPart Box(const std::string& name, const Eigen::Vector3d& size,
 }
 
 // A 40 mm cube turned 45 degrees about y with one edge (along y) at (x, z): the edge in the plane.
-scene::BoxPart EdgeBlock(const std::string& name, double x_m, double z_m) {
+scene::Part EdgeBlock(const std::string& name, double x_m, double z_m) {
   const double half_diagonal = 0.02 * std::sqrt(2.0);
   return Box(name, {0.04, 0.04, 0.04}, {x_m + (x_m > 0 ? 1.0 : -1.0) * half_diagonal, 0.0, z_m},
              std::numbers::pi / 4);
@@ -144,7 +144,7 @@ scene::BoxPart EdgeBlock(const std::string& name, double x_m, double z_m) {
 
 // A wall whose face (the box's bottom, -z) passes through (x, z) with the outward normal
 // (-sin beta, 0, -cos beta): it faces the tip, tilted by beta about y.
-scene::BoxPart Wall(const std::string& name, double x_m, double z_m, double beta_rad) {
+scene::Part Wall(const std::string& name, double x_m, double z_m, double beta_rad) {
   const double T = 0.02;
   const Eigen::Vector3d face(x_m, 0.0, z_m);
   const Eigen::Vector3d into(std::sin(beta_rad), 0.0, std::cos(beta_rad));

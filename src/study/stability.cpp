@@ -21,8 +21,8 @@ namespace {
 
 using Eigen::Vector3d;
 
-scene::BoxPart Box(const std::string& name, const Vector3d& size, const Vector3d& centre) {
-  scene::BoxPart b;
+scene::Part Box(const std::string& name, const Vector3d& size, const Vector3d& centre) {
+  scene::Part b;
   b.name = name;
   b.size_m = size;
   b.X_WP = Eigen::Isometry3d::Identity();
@@ -54,7 +54,7 @@ void AddParts(Motion motion, scene::Scene& s) {
       break;
     case Motion::kRollOverEdge: {
       // A 40 mm cube turned 45 degrees about y: its edge along y at half the tube's length.
-      scene::BoxPart b =
+      scene::Part b =
           Box("edge", {0.04, 0.04, 0.04}, {r1 + gap + 0.02 * std::sqrt(2.0), 0.0, 0.5 * l});
       b.X_WP.linear() =
           Eigen::AngleAxisd(std::numbers::pi / 4, Vector3d::UnitY()).toRotationMatrix();
@@ -237,7 +237,7 @@ Run Drive(const StabilityCase& c, bool check) {
     // Tunnelling: the tube's axis never inside a part (its surface may press in, its centre
     // line may not: that is going through), and never beyond the thin wall's far face.
     core->Centreline(centre);
-    for (const scene::BoxPart& part : s.parts) {
+    for (const scene::Part& part : s.parts) {
       const Eigen::Isometry3d X_PW = part.X_WP.inverse();
       for (const Vector3d& x : centre) {
         const Vector3d q = X_PW * x;
@@ -372,8 +372,8 @@ std::vector<StabilityCase> StabilityCases(bool quick) {
                    c.scene.device.max_force_N / c.scene.contact.stiffness_N_per_m);
       // The contact's force at the thinnest part's middle: below the device's force, a full
       // push carries the tube out the far side (scene::ContactHoldAtMiddle_N).
-      const scene::BoxPart* thinnest = nullptr;
-      for (const scene::BoxPart& part : c.scene.parts)
+      const scene::Part* thinnest = nullptr;
+      for (const scene::Part& part : c.scene.parts)
         if (!thinnest || part.size_m.minCoeff() < thinnest->size_m.minCoeff()) thinnest = &part;
       if (thinnest && scene::ContactHoldAtMiddle_N(c.scene, *thinnest) < c.scene.device.max_force_N)
         why +=

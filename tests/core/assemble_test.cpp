@@ -21,9 +21,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-scene::BoxPart Cube(const std::string& name, double size_m, const Eigen::Vector3d& centre,
-                    double turn_y_rad, const Eigen::Matrix3d& then = Eigen::Matrix3d::Identity()) {
-  scene::BoxPart b;
+scene::Part Cube(const std::string& name, double size_m, const Eigen::Vector3d& centre,
+                 double turn_y_rad, const Eigen::Matrix3d& then = Eigen::Matrix3d::Identity()) {
+  scene::Part b;
   b.name = name;
   b.size_m = Eigen::Vector3d::Constant(size_m);
   b.X_WP.linear() =
@@ -143,7 +143,7 @@ TEST_CASE("An element's side on an edge bears continuously across the edge's fac
   s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
   s.contact = {1e4, 1e-3, 1e-4};
   const double r1 = s.tube.outer_radius_m, half = r1 + 0.5e-3, height = 0.2;
-  scene::BoxPart wall;
+  scene::Part wall;
   wall.name = "wall";
   wall.size_m = {0.1, 0.4, height};
   wall.X_WP.translation() = Eigen::Vector3d(-half - 0.05, 0.0, 0.045 + height / 2);
@@ -188,7 +188,7 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
   s.device.coupling_stiffness_N_per_m = 400.0;
   s.device.coupling_damping_Ns_per_m = 0.0;
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m;
-  scene::BoxPart floor;
+  scene::Part floor;
   floor.name = "floor";
   floor.size_m = Eigen::Vector3d(0.4, 0.2, 0.02);
   floor.X_WP.translation() = Eigen::Vector3d(0.1, 0.0, -0.01);

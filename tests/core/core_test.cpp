@@ -40,8 +40,8 @@ scene::Scene SteelScene() {
   return s;
 }
 
-scene::BoxPart Box(const std::string& name, Eigen::Vector3d size, Eigen::Vector3d centre) {
-  scene::BoxPart b;
+scene::Part Box(const std::string& name, Eigen::Vector3d size, Eigen::Vector3d centre) {
+  scene::Part b;
   b.name = name;
   b.size_m = size;
   b.X_WP = Eigen::Translation3d(centre) * Eigen::Isometry3d::Identity();
@@ -187,7 +187,7 @@ TEST_CASE("A frictionless side wall at the tip: 3EI/l^3 in series, a small-defle
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   const double lean = 3.0 * kPi / 180.0;
   s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
-  scene::BoxPart wall = Box("wall", {0.02, 0.1, 0.1}, {0.0, 0.0, 0.0});
+  scene::Part wall = Box("wall", {0.02, 0.1, 0.1}, {0.0, 0.0, 0.0});
   wall.X_WP.linear() = Eigen::AngleAxisd(-lean, Eigen::Vector3d::UnitY()).toRotationMatrix();
   // Its face (x = -0.01 in its frame) through (r1 + eps / 2, 0, l).
   wall.X_WP.translation() = Eigen::Vector3d(r1 + 0.5 * eps, 0.0, l) -
@@ -229,7 +229,7 @@ TEST_CASE("The side on a frictionless edge at distance a: 3EI/a^3 in series, con
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   const double a = 2.0 * l / 3.0;
   s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
-  scene::BoxPart edge = Box("edge", {0.02, 0.1, 0.02}, {0.0, 0.0, 0.0});
+  scene::Part edge = Box("edge", {0.02, 0.1, 0.02}, {0.0, 0.0, 0.0});
   // Turned 45 deg about y: the edge between its top and its +x face (local) points along world
   // +x, at the tube.
   edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
@@ -261,6 +261,77 @@ TEST_CASE("The side on a frictionless edge at distance a: 3EI/a^3 in series, con
   }
 }
 
+TEST_CASE("The side on a frictionless round bar at distance a: 3EI/a^3 in series", "[core]") {
+  // The edge case above with a round bar of radius R across under the tube instead: the tube's
+  // side touches the bar's side at a, and the bar's curve adds no compliance of its own (both
+  // are rigid but for the penalty), so the same springs are in series.
+  scene::Scene s = SteelScene();
+  const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  const double a = 2.0 * l / 3.0, R = 5e-3;
+  s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
+  // The bar's axis along world y, its side eps / 2 from the tube's surface.
+  Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
+  X_WB.linear() = Eigen::AngleAxisd(kPi / 2.0, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  X_WB.translation() = Eigen::Vector3d(-(r1 + 0.5 * eps + R), 0.0, a);
+  s.parts.push_back(scene::MakeCylinder("bar", R, 0.1, X_WB));
+  core::Core c(s);
+  const double k_side = 3.0 * EI(s) / (a * a * a);
+  const double k_series = 1.0 / (1.0 / 400.0 + 1.0 / s.contact.stiffness_N_per_m + 1.0 / k_side);
+  double t = 0.0, F_prev = 0.0, x_prev = 0.0;
+  for (const double x_m : {-1e-3, -2e-3, -3e-3}) {
+    Eigen::Isometry3d X = s.X_WH_start;
+    X.translation().x() = x_m;
+    const core::StepOutput& out = MoveTo(c, X, 200, 300, t);
+    INFO(c.FormationText());
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    CHECK(pc.tube == states::TubeElement::kSide);
+    CHECK(c.elements()[std::size_t(pc.part_element)].name == "bar.side");
+    CHECK(pc.marker == states::Marker::kConvex);
+    // The tube turns by F a^2 / (2 EI) < 1e-3 rad at a: the contact moves along it by R times
+    // that, 5 um.
+    CHECK(pc.s_m == Approx(a).margin(1e-3));
+    CHECK(out.force_W_N.y() == Approx(0.0).margin(1e-9));
+    if (F_prev > 0.0) {
+      const double k = (out.force_W_N.x() - F_prev) / (x_prev - x_m);
+      // 1 %: as the edge's test.
+      CHECK(k == Approx(k_series).epsilon(0.01));
+    }
+    F_prev = out.force_W_N.x();
+    x_prev = x_m;
+  }
+}
+
+TEST_CASE("A frictionless post's top facing the end: K (eps - d) in series with the coupling",
+          "[core]") {
+  // The wall test with a round post under the end, wider than the tube: the whole end face on
+  // its flat top.
+  scene::Scene s = SteelScene();
+  const double l = s.tube.length_m, eps = s.contact.threshold_m, K = s.contact.stiffness_N_per_m;
+  s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
+  // The post's axis along the tube, its end face 0.5 mm beyond the tube's end; its bottom
+  // (local -z) faces the tube.
+  s.parts.push_back(scene::MakeCylinder(
+      "post", 10e-3, 0.02, Eigen::Isometry3d(Eigen::Translation3d(0.0, 0.0, l + 0.5e-3 + 0.01))));
+  core::Core c(s);
+  double t = 0.0;
+  for (const double push_m : {1e-3, 5e-3}) {
+    Eigen::Isometry3d X = s.X_WH_start;
+    X.translation().z() = push_m;
+    const core::StepOutput& out = MoveTo(c, X, 200, 200, t);
+    INFO("push " << push_m << " m: " << c.FormationText());
+    REQUIRE(out.contact_count == 1);
+    const core::ContactState& pc = out.contacts[0];
+    CHECK(pc.tube == states::TubeElement::kEndFace);
+    CHECK(c.elements()[std::size_t(pc.part_element)].name == "post.bottom");
+    const double gap_m = 0.5e-3 - eps;
+    const double expected = (push_m - gap_m) / (1.0 / 400.0 + 1.0 / K);
+    // 1e-3: as the wall's test.
+    CHECK(-out.force_W_N.z() == Approx(expected).epsilon(1e-3));
+    CHECK(out.force_W_N.head<2>().norm() < 1e-9);
+  }
+}
+
 TEST_CASE("A stiff tube pivoting on one edge onto another converges in every tick", "[core]") {
   // The steel tube along +z, its side on an edge at l/2 (-x) and its tip swinging onto a second
   // edge near the end (+x) as the hand moves towards -x: about 0.5 N, then 1.5 N at the hand,
@@ -276,7 +347,7 @@ TEST_CASE("A stiff tube pivoting on one edge onto another converges in every tic
   s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
   for (const auto& [name, x_m, z_m] :
        {std::tuple{"under", -(r1 + d1), s1}, std::tuple{"over", r1 + d2, s2}}) {
-    scene::BoxPart edge = Box(name, {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
+    scene::Part edge = Box(name, {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
     edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
     edge.X_WP.translation() =
         Eigen::Vector3d(x_m + (x_m > 0.0 ? 1.0 : -1.0) * 0.02 * std::sqrt(2.0), 0.0, z_m);
@@ -311,7 +382,7 @@ TEST_CASE("A soft tube pushed slowly onto an edge converges in every tick", "[co
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   const double a = 0.6 * l, d0 = 0.5e-3;
   s.X_WH_start = Held({0.0, 0.0, 0.0}, Eigen::Vector3d::UnitZ());
-  scene::BoxPart edge = Box("edge", {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
+  scene::Part edge = Box("edge", {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
   edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
   edge.X_WP.translation() = Eigen::Vector3d(r1 + d0 + 0.02 * std::sqrt(2.0), 0.0, a);
   s.parts.push_back(edge);
@@ -350,7 +421,7 @@ TEST_CASE("The force on an edge is smooth in where the edge meets the tube", "[c
   for (int k = 0; k <= 33; ++k) {
     const double a = 0.58 * l + 0.25e-3 * k;
     scene::Scene at = s;
-    scene::BoxPart edge = Box("edge", {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
+    scene::Part edge = Box("edge", {0.04, 0.04, 0.04}, {0.0, 0.0, 0.0});
     edge.X_WP.linear() = Eigen::AngleAxisd(kPi / 4.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
     edge.X_WP.translation() = Eigen::Vector3d(r1 + d0 + 0.02 * std::sqrt(2.0), 0.0, a);
     at.parts.push_back(edge);

@@ -11,6 +11,7 @@
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/scene/elements.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 namespace {
@@ -417,4 +418,60 @@ TEST_CASE("A scene of more than 1000 parts is refused at the part too many", "[s
   const auto loaded = LoadSceneText(head + overlapping + tail, "t.yaml");
   CHECK(loaded.diagnostics.FormatAll() ==
         "t.yaml:1007:57: error: part 'q' overlaps part 'p0', expected parts that at most touch\n");
+}
+
+TEST_CASE("A cylinder part loads with its size, pose, faces and elements", "[scene]") {
+  // A round post on the floor in place of the wall, its side renamed.
+  const std::string text =
+      WithLine(9,
+               "    cylinder: {radius: 6 mm, length: 20 mm, position: [15 mm, 0, 10 mm], "
+               "rpy: [0, 90 deg, 0]}\n    faces: {side: barrel}");
+  const auto loaded = LoadSceneText(text, "t.yaml");
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.scene);
+  const tubeplan::scene::Part& post = loaded.scene->parts[1];
+  CHECK(post.shape == tubeplan::scene::PartShape::kCylinder);
+  CHECK(post.size_m.isApprox(Eigen::Vector3d(12e-3, 12e-3, 20e-3), 1e-12));
+  // Turned 90 deg about y: the post's axis (its z) along world x.
+  CHECK((post.X_WP.linear().col(2) - Eigen::Vector3d::UnitX()).norm() < 1e-12);
+  std::vector<std::string> names;
+  for (const auto& e : tubeplan::scene::EnumerateElements(*loaded.scene))
+    if (e.part_index == 1) names.push_back(e.name);
+  CHECK(names == std::vector<std::string>{"wall.top", "wall.bottom", "wall.barrel",
+                                          "wall.top_barrel", "wall.bottom_barrel"});
+}
+
+TEST_CASE("A part's shape is exactly one box or one cylinder of positive size", "[scene]") {
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"both shapes",
+       WithLine(9,
+                "    box: {size: [10 mm, 200 mm, 20 mm]}\n"
+                "    cylinder: {radius: 6 mm, length: 20 mm}"),
+       "t.yaml:10:15: error: parts[1] has both a box and a cylinder, expected exactly one of "
+       "'box' and 'cylinder'\n"},
+      {"no shape", WithLine(9, "    friction: {static: 0.7, kinetic: 0.08}"),
+       "t.yaml:8:5: error: parts[1] has no shape, expected exactly one of 'box' and 'cylinder'\n"},
+      {"zero radius",
+       WithLine(9, "    cylinder: {radius: 0 mm, length: 20 mm, position: [15 mm, 0, 10 mm]}"),
+       "t.yaml:9:24: error: parts[1].cylinder.radius must be greater than zero, expected a length "
+       "such as 10 mm\n"},
+      {"a box's key on a cylinder",
+       WithLine(9, "    cylinder: {size: [1 mm, 1 mm, 1 mm], radius: 6 mm, length: 20 mm}"),
+       "t.yaml:9:16: error: unknown key 'size' in 'parts[1].cylinder'"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.what, c.text);
+    const auto loaded = LoadSceneText(c.text, "t.yaml");
+    CHECK_FALSE(loaded.scene);
+    const std::string got = loaded.diagnostics.FormatAll();
+    if (c.expected.back() == '\n')
+      CHECK(got == c.expected);
+    else
+      CHECK_THAT(got, Catch::StartsWith(c.expected));
+  }
 }

@@ -13,11 +13,11 @@
 
 namespace {
 
-using tubeplan::scene::BoxPart;
+using tubeplan::scene::Part;
 
-BoxPart Box(const Eigen::Vector3d& size_m, const Eigen::Vector3d& position_m,
+Part Box(const Eigen::Vector3d& size_m, const Eigen::Vector3d& position_m,
             const Eigen::Vector3d& rpy_rad = Eigen::Vector3d::Zero()) {
-  BoxPart b;
+  Part b;
   b.size_m = size_m;
   b.X_WP = Eigen::Isometry3d::Identity();
   b.X_WP.linear() = tubeplan::scene::RotationFromRpy(rpy_rad);
@@ -31,7 +31,7 @@ TEST_CASE("The broad phase finds exactly the pairs every pair's test finds", "[s
   // Random turned boxes, dense enough that many touch or overlap: 300 parts, 44 850 pairs.
   std::mt19937 random(7);
   std::uniform_real_distribution<double> at(0.0, 0.2), size(0.002, 0.03), turn(-3.0, 3.0);
-  std::vector<BoxPart> parts;
+  std::vector<Part> parts;
   for (int i = 0; i < 300; ++i)
     parts.push_back(Box({size(random), size(random), size(random)},
                         {at(random), at(random), at(random)},
@@ -67,7 +67,7 @@ TEST_CASE("The straight tube's overlap with a box is exact", "[scene]") {
   CHECK(StraightTubeOverlap(X_WH, r, l, Box({0.02, 0.02, 0.02}, {0, 0.1, 0}), 1e-9).value() == r);
   // A bar turned 45 deg about the axis, an edge towards it and 6 mm from it: 2 mm into the tube.
   const double half_diagonal = 0.005 * std::sqrt(2.0);
-  const BoxPart turned =
+  const Part turned =
       Box({0.01, 0.3, 0.01}, {0.006 + half_diagonal, 0, 0}, {0.0, std::numbers::pi / 4, 0.0});
   CHECK(StraightTubeOverlap(X_WH, r, l, turned, 1e-9).value() == Approx(0.002).margin(1e-12));
   // Only a corner region of a box near the tip counts: its piece between the end planes.

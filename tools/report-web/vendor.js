@@ -8,6 +8,7 @@ export {
   BufferGeometry,
   CatmullRomCurve3,
   Color,
+  CylinderGeometry,
   DirectionalLight,
   DoubleSide,
   EdgesGeometry,

@@ -2,7 +2,8 @@
 // Named surface elements of the rigid parts: a box has 6 faces, 12 edges and 8 vertices. A face
 // is "part.face"; an edge joins its two faces' names with '_' and a vertex its three, in the
 // order of BoxFace (top/bottom, then x faces, then y faces): "left.top", "left.top_xpos",
-// "left.top_xpos_ypos" — or, with the scene's face names, "left.top_inner".
+// "left.top_xpos_ypos" — or, with the scene's face names, "left.top_inner". A cylinder has 3
+// faces (top, bottom, side) and 2 edges, its rims: "post.top_side", "post.bottom_side".
 
 #include <cstdint>
 #include <string>
@@ -18,7 +19,7 @@ enum class ElementKind : unsigned char { kFace, kEdge, kVertex };
 struct PartElement {
   std::uint32_t part_index = 0;
   ElementKind kind = ElementKind::kFace;
-  std::uint8_t face_mask = 0;  ///< bit i set: the element lies on face BoxFace(i)
+  std::uint8_t face_mask = 0;  ///< bit i set: the element lies on face i (BoxFace, CylinderFace)
   std::string name;            ///< "part.element"
 };
 

@@ -3,6 +3,7 @@
 // overlap each other, and parts that reach into the tube at its start.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <utility>
@@ -16,12 +17,16 @@ namespace tubeplan::scene {
 
 /// Separating-axis test of two oriented boxes: true when they share a volume thicker than
 /// `tolerance_m` along every axis (boxes that only touch do not overlap).
-bool BoxesOverlap(const BoxPart& a, const BoxPart& b, double tolerance_m);
+bool BoxesOverlap(const Part& a, const Part& b, double tolerance_m);
 
-/// Every pair {later, earlier} of overlapping parts (BoxesOverlap), sorted by the later part's
+/// Whether two parts share a volume thicker than `tolerance_m`: BoxesOverlap for two boxes, FCL's
+/// penetration depth for other shapes.
+bool PartsOverlap(const Part& a, const Part& b, double tolerance_m);
+
+/// Every pair {later, earlier} of overlapping parts (PartsOverlap), sorted by the later part's
 /// index, then the earlier's. Only parts whose bounding boxes meet are compared (FCL's dynamic
 /// AABB tree): time grows as n log n with n parts spread in space, memory as n.
-std::vector<std::pair<std::size_t, std::size_t>> OverlappingParts(std::span<const BoxPart> parts,
+std::vector<std::pair<std::size_t, std::size_t>> OverlappingParts(std::span<const Part> parts,
                                                                   double tolerance_m);
 
 /// How deep `part` reaches into the straight tube held at X_WH: the flat-ended cylinder of
@@ -30,8 +35,23 @@ std::vector<std::pair<std::size_t, std::size_t>> OverlappingParts(std::span<cons
 /// the ends' planes (the radius itself when the part crosses the axis); nullopt when the part
 /// does not reach into the tube by more than `tolerance_m`, sideways or past an end's plane. Exact:
 /// the piece is a convex polygon when seen along the axis, and its distance to the axis is a
-/// point-polygon distance.
+/// point-polygon distance (a cylinder is taken as a prism of 64 sides).
 std::optional<double> StraightTubeOverlap(const Eigen::Isometry3d& X_WH, double radius_m,
-                                          double length_m, const BoxPart& part, double tolerance_m);
+                                          double length_m, const Part& part, double tolerance_m);
+
+/// Whether p_W lies strictly inside the part.
+bool Contains(const Part& part, const Eigen::Vector3d& p_W);
+
+/// A point on an element of a part and the element's outward direction there.
+struct ElementPoint {
+  Eigen::Vector3d p_W = Eigen::Vector3d::Zero();
+  Eigen::Vector3d n_W = Eigen::Vector3d::UnitZ();  ///< unit
+};
+
+/// The middle of the element on the faces of `face_mask` (PartElement::face_mask): a face's or an
+/// edge's middle, a vertex. On a cylinder's side and rims, the point facing `toward_W` (a
+/// direction) most.
+ElementPoint PointOnElement(const Part& part, std::uint8_t face_mask,
+                            const Eigen::Vector3d& toward_W);
 
 }  // namespace tubeplan::scene

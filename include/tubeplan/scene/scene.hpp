@@ -4,6 +4,7 @@
 
 #include <array>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -38,14 +39,35 @@ enum class BoxFace : int { kTop = 0, kBottom, kXPos, kXNeg, kYPos, kYNeg };
 inline constexpr std::array<const char*, 6> kBoxFaceIds = {"top",  "bottom", "xpos",
                                                            "xneg", "ypos",   "yneg"};
 
-struct BoxPart {
-  std::string name;                                  ///< [A-Za-z][A-Za-z0-9_]*
-  Eigen::Vector3d size_m = Eigen::Vector3d::Zero();  ///< full extents along the box's x, y, z [m]
-  Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();  ///< box centre frame P in world W
+/// Faces of a cylinder: its two flat ends (normals +z and -z of its frame) and its round side.
+enum class CylinderFace : int { kTop = 0, kBottom, kSide };
+inline constexpr std::array<const char*, 3> kCylinderFaceIds = {"top", "bottom", "side"};
+
+/// The shape of a rigid part.
+enum class PartShape {
+  kBox,       ///< six flat faces, twelve edges, eight vertices
+  kCylinder,  ///< along its frame's z: a flat top and bottom, a round side, two rims
+};
+
+struct Part {
+  std::string name;  ///< [A-Za-z][A-Za-z0-9_]*
+  PartShape shape = PartShape::kBox;
+  /// Full extents along the part frame's x, y, z [m]: a box's sides; a cylinder's diameter twice,
+  /// then its length.
+  Eigen::Vector3d size_m = Eigen::Vector3d::Zero();
+  Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();  ///< part centre frame P in world W
   std::optional<Friction> friction;  ///< overrides the scene's friction if set
-  /// Name of each face, indexed by BoxFace: the ids of kBoxFaceIds unless the scene renames them.
+  /// Name of each face, indexed by BoxFace or CylinderFace: the shape's face ids unless the
+  /// scene renames them (a cylinder uses the first three).
   std::array<std::string, 6> face_names = {"top", "bottom", "xpos", "xneg", "ypos", "yneg"};
 };
+
+/// The ids of a shape's faces, in the order of BoxFace or CylinderFace.
+std::span<const char* const> FaceIds(PartShape shape);
+
+/// A cylinder of `radius_m` and `length_m` along z of X_WP, its faces named by their ids.
+Part MakeCylinder(std::string name, double radius_m, double length_m,
+                  const Eigen::Isometry3d& X_WP);
 
 /// How the core models the tube's bending.
 enum class TubeModel {
@@ -94,7 +116,7 @@ struct Scene {
   model::TubeSpec tube;
   Contact contact;
   Friction friction;
-  std::vector<BoxPart> parts;
+  std::vector<Part> parts;
   Eigen::Isometry3d X_WH_start = Eigen::Isometry3d::Identity();  ///< held end at the start
   states::ContactFormation goal;
   Device device;
@@ -109,7 +131,7 @@ const Friction& FrictionAt(const Scene& scene, std::size_t part_index);
 /// The force the contact law pushes back with when a point reaches a part's middle,
 /// K (eps + half the part's thinnest size) [N]: below the device's force, a full push can carry
 /// the tube through the part.
-double ContactHoldAtMiddle_N(const Scene& scene, const BoxPart& part);
+double ContactHoldAtMiddle_N(const Scene& scene, const Part& part);
 
 /// Rotation from roll-pitch-yaw [rad], applied as R = Rz(yaw) Ry(pitch) Rx(roll) (extrinsic
 /// x-y-z, the ROS/URDF convention).

@@ -82,7 +82,11 @@
     const lo = new THREE.Vector3(Infinity, Infinity, Infinity);
     const hi = new THREE.Vector3(-Infinity, -Infinity, -Infinity);
     for (const part of p.parts) {
-      const geometry = new THREE.BoxGeometry(...part.size_mm);
+      // A cylinder's axis is its frame's z; three.js builds one along y.
+      const geometry = part.shape === 'cylinder'
+        ? new THREE.CylinderGeometry(part.size_mm[0] / 2, part.size_mm[0] / 2, part.size_mm[2], 48)
+          .rotateX(Math.PI / 2)
+        : new THREE.BoxGeometry(...part.size_mm);
       const box = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial(
         { color: 0xb9c2cb, transparent: true, opacity: 0.55, depthWrite: false }));
       const [w, x, y, z] = part.q_wxyz;
