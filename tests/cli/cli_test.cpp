@@ -158,6 +158,29 @@ TEST_CASE("plans: the pocket scene gives a verified plan that puts the tube's en
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-pocket"));
 }
 
+TEST_CASE("plans: the rail scene gives a verified plan that hangs the tube over a round part",
+          "[cli][explore]") {
+  // A cylinder met along its curved side: the tube's side laid across a round rail, bent over
+  // it. 300 motions reach the goal (about 12 s); the plan's replay ends there within the
+  // device's force.
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("plans-rail") / "out";
+  const Outcome r = RunTool({"plans", SourcePath("scenes/rail.yaml"), "--budget", "300", "--jobs",
+                             "2", "--out-dir", dir.string()});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  const std::size_t line = r.out.find("rail-candidate-1: cost");
+  REQUIRE(line != std::string::npos);
+  const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
+  CHECK(said.find("-> {Fs n rail.side}; feasible") != std::string::npos);
+  const double peak_N = std::stod(said.substr(said.rfind("force ") + 6));
+  CHECK(peak_N > 0.0);
+  CHECK(peak_N < 8.5);  // the device's force
+  const Outcome judged = RunTool({"evaluate", dir.string()});
+  INFO(judged.out);
+  CHECK(judged.exit_code == 0);
+  std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-rail"));
+}
+
 TEST_CASE("plans: the tilted groove's two-PC goal gives verified plans on a small budget",
           "[cli][explore]") {
   // Parts turned about a non-vertical axis and a goal of two PCs (the tube seated in the corner
