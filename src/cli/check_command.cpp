@@ -23,6 +23,7 @@ namespace {
 struct CheckOptions {
   std::vector<std::string> files;
   bool json = false;
+  bool elements = false;
 };
 
 std::string Summary(const scene::Scene& s) {
@@ -69,14 +70,21 @@ std::string Summary(const io::TrajectoryInfo& t) {
 struct Checked {
   const char* kind;
   io::Diagnostics diagnostics;
-  std::optional<std::string> summary;  // set when valid
+  std::optional<std::string> summary;        // set when valid
+  std::vector<scene::PartElement> elements;  // a valid scene's
 };
+
+const char* KindName(scene::ElementKind kind) {
+  return kind == scene::ElementKind::kFace   ? "face"
+         : kind == scene::ElementKind::kEdge ? "edge"
+                                             : "vertex";
+}
 
 Checked CheckFile(const std::string& file) {
   if (std::filesystem::path(file).extension() == ".csv") {
     // Streamed: a recording of hours is checked in the memory of a few lines.
     io::TrajectoryScanResult scanned = io::ScanTrajectoryFile(file);
-    Checked c{"trajectory", std::move(scanned.diagnostics), std::nullopt};
+    Checked c{"trajectory", std::move(scanned.diagnostics), std::nullopt, {}};
     if (scanned.info) c.summary = Summary(*scanned.info);
     return c;
   }
@@ -84,7 +92,7 @@ Checked CheckFile(const std::string& file) {
   if (const std::optional<std::string> text = io::ReadTextFile(file);
       text && (text->rfind("plan:", 0) == 0 || text->find("\nplan:") != std::string::npos)) {
     io::PlanLoadResult plan = io::LoadPlanFile(file, {.trajectory_in_memory = false});
-    Checked c{"plan", std::move(plan.diagnostics), std::nullopt};
+    Checked c{"plan", std::move(plan.diagnostics), std::nullopt, {}};
     if (plan.plan) {
       std::ostringstream out;
       out << "plan \"" << plan.plan->name << "\": " << plan.plan->states.size() << " states, "
@@ -95,8 +103,11 @@ Checked CheckFile(const std::string& file) {
     return c;
   }
   io::SceneLoadResult loaded = io::LoadSceneFile(file);
-  Checked c{"scene", std::move(loaded.diagnostics), std::nullopt};
-  if (loaded.scene) c.summary = Summary(*loaded.scene);
+  Checked c{"scene", std::move(loaded.diagnostics), std::nullopt, {}};
+  if (loaded.scene) {
+    c.summary = Summary(*loaded.scene);
+    c.elements = scene::EnumerateElements(*loaded.scene);
+  }
   return c;
 }
 
@@ -119,9 +130,17 @@ int RunCheck(const CheckOptions& o, Streams io) {
       nlohmann::json entry = {
           {"file", file}, {"kind", checked.kind}, {"valid", valid}, {"diagnostics", diagnostics}};
       if (valid) entry["summary"] = *checked.summary;
+      if (o.elements) {
+        entry["elements"] = nlohmann::json::array();
+        for (const scene::PartElement& e : checked.elements)
+          entry["elements"].push_back({{"name", e.name}, {"kind", KindName(e.kind)}});
+      }
       files.push_back(entry);
     } else if (valid) {
       io.out << file << ": ok: " << *checked.summary << "\n";
+      if (o.elements)
+        for (const scene::PartElement& e : checked.elements)
+          io.out << "  " << KindName(e.kind) << " " << e.name << "\n";
     }
   }
   if (o.json) io.out << nlohmann::json{{"files", files}}.dump(2) << "\n";
@@ -139,6 +158,9 @@ Command AddCheckCommand(CLI::App& app, Streams streams) {
   sub->add_option("files", options->files, "scene files (.yaml) and trajectory files (.csv)")
       ->required();
   sub->add_flag("--json", options->json, "print one JSON document");
+  sub->add_flag("--elements", options->elements,
+                "list each scene's part elements (faces, edges, vertices) by the names goals and "
+                "plans use");
   return {sub, [options, streams] { return RunCheck(*options, streams); }};
 }
 

@@ -158,6 +158,26 @@ TEST_CASE("plans: the pocket scene gives a verified plan that puts the tube's en
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("plans-pocket"));
 }
 
+TEST_CASE("check --elements lists a box's 26 elements and a cylinder's 5 by name", "[cli]") {
+  const Outcome r = RunTool({"check", SourcePath("scenes/rail.yaml"), "--elements"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  // The base plate: 6 faces, 12 edges, 8 vertices; the rail: 3 faces, 2 rims, no vertex.
+  int faces = 0, edges = 0, vertices = 0;
+  std::istringstream lines(r.out);
+  for (std::string l; std::getline(lines, l);) {
+    faces += l.rfind("  face ", 0) == 0;
+    edges += l.rfind("  edge ", 0) == 0;
+    vertices += l.rfind("  vertex ", 0) == 0;
+  }
+  CHECK(faces == 6 + 3);
+  CHECK(edges == 12 + 2);
+  CHECK(vertices == 8);
+  for (const char* name : {"  face rail.side\n", "  edge rail.top_side\n",
+                           "  edge rail.bottom_side\n", "  vertex base.top_xpos_ypos\n"})
+    CHECK(r.out.find(name) != std::string::npos);
+}
+
 TEST_CASE("plans: the rail scene gives a verified plan that hangs the tube over a round part",
           "[cli][explore]") {
   // A cylinder met along its curved side: the tube's side laid across a round rail, bent over
