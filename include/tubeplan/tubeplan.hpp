@@ -3,9 +3,9 @@
 // and a plan (io), step the core with a hand pose (core), judge a plan's replay or sum up a
 // trajectory's (plan), judge a set of plans and replay a trajectory file (batch), explore and
 // prune the contact-state graph and make candidate plans (graph, plan) and write them (batch),
-// run the 1 kHz servo against a device (device), write the reports of judged plans and of the
-// graph (report). Each header says what it holds; docs/layout.md says which library each folder
-// is.
+// make a hand trajectory through poses or perturb one (trajectories), run the 1 kHz servo
+// against a device (device), write the reports of judged plans and of the graph (report). Each
+// header says what it holds; docs/layout.md says which library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/evaluation.hpp>
@@ -29,9 +29,11 @@
 #include <tubeplan/plan/candidates.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/simulate.hpp>
-#include <tubeplan/plan/synthesize.hpp>
 #include <tubeplan/report/graph_json.hpp>
 #include <tubeplan/report/html_report.hpp>
 #include <tubeplan/report/text_report.hpp>
 #include <tubeplan/scene/scene.hpp>
 #include <tubeplan/states/contact_formation.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>

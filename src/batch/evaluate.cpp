@@ -12,7 +12,7 @@
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/io/interrupt.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/perturb.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
 
 namespace tubeplan::batch {
 
@@ -35,8 +35,8 @@ std::optional<Evaluated> JudgePlan(const std::string& file, const io::PlanLoadRe
     judgement = plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits, watch);
   } else {
     io::TrajectoryFileSamples samples(*l.trajectory_file);
-    plan::SampleTicks ticks(samples, l.trajectory_file->t_first_s, l.trajectory_file->t_last_s,
-                            l.scene->model.time_step_s);
+    trajectories::SampleTicks ticks(samples, l.trajectory_file->t_first_s,
+                                    l.trajectory_file->t_last_s, l.scene->model.time_step_s);
     judgement = plan::Judge(*l.scene, ticks, l.plan->states, l.plan->limits, watch,
                             l.trajectory_file->stopped_early);
   }
@@ -46,10 +46,11 @@ std::optional<Evaluated> JudgePlan(const std::string& file, const io::PlanLoadRe
   e.replayed_s = e.judgement.replayed_s;
   e.run_s = e.judgement.run_s;
   for (int r = 0; r < options.monte_carlo && !io::Interrupted(); ++r) {
-    const plan::Judgement jr = plan::Judge(
-        *l.scene,
-        plan::Perturb(*l.trajectory, plan::Perturbation{}, PlanSeed(options.seed, file), r),
-        l.plan->states, l.plan->limits);
+    const plan::Judgement jr =
+        plan::Judge(*l.scene,
+                    trajectories::Perturb(*l.trajectory, trajectories::Perturbation{},
+                                          PlanSeed(options.seed, file), r),
+                    l.plan->states, l.plan->limits);
     for (std::size_t k = 0; k < jr.transitions.size(); ++k)
       e.robust[k] += plan::IsFeasible(jr.transitions[k].verdict);
     e.replayed_s += jr.replayed_s;

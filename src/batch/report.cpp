@@ -1,7 +1,7 @@
 #include <algorithm>
 
 #include <tubeplan/batch/report.hpp>
-#include <tubeplan/plan/perturb.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
 
 namespace tubeplan::batch {
 
@@ -63,7 +63,7 @@ nlohmann::json ToJson(const std::vector<Evaluated>& results, const ReportScope& 
     for (std::size_t k = 0; k < j.transitions.size(); ++k) {
       transitions.push_back(SpanJson(j.transitions[k]));
       if (e.runs > 0) {
-        const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+        const trajectories::Interval ci = trajectories::WilsonInterval(e.robust[k], e.runs);
         transitions.back()["monte_carlo"] = {{"runs", e.runs},
                                              {"feasible", e.robust[k]},
                                              {"fraction", double(e.robust[k]) / e.runs},

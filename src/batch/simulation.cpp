@@ -10,7 +10,8 @@ namespace {
 
 // The core starts with the held end at the hand's first pose. A trajectory that starts away
 // from the scene's start is allowed but said.
-void SayStartAway(const SimulationInput& input, const plan::HandSample& first, std::ostream& err) {
+void SayStartAway(const SimulationInput& input, const trajectories::HandSample& first,
+                  std::ostream& err) {
   const scene::Scene& s = *input.scene;
   const double start_offset_m = (first.p_WH_m - s.X_WH_start.translation()).norm();
   const double start_turn_rad =
@@ -41,8 +42,8 @@ Simulated RunSimulation(const SimulationInput& input, std::ostream& err,
   const scene::Scene& s = *input.scene;
   // Ticks one at a time from the file's rows: only the two samples around a tick are held.
   io::TrajectoryFileSamples samples(*input.trajectory);
-  plan::SampleTicks ticks(samples, input.trajectory->t_first_s, input.trajectory->t_last_s,
-                          s.model.time_step_s);
+  trajectories::SampleTicks ticks(samples, input.trajectory->t_first_s, input.trajectory->t_last_s,
+                                  s.model.time_step_s);
   core::Core core(s);
   SayStartAway(input, ticks.Tick(0), err);
   Simulated simulated;

@@ -30,7 +30,8 @@ struct PlansOptions {
 };
 
 // --tremor, --quantum and --speed in SI, each checked; nullopt after saying what is wrong.
-std::optional<plan::SynthesisOptions> ParseSynthesis(const PlansOptions& o, std::ostream& err) {
+std::optional<trajectories::SynthesisOptions> ParseSynthesis(const PlansOptions& o,
+                                                             std::ostream& err) {
   double tremor_m = 0.0, quantum_m = 0.0, speed_m_per_s = 0.0;
   for (auto [option, text, dimension, target] :
        {std::tuple{"--tremor", &o.tremor, io::dim::kLength, &tremor_m},
@@ -50,7 +51,7 @@ std::optional<plan::SynthesisOptions> ParseSynthesis(const PlansOptions& o, std:
            "--speed above 0 and at most 1 m/s\n";
     return std::nullopt;
   }
-  plan::SynthesisOptions synthesis;
+  trajectories::SynthesisOptions synthesis;
   synthesis.peak_speed_m_per_s = speed_m_per_s;
   synthesis.tremor_m = tremor_m;
   synthesis.quantum_m = quantum_m;
@@ -60,7 +61,7 @@ std::optional<plan::SynthesisOptions> ParseSynthesis(const PlansOptions& o, std:
 
 int RunPlans(const PlansOptions& o, Streams io) {
   // Quantities first: a typo should not cost an exploration.
-  const std::optional<plan::SynthesisOptions> synthesis = ParseSynthesis(o, io.err);
+  const std::optional<trajectories::SynthesisOptions> synthesis = ParseSynthesis(o, io.err);
   if (!synthesis) return kExitBadInput;
   const batch::PlansRequest request{.scene_path = o.graph.scene_path,
                                     .seed = o.graph.seed,

@@ -141,7 +141,8 @@ bool ParseDeviceChoice(const std::string& text, DeviceChoice& choice, std::strin
 }
 
 std::unique_ptr<HapticDevice> MakeDevice(const DeviceChoice& choice, Clock& clock,
-                                         const plan::Trajectory& target, std::string& error) {
+                                         const trajectories::Trajectory& target,
+                                         std::string& error) {
   switch (choice.kind) {
     case DeviceChoice::Kind::kEmulator:
       return std::make_unique<EmulatorDevice>(clock, target, choice.emulator.hand);

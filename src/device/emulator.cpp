@@ -6,7 +6,7 @@
 
 namespace tubeplan::device {
 
-EmulatorDevice::EmulatorDevice(Clock& clock, plan::Trajectory target, HandModel hand)
+EmulatorDevice::EmulatorDevice(Clock& clock, trajectories::Trajectory target, HandModel hand)
     : clock_(clock), target_(std::move(target)), hand_(hand), spec_(PhantomPremium15Spec()) {
   if (target_.samples.size() < 2)
     throw std::invalid_argument("EmulatorDevice: the target trajectory needs two samples");
@@ -26,8 +26,8 @@ Eigen::Isometry3d EmulatorDevice::TargetAt(double t_s, Eigen::Vector3d& v_W_m_pe
   // in a 1 kHz recording: finer would only see the interpolation's kinks).
   constexpr double kDt_s = 1e-3;
   std::size_t ahead = cursor_;
-  const plan::HandSample a = plan::PoseAt(target_, t0 + t_s, cursor_);
-  const plan::HandSample b = plan::PoseAt(target_, t0 + t_s + kDt_s, ahead);
+  const trajectories::HandSample a = trajectories::PoseAt(target_, t0 + t_s, cursor_);
+  const trajectories::HandSample b = trajectories::PoseAt(target_, t0 + t_s + kDt_s, ahead);
   v_W_m_per_s = (b.p_WH_m - a.p_WH_m) / kDt_s;
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = a.q_WH.toRotationMatrix();

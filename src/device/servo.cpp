@@ -39,7 +39,7 @@ double Percentile(const std::vector<std::uint32_t>& histogram, long count, doubl
   return double(histogram.size());
 }
 
-Eigen::Isometry3d PoseOf(const plan::HandSample& s) {
+Eigen::Isometry3d PoseOf(const trajectories::HandSample& s) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = s.q_WH.normalized().toRotationMatrix();
   X.translation() = s.p_WH_m;
@@ -109,8 +109,8 @@ ScopedStopSignals::~ScopedStopSignals() {
 int ScopedStopSignals::received() { return g_signal.load(std::memory_order_relaxed); }
 void ScopedStopSignals::Clear() { g_signal.store(0); }
 
-plan::HandSample AsRecorded(double t_s, const Eigen::Isometry3d& X_W_hand) {
-  plan::HandSample s;
+trajectories::HandSample AsRecorded(double t_s, const Eigen::Isometry3d& X_W_hand) {
+  trajectories::HandSample s;
   s.t_s = t_s;
   const Eigen::Vector3d& p = X_W_hand.translation();
   s.p_WH_m = Eigen::Vector3d(Nano(p.x()), Nano(p.y()), Nano(p.z()));

@@ -61,7 +61,7 @@ std::string TrajectoryCsvStopped(const std::string& stopped_early) {
   return "# stopped: " + stopped_early + "\n";
 }
 
-void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s,
+void AppendTrajectoryCsvRow(std::string& out, const trajectories::HandSample& s,
                             std::string_view extra_fields) {
   char t[32];
   const auto [end, ec] = std::to_chars(t, t + sizeof t, s.t_s);  // shortest round trip
@@ -74,15 +74,16 @@ void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& s,
   out += '\n';
 }
 
-std::optional<plan::Trajectory> TrajectoryAsWritten(const plan::Trajectory& trajectory) {
+std::optional<trajectories::Trajectory> TrajectoryAsWritten(
+    const trajectories::Trajectory& trajectory) {
   TrajectoryLoadResult read = LoadTrajectoryText(FormatTrajectoryCsv(trajectory), "candidate");
   return std::move(read.trajectory);
 }
 
-std::string FormatTrajectoryCsv(const plan::Trajectory& t) {
+std::string FormatTrajectoryCsv(const trajectories::Trajectory& t) {
   std::string out = TrajectoryCsvHeader(t.device, t.nominal_rate_Hz);
   char row[192];
-  for (const plan::HandSample& s : t.samples) {
+  for (const trajectories::HandSample& s : t.samples) {
     std::snprintf(row, sizeof row, "%.6f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f,%.9f\n", s.t_s, s.p_WH_m.x(),
                   s.p_WH_m.y(), s.p_WH_m.z(), s.q_WH.w(), s.q_WH.x(), s.q_WH.y(), s.q_WH.z());
     out += row;

@@ -105,7 +105,7 @@ class RowParser {
 
   /// One line without its '\n' (a UTF-8 byte-order mark already removed from the first); true
   /// when it gave a sample, in `sample`, with its extra columns' values in extra_values().
-  bool Line(std::string_view line, int line_number, plan::HandSample& sample);
+  bool Line(std::string_view line, int line_number, trajectories::HandSample& sample);
   /// True after a header without the pose columns: the rows cannot be read.
   bool stopped() const { return stopped_; }
   /// The whole-file checks (a header, two samples) and the count of errors beyond the cap.
@@ -222,7 +222,7 @@ void RowParser::Header(std::string_view content, int line_number) {
   }
 }
 
-bool RowParser::Line(std::string_view line, int line_number, plan::HandSample& sample) {
+bool RowParser::Line(std::string_view line, int line_number, trajectories::HandSample& sample) {
   if (stopped_) return false;
   std::size_t leading = 0;
   const std::string_view content = Trim(line, leading);
@@ -296,7 +296,7 @@ bool RowParser::Line(std::string_view line, int line_number, plan::HandSample& s
     rows_ok_ = false;
     return false;
   }
-  plan::HandSample s;
+  trajectories::HandSample s;
   s.t_s = values_[pose_index_[0]];
   s.p_WH_m = position_scale_ * Eigen::Vector3d(values_[pose_index_[1]], values_[pose_index_[2]],
                                                values_[pose_index_[3]]);
@@ -377,7 +377,7 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
   TrajectoryLoadResult result;
   if (!CheckInputText(text, display_name, kExpected, result.diagnostics)) return result;
   text = WithoutBom(text);
-  plan::Trajectory trajectory;
+  trajectories::Trajectory trajectory;
   // At most one sample per line: reserving that bound once avoids the vector's doublings, each
   // of which briefly holds the old and the new array (3x the samples' size at the peak).
   // The shortest row ("0,0,0,0,1,0,0,0\n") is 16 bytes, which bounds a file of blank lines.
@@ -385,7 +385,7 @@ TrajectoryLoadResult LoadTrajectoryText(std::string_view text, const std::string
       std::min(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1,
                text.size() / 16 + 1));
   RowParser rows(display_name, options, result.diagnostics);
-  plan::HandSample sample;
+  trajectories::HandSample sample;
   std::size_t start = 0;
   for (int line_number = 1; start <= text.size() && !rows.stopped(); ++line_number) {
     const std::size_t newline = text.find('\n', start);
@@ -429,7 +429,7 @@ TrajectoryScanResult ScanTrajectoryFile(const std::filesystem::path& path,
   Diagnostics row_diagnostics;
   RowParser rows(name, options, row_diagnostics);
   TrajectoryInfo info;
-  plan::HandSample sample;
+  trajectories::HandSample sample;
   std::string_view line;
   for (int line_number = 1; result.read_error.empty() && in.Next(line); ++line_number) {
     // Rows are not parsed once the text fails (a binary file): only its checks go on.
@@ -487,7 +487,7 @@ TrajectoryFileSamples::~TrajectoryFileSamples() = default;
                      ", expected the trajectory file to stay as it was while it is replayed");
 }
 
-bool TrajectoryFileSamples::Next(plan::HandSample& sample) {
+bool TrajectoryFileSamples::Next(trajectories::HandSample& sample) {
   Rows& r = *rows_;
   std::string_view line;
   while (r.in.Next(line)) {

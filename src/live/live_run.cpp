@@ -154,7 +154,7 @@ LiveRun RunLive(const LiveRequest& o, std::ostream& err, const LiveProgress& pro
     err << "tubeplan live: error: " << problem << "\n";
     return run;
   }
-  plan::Trajectory target = *loaded.trajectory;
+  trajectories::Trajectory target = *loaded.trajectory;
   if (emulated && !args.trajectory.empty()) {
     io::TrajectoryLoadResult t = io::LoadTrajectoryFile(args.trajectory);
     err << t.diagnostics.FormatAll();

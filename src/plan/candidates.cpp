@@ -38,7 +38,7 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     c.plan.limits.dwell_s = options.dwell_s;
     // The asked speed, then each slower one until a replay is feasible; then the same aiming
     // the hand at the held end's poses.
-    SynthesisOptions synthesis = options.synthesis;
+    trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
     const std::size_t speeds = options.slower.size() + 1;
     const std::array<std::vector<Eigen::Isometry3d>, 2> aims = {
@@ -47,12 +47,12 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
       const std::vector<Eigen::Isometry3d>& waypoints = aims[k >= speeds ? 1 : 0];
       synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s /
                                      (k % speeds > 0 ? options.slower[k % speeds - 1] : 1.0);
-      c.trajectory = SynthesizeTrajectory(waypoints, synthesis);
+      c.trajectory = trajectories::SynthesizeTrajectory(waypoints, synthesis);
       c.duration_s = c.trajectory.samples.back().t_s;
       c.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
       c.held = k >= speeds;
       c.tries = int(k) + 1;
-      const std::optional<Trajectory> read = as_written(c.trajectory);
+      const std::optional<trajectories::Trajectory> read = as_written(c.trajectory);
       c.judgement = read ? Judge(scene, *read, c.plan.states, c.plan.limits) : Judgement{};
       if (c.judgement.feasible) break;
     }

@@ -31,7 +31,7 @@ std::string Format(const char* what, double value, const char* unit, double limi
   return buffer;
 }
 
-Eigen::Isometry3d Pose(const HandSample& s) {
+Eigen::Isometry3d Pose(const trajectories::HandSample& s) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = s.q_WH.toRotationMatrix();
   X.translation() = s.p_WH_m;
@@ -344,15 +344,15 @@ Judgement Judging::Finish(const std::string& stopped_early) {
   return j_;
 }
 
-Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
+Judgement Judge(const scene::Scene& scene, const trajectories::Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch) {
   // One tick at a time (TickStream), not Resample: a long recording is not held twice.
-  TickStream ticks(trajectory, scene.model.time_step_s);
+  trajectories::TickStream ticks(trajectory, scene.model.time_step_s);
   return Judge(scene, ticks, states, limits, watch, trajectory.stopped_early);
 }
 
-Judgement Judge(const scene::Scene& scene, TickSource& ticks,
+Judgement Judge(const scene::Scene& scene, trajectories::TickSource& ticks,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch, const std::string& stopped_early) {
   const auto clock_start = std::chrono::steady_clock::now();
@@ -362,7 +362,7 @@ Judgement Judge(const scene::Scene& scene, TickSource& ticks,
   Judging judging(states, limits, T, scene.tube);
   const auto text = [&core] { return core.FormationText(); };
   for (std::size_t k = 0; k < ticks.count(); ++k) {
-    const HandSample sample = ticks.Tick(k);
+    const trajectories::HandSample sample = ticks.Tick(k);
     judging.Tick(sample.t_s, core.Step(sample.t_s, Pose(sample)), text);
     if (watch) watch(sample.t_s, core);
   }

@@ -6,7 +6,7 @@
 namespace tubeplan::plan {
 namespace {
 
-Eigen::Isometry3d HandPose(const HandSample& sample) {
+Eigen::Isometry3d HandPose(const trajectories::HandSample& sample) {
   Eigen::Isometry3d X_W_hand = Eigen::Isometry3d::Identity();
   X_W_hand.linear() = sample.q_WH.toRotationMatrix();
   X_W_hand.translation() = sample.p_WH_m;
@@ -30,11 +30,11 @@ void Count(const core::StepOutput& out, double t_s, const std::string& cf_text, 
 
 }  // namespace
 
-Simulation Simulate(TickSource& ticks, core::Core& core, const StepWatcher& watch) {
+Simulation Simulate(trajectories::TickSource& ticks, core::Core& core, const StepWatcher& watch) {
   core.Reset(HandPose(ticks.Tick(0)));
   Simulation sum;
   for (std::size_t k = 0; k < ticks.count(); ++k) {
-    const HandSample sample = ticks.Tick(k);
+    const trajectories::HandSample sample = ticks.Tick(k);
     const Eigen::Isometry3d X_W_hand = HandPose(sample);
     // The core's step alone is timed.
     const auto start = std::chrono::steady_clock::now();

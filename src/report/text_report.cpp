@@ -6,8 +6,8 @@
 #include <iomanip>
 #include <sstream>
 
-#include <tubeplan/plan/perturb.hpp>
 #include <tubeplan/report/text_report.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
 
 namespace tubeplan::report {
 
@@ -68,7 +68,7 @@ void PrintVerdicts(std::ostream& t, const batch::Evaluated& e, bool colour) {
     std::ostringstream robust;
     if (e.runs > 0) {
       robust.precision(3);
-      const plan::Interval ci = plan::WilsonInterval(e.robust[k], e.runs);
+      const trajectories::Interval ci = trajectories::WilsonInterval(e.robust[k], e.runs);
       robust << "\n      robust: feasible in " << e.robust[k] << " of " << e.runs
              << " perturbed replays (95 % interval " << ci.low << " .. " << ci.high << ")";
     }

@@ -32,13 +32,13 @@ scene::Scene LoadScene(const std::string& relative) {
   return *loaded.scene;
 }
 
-std::vector<plan::HandSample> InsertTicks() {
+std::vector<trajectories::HandSample> InsertTicks() {
   io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(SourcePath("plans/groove-insert.csv"));
   REQUIRE(loaded.trajectory.has_value());
-  return plan::Resample(*loaded.trajectory, 1e-3);
+  return trajectories::Resample(*loaded.trajectory, 1e-3);
 }
 
-Eigen::Isometry3d Pose(const plan::HandSample& s) {
+Eigen::Isometry3d Pose(const trajectories::HandSample& s) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = s.q_WH.toRotationMatrix();
   X.translation() = s.p_WH_m;
@@ -59,7 +59,7 @@ struct Hash {
 };
 
 // The hash of ticks [first, last) run on `c` as it is.
-std::uint64_t HashTicks(core::Core& c, const std::vector<plan::HandSample>& ticks,
+std::uint64_t HashTicks(core::Core& c, const std::vector<trajectories::HandSample>& ticks,
                         std::size_t first, std::size_t last) {
   Hash hash;
   for (std::size_t k = first; k < last; ++k) {
@@ -84,7 +84,7 @@ std::uint64_t HashTicks(core::Core& c, const std::vector<plan::HandSample>& tick
 TEST_CASE("A tick allocates nothing, with or without the shape", "[core][alloc]") {
   // The whole insertion: free motion, the rim on the floor, sliding, the side landing.
   const scene::Scene s = LoadScene("scenes/groove.yaml");
-  const std::vector<plan::HandSample> ticks = InsertTicks();
+  const std::vector<trajectories::HandSample> ticks = InsertTicks();
   core::Core c(s);
   c.Reset(Pose(ticks.front()));
   c.Step(ticks[0].t_s, Pose(ticks[0]));
@@ -103,7 +103,7 @@ TEST_CASE("A tick allocates nothing, with or without the shape", "[core][alloc]"
 
 TEST_CASE("The same inputs give the same bits, in any thread", "[core][determinism]") {
   const scene::Scene s = LoadScene("scenes/groove.yaml");
-  const std::vector<plan::HandSample> ticks = InsertTicks();
+  const std::vector<trajectories::HandSample> ticks = InsertTicks();
   const auto run = [&] {
     core::Core c(s);
     c.Reset(Pose(ticks.front()));
@@ -127,7 +127,7 @@ TEST_CASE("The same inputs give the same bits, in any thread", "[core][determini
 TEST_CASE("A snapshot puts a core back where it was, bit for bit, in another core too",
           "[core][determinism]") {
   const scene::Scene s = LoadScene("scenes/groove.yaml");
-  const std::vector<plan::HandSample> ticks = InsertTicks();
+  const std::vector<trajectories::HandSample> ticks = InsertTicks();
   // Saved while the rim presses and slides on the floor (t = 2.5 s).
   const std::size_t at = 2500;
   core::Core a(s), b(s);

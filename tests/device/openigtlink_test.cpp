@@ -251,7 +251,7 @@ TEST_CASE("Poses from an OpenIGTLink bridge are the trajectory's, in order",
   Bridge bridge({});
   device::OpenIGTLinkDevice dev(Loopback(bridge.port()));
   REQUIRE(dev.Open().empty());
-  const plan::Trajectory& trajectory = *InsertPlan().trajectory;
+  const trajectories::Trajectory& trajectory = *InsertPlan().trajectory;
   std::size_t cursor = 0;
   std::uint64_t previous = 0;
   int checked = 0;
@@ -262,7 +262,7 @@ TEST_CASE("Poses from an OpenIGTLink bridge are the trajectory's, in order",
     REQUIRE(dev.Read(s));
     REQUIRE(s.sequence >= previous);
     if (s.sequence != previous) {
-      const plan::HandSample expected = plan::PoseAt(
+      const trajectories::HandSample expected = trajectories::PoseAt(
           trajectory, trajectory.samples.front().t_s + double(s.sequence - 1) * 1e-3, cursor);
       // float32 millimetres on the wire: 2^-24 of 300 mm is 2e-8 m; the rotation's float32
       // entries are good to about 1e-7.
@@ -273,7 +273,7 @@ TEST_CASE("Poses from an OpenIGTLink bridge are the trajectory's, in order",
         // The velocity: the difference of the last two poses over their timestamps, 1 ms apart
         // (the bridge stamps sample times). float32 positions, 2e-8 m over 1 ms: 2e-5 m/s.
         std::size_t c = 0;
-        const plan::HandSample before = plan::PoseAt(
+        const trajectories::HandSample before = trajectories::PoseAt(
             trajectory, trajectory.samples.front().t_s + double(s.sequence - 2) * 1e-3, c);
         const Eigen::Vector3d v = (expected.p_WH_m - before.p_WH_m) / 1e-3;
         CHECK((s.v_W_m_per_s - v).norm() < 1e-4);
@@ -414,7 +414,7 @@ TEST_CASE(
   // The velocity differences the poses' sample times, not their arrival: a drop (2 ms between
   // two poses) or a burst (poses microseconds apart) leaves it the trajectory's. Read here, after
   // the servo, where the bridge keeps streaming through its pauses (0.6 s: two of them).
-  const plan::Trajectory& trajectory = *InsertPlan().trajectory;
+  const trajectories::Trajectory& trajectory = *InsertPlan().trajectory;
   double fastest_m_per_s = 0.0;
   for (std::size_t i = 1; i < trajectory.samples.size(); ++i)
     fastest_m_per_s = std::max(
@@ -505,9 +505,9 @@ TEST_CASE(
   // differs.
   const io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(recording.string());
   REQUIRE(loaded.trajectory);
-  const std::vector<plan::HandSample>& samples = loaded.trajectory->samples;
+  const std::vector<trajectories::HandSample>& samples = loaded.trajectory->samples;
   REQUIRE(samples.size() == std::size_t(ticks - 1));
-  const plan::HandSample& last = samples.back();
+  const trajectories::HandSample& last = samples.back();
   std::size_t same = 0;
   while (same < samples.size() && samples[samples.size() - 1 - same].p_WH_m == last.p_WH_m &&
          samples[samples.size() - 1 - same].q_WH.coeffs() == last.q_WH.coeffs())

@@ -31,8 +31,8 @@ using device::StopReason;
 using testing::InsertPlan;
 using testing::SourcePath;
 
-plan::Trajectory StillTarget(const Eigen::Vector3d& p_W_m, double duration_s) {
-  plan::Trajectory t;
+trajectories::Trajectory StillTarget(const Eigen::Vector3d& p_W_m, double duration_s) {
+  trajectories::Trajectory t;
   t.samples.resize(2);
   t.samples[0].p_WH_m = t.samples[1].p_WH_m = p_W_m;
   t.samples[1].t_s = duration_s;
@@ -138,7 +138,7 @@ TEST_CASE("A recorded pose reads back to the same bits", "[device]") {
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   std::string csv = io::TrajectoryCsvHeader("test", 1000.0);
-  std::vector<plan::HandSample> written;
+  std::vector<trajectories::HandSample> written;
   for (int k = 0; k < 500; ++k) {
     Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
     X.linear() = Eigen::Quaterniond(Eigen::Vector4d(u(random), u(random), u(random), u(random)))
@@ -151,7 +151,7 @@ TEST_CASE("A recorded pose reads back to the same bits", "[device]") {
   const io::TrajectoryLoadResult read = io::LoadTrajectoryText(csv, "recording.csv");
   INFO(read.diagnostics.FormatAll());
   REQUIRE(read.trajectory);
-  const std::vector<plan::HandSample> grid = plan::Resample(*read.trajectory, 1e-3);
+  const std::vector<trajectories::HandSample> grid = trajectories::Resample(*read.trajectory, 1e-3);
   REQUIRE(grid.size() == written.size());
   for (std::size_t k = 0; k < written.size(); ++k) {
     // Exactly: the replay must step the core with the bits the live run used.

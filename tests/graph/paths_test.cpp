@@ -12,7 +12,7 @@
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
 
 namespace {
 
@@ -70,7 +70,7 @@ TEST_CASE("Yen's k shortest paths match brute-force enumeration on random graphs
 }
 
 TEST_CASE("The minimum-jerk profile", "[plan]") {
-  using plan::MinimumJerk;
+  using trajectories::MinimumJerk;
   CHECK(MinimumJerk(0.0) == 0.0);
   CHECK(MinimumJerk(1.0) == 1.0);
   CHECK(MinimumJerk(0.5) == Approx(0.5).epsilon(1e-15));
@@ -88,8 +88,8 @@ TEST_CASE("Synthesized trajectories pass through the waypoints at the set speed"
   waypoints[1].translation() = Eigen::Vector3d(0.05, 0.0, -0.02);
   waypoints[1].linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitX()).toRotationMatrix();
   waypoints[2].translation() = Eigen::Vector3d(0.05, 0.03, -0.03);
-  plan::SynthesisOptions o;
-  const plan::Trajectory t = plan::SynthesizeTrajectory(waypoints, o);
+  trajectories::SynthesisOptions o;
+  const trajectories::Trajectory t = trajectories::SynthesizeTrajectory(waypoints, o);
   // Duration: holds at each of 3 waypoints plus two reaches, each max(1.875 d / v, min).
   const double d1 = waypoints[1].translation().norm();
   const double d2 = (waypoints[2].translation() - waypoints[1].translation()).norm();
@@ -117,12 +117,12 @@ TEST_CASE("Synthesized trajectories round-trip through the CSV format; quantised
           "[plan]") {
   std::vector<Eigen::Isometry3d> waypoints(2, Eigen::Isometry3d::Identity());
   waypoints[1].translation() = Eigen::Vector3d(0.0, 0.04, -0.01);
-  plan::SynthesisOptions o;
+  trajectories::SynthesisOptions o;
   o.tremor_m = 1e-4;
   o.quantum_m = 3e-5;
-  const plan::Trajectory t = plan::SynthesizeTrajectory(waypoints, o);
+  const trajectories::Trajectory t = trajectories::SynthesizeTrajectory(waypoints, o);
   double largest_offset = 0.0;
-  for (const plan::HandSample& s : t.samples) {
+  for (const trajectories::HandSample& s : t.samples) {
     for (int axis = 0; axis < 3; ++axis) {
       const double steps = s.p_WH_m[axis] / o.quantum_m;
       CHECK(std::abs(steps - std::round(steps)) < 1e-6);

@@ -11,7 +11,7 @@
 #include <catch2/catch.hpp>
 
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 #include "../scratch.hpp"
 #include "io/text_file.hpp"
@@ -19,7 +19,7 @@
 namespace {
 
 namespace io = tubeplan::io;
-namespace plan = tubeplan::plan;
+namespace trajectories = tubeplan::trajectories;
 
 std::filesystem::path Scratch() { return tubeplan::testing::ScratchDir("trajectory-stream"); }
 
@@ -115,22 +115,22 @@ std::vector<std::pair<std::string, std::string>> BadTexts() {
 }
 
 // Every tick of the file at `step_s`, from the in-memory loader and TickStream.
-std::vector<plan::HandSample> MemoryTicks(const std::string& path, double step_s) {
+std::vector<trajectories::HandSample> MemoryTicks(const std::string& path, double step_s) {
   const io::TrajectoryLoadResult loaded = io::LoadTrajectoryFile(path);
   REQUIRE(loaded.trajectory);
-  plan::TickStream ticks(*loaded.trajectory, step_s);
-  std::vector<plan::HandSample> out;
+  trajectories::TickStream ticks(*loaded.trajectory, step_s);
+  std::vector<trajectories::HandSample> out;
   for (std::size_t k = 0; k < ticks.count(); ++k) out.push_back(ticks.Tick(k));
   return out;
 }
 
 // The same from the streamed passes: ScanTrajectoryFile, then the rows again.
-std::vector<plan::HandSample> StreamedTicks(const std::string& path, double step_s) {
+std::vector<trajectories::HandSample> StreamedTicks(const std::string& path, double step_s) {
   const io::TrajectoryScanResult scanned = io::ScanTrajectoryFile(path);
   REQUIRE(scanned.info);
   io::TrajectoryFileSamples samples(*scanned.info);
-  plan::SampleTicks ticks(samples, scanned.info->t_first_s, scanned.info->t_last_s, step_s);
-  std::vector<plan::HandSample> out;
+  trajectories::SampleTicks ticks(samples, scanned.info->t_first_s, scanned.info->t_last_s, step_s);
+  std::vector<trajectories::HandSample> out;
   for (std::size_t k = 0; k < ticks.count(); ++k) out.push_back(ticks.Tick(k));
   return out;
 }
@@ -166,7 +166,7 @@ TEST_CASE("The streamed check of a trajectory file gives the in-memory loader's 
     CHECK(scanned.diagnostics.FormatAll() == loaded.diagnostics.FormatAll());
     REQUIRE(scanned.info.has_value() == loaded.trajectory.has_value());
     if (!loaded.trajectory) continue;
-    const plan::Trajectory& t = *loaded.trajectory;
+    const trajectories::Trajectory& t = *loaded.trajectory;
     CHECK(scanned.info->sample_count == t.samples.size());
     CHECK(scanned.info->t_first_s == t.samples.front().t_s);
     CHECK(scanned.info->t_last_s == t.samples.back().t_s);
@@ -212,8 +212,8 @@ TEST_CASE("A streamed replay of the shipped trajectories gives the in-memory tic
                                  "tests/data/trajectories/good.csv"}) {
     for (const double step_s : {1e-3, 3.7e-4, 2.5e-3}) {
       CAPTURE(file, step_s);
-      const std::vector<plan::HandSample> memory = MemoryTicks(Source(file), step_s);
-      const std::vector<plan::HandSample> streamed = StreamedTicks(Source(file), step_s);
+      const std::vector<trajectories::HandSample> memory = MemoryTicks(Source(file), step_s);
+      const std::vector<trajectories::HandSample> streamed = StreamedTicks(Source(file), step_s);
       REQUIRE(streamed.size() == memory.size());
       for (std::size_t k = 0; k < memory.size(); ++k) {
         REQUIRE(streamed[k].t_s == memory[k].t_s);

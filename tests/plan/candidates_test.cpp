@@ -53,9 +53,9 @@ TEST_CASE("Candidates: a failing one is retried slower, then at the held poses; 
   options.scene_ref = "groove.yaml";
   int replays = 0;
   const std::vector<plan::Candidate> c =
-      plan::MakeCandidates(scene, g, paths, options, [&](const plan::Trajectory& t) {
+      plan::MakeCandidates(scene, g, paths, options, [&](const trajectories::Trajectory& t) {
         ++replays;
-        return std::optional<plan::Trajectory>(t);
+        return std::optional<trajectories::Trajectory>(t);
       });
   REQUIRE(c.size() == 3);
   // The stretched witness fails at each speed aimed at the hand's pose, and replays feasible

@@ -14,7 +14,7 @@
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/judge.hpp>
-#include <tubeplan/plan/perturb.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
 
 #include "cli/app.hpp"
 
@@ -95,15 +95,15 @@ TEST_CASE("A force limit is reported at the tick the force first exceeds it", "[
   // tube entered {Ee ~ floor.top} at which the operator force exceeds 0.05 N.
   const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-gentle.yaml"));
   REQUIRE(loaded.plan);
-  const std::vector<plan::HandSample> ticks =
-      plan::Resample(*loaded.trajectory, loaded.scene->model.time_step_s);
+  const std::vector<trajectories::HandSample> ticks =
+      trajectories::Resample(*loaded.trajectory, loaded.scene->model.time_step_s);
   core::Core core(*loaded.scene);
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = ticks.front().q_WH.toRotationMatrix();
   X.translation() = ticks.front().p_WH_m;
   core.Reset(X);
   double first_t = -1.0, force = 0.0;
-  for (const plan::HandSample& s : ticks) {
+  for (const trajectories::HandSample& s : ticks) {
     X.linear() = s.q_WH.toRotationMatrix();
     X.translation() = s.p_WH_m;
     const core::StepOutput& out = core.Step(s.t_s, X);
@@ -189,8 +189,9 @@ TEST_CASE("A plan replayed from its trajectory file row by row gets the same jud
     const plan::Judgement a =
         plan::Judge(*memory.scene, *memory.trajectory, memory.plan->states, memory.plan->limits);
     io::TrajectoryFileSamples samples(*streamed.trajectory_file);
-    plan::SampleTicks ticks(samples, streamed.trajectory_file->t_first_s,
-                            streamed.trajectory_file->t_last_s, streamed.scene->model.time_step_s);
+    trajectories::SampleTicks ticks(samples, streamed.trajectory_file->t_first_s,
+                                    streamed.trajectory_file->t_last_s,
+                                    streamed.scene->model.time_step_s);
     const plan::Judgement b =
         plan::Judge(*streamed.scene, ticks, streamed.plan->states, streamed.plan->limits);
     CHECK(b.feasible == a.feasible);
@@ -266,19 +267,19 @@ TEST_CASE("Shards merged give the unsharded report", "[plan]") {
 TEST_CASE("Wilson intervals and perturbed trajectories", "[plan]") {
   // Known values of the 95 % Wilson score interval (e.g. Newcombe 1998, Table I: 8/10 gives
   // 0.490 .. 0.943; 0/10 gives 0 .. 0.278).
-  const plan::Interval a = plan::WilsonInterval(8, 10);
+  const trajectories::Interval a = trajectories::WilsonInterval(8, 10);
   CHECK(a.low == Approx(0.4902).margin(5e-5));
   CHECK(a.high == Approx(0.9433).margin(5e-5));
-  const plan::Interval b = plan::WilsonInterval(0, 10);
+  const trajectories::Interval b = trajectories::WilsonInterval(0, 10);
   CHECK(b.low == 0.0);
   CHECK(b.high == Approx(0.2775).margin(5e-5));
-  CHECK(plan::WilsonInterval(10, 10).low == Approx(1.0 - 0.2775).margin(5e-5));
+  CHECK(trajectories::WilsonInterval(10, 10).low == Approx(1.0 - 0.2775).margin(5e-5));
 
   const io::PlanLoadResult loaded = io::LoadPlanFile(SourcePath("plans/groove-insert.yaml"));
   REQUIRE(loaded.trajectory);
-  const plan::Trajectory& nominal = *loaded.trajectory;
+  const trajectories::Trajectory& nominal = *loaded.trajectory;
   // No perturbation: the same samples, bit for bit.
-  const plan::Trajectory same = plan::Perturb(nominal, {0.0, 0.0, 1.0, 1.0}, 7, 3);
+  const trajectories::Trajectory same = trajectories::Perturb(nominal, {0.0, 0.0, 1.0, 1.0}, 7, 3);
   REQUIRE(same.samples.size() == nominal.samples.size());
   for (std::size_t i = 0; i < same.samples.size(); i += 251) {
     CHECK(same.samples[i].t_s == nominal.samples[i].t_s);
@@ -286,9 +287,9 @@ TEST_CASE("Wilson intervals and perturbed trajectories", "[plan]") {
   }
   // The defaults: the offset stays within 1 mm plus the tremor's reach, the duration within the
   // speed range, and another replicate differs.
-  const plan::Perturbation p;
+  const trajectories::Perturbation p;
   for (int r = 0; r < 20; ++r) {
-    const plan::Trajectory t = plan::Perturb(nominal, p, 7, r);
+    const trajectories::Trajectory t = trajectories::Perturb(nominal, p, 7, r);
     const double duration = t.samples.back().t_s - t.samples.front().t_s;
     const double nominal_duration = nominal.samples.back().t_s - nominal.samples.front().t_s;
     CHECK(duration >= nominal_duration / p.speed_max - 1e-12);
@@ -296,8 +297,8 @@ TEST_CASE("Wilson intervals and perturbed trajectories", "[plan]") {
     CHECK((t.samples.front().p_WH_m - nominal.samples.front().p_WH_m).norm() <=
           p.offset_m + std::sqrt(3.0) * p.tremor_m + 1e-12);
   }
-  CHECK(plan::Perturb(nominal, p, 7, 0).samples[100].p_WH_m !=
-        plan::Perturb(nominal, p, 7, 1).samples[100].p_WH_m);
+  CHECK(trajectories::Perturb(nominal, p, 7, 0).samples[100].p_WH_m !=
+        trajectories::Perturb(nominal, p, 7, 1).samples[100].p_WH_m);
 }
 
 TEST_CASE("Monte-Carlo robustness is the same for any --jobs", "[plan]") {

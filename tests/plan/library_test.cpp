@@ -51,7 +51,7 @@ TEST_CASE("The library header alone replays a trajectory file as simulate does",
   const io::TrajectoryLoadResult loaded =
       io::LoadTrajectoryFile(source + "/plans/groove-insert.csv");
   REQUIRE(loaded.trajectory);
-  plan::TickStream ticks(*loaded.trajectory, input.scene->model.time_step_s);
+  trajectories::TickStream ticks(*loaded.trajectory, input.scene->model.time_step_s);
   core::Core core(*input.scene);
   const plan::Simulation in_memory = plan::Simulate(ticks, core);
   REQUIRE(in_memory.visits.size() == simulated.run.visits.size());

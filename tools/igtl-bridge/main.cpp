@@ -44,7 +44,7 @@
 #include <CLI/CLI.hpp>
 
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace {
 
@@ -174,7 +174,7 @@ struct Link {
 };
 
 // Packs pose `s` into the link's TRANSFORM message, stamped `stamp_ns` (wall clock).
-void PackPose(Link& link, const tubeplan::plan::HandSample& s, std::int64_t stamp_ns) {
+void PackPose(Link& link, const tubeplan::trajectories::HandSample& s, std::int64_t stamp_ns) {
   igtl::Matrix4x4 m;
   const Eigen::Matrix3d R = s.q_WH.normalized().toRotationMatrix();
   for (int i = 0; i < 3; ++i) {
@@ -192,13 +192,13 @@ void PackPose(Link& link, const tubeplan::plan::HandSample& s, std::int64_t stam
 
 // Sends the next sample's pose, or drops it, or holds it back in a pause (the faults asked
 // for). False, with `ended` said, when the connection fails.
-bool SendPose(const Options& o, const tubeplan::plan::Trajectory& trajectory, double t0,
+bool SendPose(const Options& o, const tubeplan::trajectories::Trajectory& trajectory, double t0,
               std::size_t& cursor, Link& link, std::string& ended) {
   const std::int64_t period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
   const long hold_count = std::lround(o.delay_ms * 1e-3 * o.rate_hz);
   // The pose of the trajectory at this tick's time; held at its last pose after its end.
-  const tubeplan::plan::HandSample s =
-      tubeplan::plan::PoseAt(trajectory, t0 + double(link.samples) / o.rate_hz, cursor);
+  const tubeplan::trajectories::HandSample s =
+      tubeplan::trajectories::PoseAt(trajectory, t0 + double(link.samples) / o.rate_hz, cursor);
   // Stamped with its sample time, start + n / rate, as a device stamps its samples: the
   // client's finite-difference velocity then sees the trajectory's, not this process's
   // scheduling; the round trip counts from it, so any lateness of this send is in it.
@@ -274,7 +274,8 @@ void TakeMessages(Link& link, std::int64_t arrived_ns) {
 
 // Streams the poses on absolute deadlines and takes the wrenches between them, until the client
 // closes, a fault option or a signal ends it, or the link fails; returns what ended it.
-std::string Stream(const Options& o, const tubeplan::plan::Trajectory& trajectory, Link& link) {
+std::string Stream(const Options& o, const tubeplan::trajectories::Trajectory& trajectory,
+                   Link& link) {
   const auto period_ns = std::int64_t(std::llround(1e9 / o.rate_hz));
   link.start_ns = NowNs(CLOCK_MONOTONIC);
   link.start_realtime_ns = NowNs(CLOCK_REALTIME);

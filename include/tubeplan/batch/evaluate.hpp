@@ -53,8 +53,8 @@ std::string CanonicalPlanPath(const std::string& path);
 
 struct BatchOptions {
   int jobs = 1;  ///< threads, each with its own core
-  int monte_carlo =
-      0;  ///< perturbed replicates per plan (plan::Perturb); needs trajectories loaded
+  /// Perturbed replicates per plan (trajectories::Perturb); needs trajectories loaded.
+  int monte_carlo = 0;
   std::uint64_t seed = 1;
   /// The watcher of plan i's judged replay (an HTML report records it), or none.
   std::function<plan::TickWatcher(std::size_t)> watch;

@@ -14,8 +14,8 @@
 #include <tubeplan/graph/contact_graph.hpp>
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/plan/candidates.hpp>
-#include <tubeplan/plan/synthesize.hpp>
 #include <tubeplan/scene/scene.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
 
 namespace tubeplan::batch {
 
@@ -26,7 +26,8 @@ struct PlansRequest {
   int k = 3;               ///< paths asked for
   bool all = false;        ///< also write the candidates that replay infeasible, after the others
   std::string out_dir;     ///< empty: SCENE_NAME-plans
-  plan::SynthesisOptions synthesis;  ///< the hand's trajectories (seed offset by the path's rank)
+  /// The hand's trajectories (seed offset by the path's rank).
+  trajectories::SynthesisOptions synthesis;
 };
 
 /// The directory the plans of the scene named `scene_name` go to.

@@ -36,6 +36,7 @@ bool ParseDeviceChoice(const std::string& text, DeviceChoice& choice, std::strin
 /// bridge over OpenIGTLink, or OpenHaptics; null with `error` when it cannot be made (OpenHaptics
 /// not built in, or its device not found).
 std::unique_ptr<HapticDevice> MakeDevice(const DeviceChoice& choice, Clock& clock,
-                                         const plan::Trajectory& target, std::string& error);
+                                         const trajectories::Trajectory& target,
+                                         std::string& error);
 
 }  // namespace tubeplan::device

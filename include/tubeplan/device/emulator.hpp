@@ -13,7 +13,7 @@
 
 #include <tubeplan/device/clock.hpp>
 #include <tubeplan/device/device.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::device {
 
@@ -37,7 +37,7 @@ class EmulatorDevice final : public HapticDevice {
  public:
   /// Follows `target` (at least two samples) from its first pose, starting at the clock's time
   /// when Open() is called; after its end the target stays at its last pose.
-  EmulatorDevice(Clock& clock, plan::Trajectory target, HandModel hand = {});
+  EmulatorDevice(Clock& clock, trajectories::Trajectory target, HandModel hand = {});
 
   std::string Open() override;
   std::string Calibrate() override { return {}; }
@@ -69,7 +69,7 @@ class EmulatorDevice final : public HapticDevice {
   Eigen::Isometry3d TargetAt(double t_s, Eigen::Vector3d& v_W_m_per_s);
 
   Clock& clock_;
-  plan::Trajectory target_;
+  trajectories::Trajectory target_;
   HandModel hand_;
   DeviceSpec spec_;
   bool open_ = false;

@@ -20,7 +20,7 @@
 #include <tubeplan/device/device.hpp>
 #include <tubeplan/device/handoff.hpp>
 #include <tubeplan/device/wrench_limiter.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::device {
 
@@ -65,9 +65,9 @@ struct ServoConfig {
 /// What one tick did, handed to the judge and the recorder (every tick, in order).
 struct TickRecord {
   long tick = 0;
-  plan::HandSample hand;  ///< the pose given to the core, as the recording stores it
-  core::StepOutput out;   ///< valid when stepped
-  bool stepped = false;   ///< false on a tick that faulted before stepping the core
+  trajectories::HandSample hand;  ///< the pose given to the core, as the recording stores it
+  core::StepOutput out;           ///< valid when stepped
+  bool stepped = false;           ///< false on a tick that faulted before stepping the core
   Eigen::Vector3d force_sent_N = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_sent_Nm = Eigen::Vector3d::Zero();
   std::uint32_t buttons = 0;
@@ -128,7 +128,7 @@ std::string TryRealtime();
 /// The pose a recording (io::FormatTrajectoryCsvRow, 1 nm and 1e-9) gives back on reading,
 /// including the reader's normalisation of the quaternion. The servo feeds the core this pose,
 /// so a replay of the recording steps the core with the same bits and reaches the same verdicts.
-plan::HandSample AsRecorded(double t_s, const Eigen::Isometry3d& X_W_hand);
+trajectories::HandSample AsRecorded(double t_s, const Eigen::Isometry3d& X_W_hand);
 
 class ServoLoop {
  public:

@@ -11,9 +11,9 @@
 #include <tubeplan/io/diagnostics.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
 #include <tubeplan/plan/plan.hpp>
-#include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
 #include <tubeplan/states/contact_formation.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::io {
 
@@ -21,7 +21,7 @@ struct PlanLoadResult {
   /// All set only when there is no error anywhere (plan, its scene, its trajectory).
   std::optional<plan::Plan> plan;
   std::optional<scene::Scene> scene;
-  std::optional<plan::Trajectory> trajectory;  ///< unless the options asked for it streamed
+  std::optional<trajectories::Trajectory> trajectory;  ///< unless the options asked for it streamed
   /// With PlanLoadOptions::trajectory_in_memory false: the checked trajectory file, to replay
   /// row by row (TrajectoryFileSamples) instead of `trajectory`.
   std::optional<TrajectoryInfo> trajectory_file;
@@ -50,25 +50,26 @@ std::string FormatPlanYaml(const plan::Plan& plan);
 /// A trajectory as CSV in the format LoadTrajectoryText reads: '#' metadata lines (device,
 /// rate, units), the header t,px,py,pz,qw,qx,qy,qz, one row per sample (positions to the
 /// nanometre, quaternions to 1e-9), and the "# stopped:" line of a trajectory that has one.
-std::string FormatTrajectoryCsv(const plan::Trajectory& trajectory);
+std::string FormatTrajectoryCsv(const trajectories::Trajectory& trajectory);
 
 /// The trajectory as its file reads back (FormatTrajectoryCsv, then LoadTrajectoryText: rounded
 /// as written), or nothing if it would not load; what a replay of the written plan sees
 /// (plan::AsWritten).
-std::optional<plan::Trajectory> TrajectoryAsWritten(const plan::Trajectory& trajectory);
+std::optional<trajectories::Trajectory> TrajectoryAsWritten(
+    const trajectories::Trajectory& trajectory);
 
 /// The '#' metadata lines and the header of a trajectory CSV, as FormatTrajectoryCsv writes them,
 /// with `extra_columns` after the pose columns.
 std::string TrajectoryCsvHeader(const std::string& device, double nominal_rate_Hz,
                                 const std::vector<std::string>& extra_columns = {});
-/// The line that ends the recording of a run that stopped early (plan::Trajectory's
+/// The line that ends the recording of a run that stopped early (trajectories::Trajectory's
 /// stopped_early).
 std::string TrajectoryCsvStopped(const std::string& stopped_early);
 /// Appends one sample as a row for a streamed recording: t as the shortest text that reads back
 /// to the same double (so a replay's grid t0 + k T meets the samples exactly), the position to
 /// the nanometre and the quaternion to 1e-9 as written (the reader normalises it), then
 /// `extra_fields` (the extra columns' fields, comma-separated) when not empty.
-void AppendTrajectoryCsvRow(std::string& out, const plan::HandSample& sample,
+void AppendTrajectoryCsvRow(std::string& out, const trajectories::HandSample& sample,
                             std::string_view extra_fields = {});
 
 }  // namespace tubeplan::io

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include <tubeplan/io/diagnostics.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::io {
 
@@ -28,8 +28,8 @@ struct TrajectoryLoadOptions {
 };
 
 struct TrajectoryLoadResult {
-  std::optional<plan::Trajectory> trajectory;  ///< set only when there is no error
-  Diagnostics diagnostics;                     ///< every problem found (capped, see the docs)
+  std::optional<trajectories::Trajectory> trajectory;  ///< set only when there is no error
+  Diagnostics diagnostics;  ///< every problem found (capped, see the docs)
 };
 
 TrajectoryLoadResult LoadTrajectoryFile(const std::filesystem::path& path,
@@ -44,10 +44,10 @@ struct TrajectoryInfo {
   std::size_t sample_count = 0;  ///< at least two
   double t_first_s = 0.0;        ///< the first and last samples' times
   double t_last_s = 0.0;
-  std::string device;                      ///< as plan::Trajectory's
-  double nominal_rate_Hz = 0.0;            ///< as plan::Trajectory's
-  std::string stopped_early;               ///< as plan::Trajectory's
-  std::vector<std::string> extra_columns;  ///< as plan::Trajectory's
+  std::string device;                      ///< as trajectories::Trajectory's
+  double nominal_rate_Hz = 0.0;            ///< as trajectories::Trajectory's
+  std::string stopped_early;               ///< as trajectories::Trajectory's
+  std::vector<std::string> extra_columns;  ///< as trajectories::Trajectory's
   std::uintmax_t file_bytes = 0;           ///< the file as it was checked, to see it change
   std::int64_t modified_ns = 0;
 };
@@ -72,14 +72,14 @@ class InputChanged : public std::runtime_error {
 
 /// The samples of a checked trajectory file (ScanTrajectoryFile), read again in order, exactly
 /// as LoadTrajectoryFile gives them: the second pass of a streamed replay
-/// (plan::SampleTicks). Throws InputChanged, with a "file: error: ..." message, when the file is
-/// not the one that was checked (its size, time or rows differ).
-class TrajectoryFileSamples final : public plan::SampleSource {
+/// (trajectories::SampleTicks). Throws InputChanged, with a "file: error: ..." message, when the
+/// file is not the one that was checked (its size, time or rows differ).
+class TrajectoryFileSamples final : public trajectories::SampleSource {
  public:
   explicit TrajectoryFileSamples(const TrajectoryInfo& info,
                                  const TrajectoryLoadOptions& options = {});
   ~TrajectoryFileSamples() override;
-  bool Next(plan::HandSample& sample) override;
+  bool Next(trajectories::HandSample& sample) override;
 
  private:
   struct Rows;

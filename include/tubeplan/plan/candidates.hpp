@@ -14,16 +14,17 @@
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/plan/plan.hpp>
-#include <tubeplan/plan/synthesize.hpp>
-#include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::plan {
 
 struct CandidateOptions {
-  SynthesisOptions synthesis;  ///< the first try's; its seed is offset by the path's rank
-  double dwell_s = 0.0;        ///< the plans' dwell (the explorer's)
-  std::string scene_ref;       ///< the scene as the plan files name it
+  /// The first try's; its seed is offset by the path's rank.
+  trajectories::SynthesisOptions synthesis;
+  double dwell_s = 0.0;   ///< the plans' dwell (the explorer's)
+  std::string scene_ref;  ///< the scene as the plan files name it
   /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
   /// less): the first try is at the asked speed. When none replays feasible, the same speeds
   /// are tried again aiming the hand at the held end's poses at the witnesses (Node::X_WH) rather
@@ -36,7 +37,7 @@ struct CandidateOptions {
 struct Candidate {
   const graph::Path* path = nullptr;
   Plan plan;  ///< name, trajectory and comment left to the writer
-  Trajectory trajectory;
+  trajectories::Trajectory trajectory;
   double duration_s = 0.0;
   double peak_speed_m_per_s = 0.0;  ///< of the try kept
   bool held = false;                ///< the try kept aims at the held end's poses
@@ -46,7 +47,8 @@ struct Candidate {
 
 /// The trajectory as its file will read it back (rounded as written), or nothing if it would
 /// not load: what the verdict is taken on, so that `evaluate` on the written files agrees.
-using AsWritten = std::function<std::optional<Trajectory>(const Trajectory&)>;
+using AsWritten =
+    std::function<std::optional<trajectories::Trajectory>(const trajectories::Trajectory&)>;
 
 /// One candidate for each path (in order), each the first try that replays feasible or else the
 /// last; the feasible come first, each kind in the paths' order.

@@ -13,9 +13,9 @@
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/model/tube.hpp>
 #include <tubeplan/plan/plan.hpp>
-#include <tubeplan/plan/trajectory.hpp>
 #include <tubeplan/scene/scene.hpp>
 #include <tubeplan/states/contact_formation.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::plan {
 
@@ -187,13 +187,13 @@ using TickWatcher = std::function<void(double t_s, const core::Core& core)>;
 /// Replays `trajectory` (resampled onto the scene's step) from its first pose and judges
 /// `states` (planned CFs, canonical) under `limits`; `watch` (may be empty) sees every tick. A
 /// recording of a run that stopped early (Trajectory::stopped_early) is judged as that run was.
-Judgement Judge(const scene::Scene& scene, const Trajectory& trajectory,
+Judgement Judge(const scene::Scene& scene, const trajectories::Trajectory& trajectory,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch = {});
 /// The same from ticks that come one at a time (a trajectory file replayed row by row,
 /// SampleTicks); `ticks` must be on the scene's step. The same ticks give the same judgement.
 /// `stopped_early` as Judging::Finish's.
-Judgement Judge(const scene::Scene& scene, TickSource& ticks,
+Judgement Judge(const scene::Scene& scene, trajectories::TickSource& ticks,
                 const std::vector<std::string>& states, const Limits& limits,
                 const TickWatcher& watch = {}, const std::string& stopped_early = {});
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include <tubeplan/core/core.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::plan {
 
@@ -42,6 +42,7 @@ using StepWatcher = std::function<void(const core::Core& core, const core::StepO
 
 /// Resets `core` with the held end at the first tick's pose and steps it through every tick of
 /// `ticks` (at least one); `watch` (may be empty) sees each tick.
-Simulation Simulate(TickSource& ticks, core::Core& core, const StepWatcher& watch = {});
+Simulation Simulate(trajectories::TickSource& ticks, core::Core& core,
+                    const StepWatcher& watch = {});
 
 }  // namespace tubeplan::plan

@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 
 /// One sample of the hand pose X_WH at time t_s.
 struct HandSample {
@@ -108,4 +108,4 @@ class SampleTicks final : public TickSource {
 /// forward in time pass it back each call, so a replay costs O(1) per tick and allocates nothing.
 HandSample PoseAt(const Trajectory& trajectory, double t_s, std::size_t& cursor);
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories

@@ -3,9 +3,9 @@
 #include <numbers>
 #include <random>
 
-#include <tubeplan/plan/perturb.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 
 Trajectory Perturb(const Trajectory& trajectory, const Perturbation& p, std::uint64_t seed,
                    int replicate) {
@@ -45,4 +45,4 @@ Interval WilsonInterval(int successes, int trials) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories

@@ -12,14 +12,14 @@
 
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/trajectory_csv.hpp>
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace {
 
 using tubeplan::io::LoadTrajectoryFile;
 using tubeplan::io::LoadTrajectoryText;
-using tubeplan::plan::HandSample;
-using tubeplan::plan::Trajectory;
+using tubeplan::trajectories::HandSample;
+using tubeplan::trajectories::Trajectory;
 
 Eigen::Quaterniond AboutZ(double angle_rad) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(angle_rad, Eigen::Vector3d::UnitZ()));
@@ -41,7 +41,7 @@ TEST_CASE("Resampling a constant-velocity line gives the analytic position every
     const double t = i / 250.0;
     trajectory.samples.push_back({t, p0 + v * t, Eigen::Quaterniond::Identity()});
   }
-  const std::vector<HandSample> ticks = tubeplan::plan::Resample(trajectory, 1e-3);
+  const std::vector<HandSample> ticks = tubeplan::trajectories::Resample(trajectory, 1e-3);
   REQUIRE(ticks.size() == 1001);  // 0 .. 1 s inclusive
   for (std::size_t k = 0; k < ticks.size(); ++k) {
     const double t = static_cast<double>(k) * 1e-3;
@@ -58,14 +58,14 @@ TEST_CASE("Orientation is interpolated on the shorter arc", "[trajectory]") {
   Trajectory trajectory;
   trajectory.samples.push_back({0.0, Eigen::Vector3d::Zero(), AboutZ(0.0)});
   trajectory.samples.push_back({0.002, Eigen::Vector3d::Zero(), AboutZ(std::numbers::pi / 2)});
-  const auto ticks = tubeplan::plan::Resample(trajectory, 1e-3);
+  const auto ticks = tubeplan::trajectories::Resample(trajectory, 1e-3);
   REQUIRE(ticks.size() == 3);
   // Halfway through a 90 degree turn about z is a 45 degree turn (SLERP is uniform in angle).
   CHECK(AngleBetween(ticks[1].q_WH, AboutZ(std::numbers::pi / 4)) < 1e-12);
 
   // The same end orientation written as -q: still the 90 degree way, not the 270 degree way.
   trajectory.samples[1].q_WH.coeffs() = -trajectory.samples[1].q_WH.coeffs();
-  const auto flipped = tubeplan::plan::Resample(trajectory, 1e-3);
+  const auto flipped = tubeplan::trajectories::Resample(trajectory, 1e-3);
   CHECK(AngleBetween(flipped[1].q_WH, AboutZ(std::numbers::pi / 4)) < 1e-12);
 }
 
@@ -75,12 +75,12 @@ TEST_CASE("PoseAt holds the ends and moves its cursor forward", "[trajectory]") 
     trajectory.samples.push_back(
         {0.01 * i, Eigen::Vector3d(i, 0, 0), Eigen::Quaterniond::Identity()});
   std::size_t cursor = 0;
-  CHECK(tubeplan::plan::PoseAt(trajectory, -1.0, cursor).p_WH_m.x() == 0.0);
-  CHECK(tubeplan::plan::PoseAt(trajectory, 0.025, cursor).p_WH_m.x() == Approx(2.5));
+  CHECK(tubeplan::trajectories::PoseAt(trajectory, -1.0, cursor).p_WH_m.x() == 0.0);
+  CHECK(tubeplan::trajectories::PoseAt(trajectory, 0.025, cursor).p_WH_m.x() == Approx(2.5));
   CHECK(cursor == 2);
   // Going back in time still answers correctly.
-  CHECK(tubeplan::plan::PoseAt(trajectory, 0.005, cursor).p_WH_m.x() == Approx(0.5));
-  CHECK(tubeplan::plan::PoseAt(trajectory, 9.0, cursor).p_WH_m.x() == 4.0);
+  CHECK(tubeplan::trajectories::PoseAt(trajectory, 0.005, cursor).p_WH_m.x() == Approx(0.5));
+  CHECK(tubeplan::trajectories::PoseAt(trajectory, 9.0, cursor).p_WH_m.x() == 4.0);
 }
 
 TEST_CASE("TickStream gives Resample's ticks exactly, one at a time", "[trajectory]") {
@@ -94,8 +94,8 @@ TEST_CASE("TickStream gives Resample's ticks exactly, one at a time", "[trajecto
     s.q_WH = AboutZ(0.003 * i);
     trajectory.samples.push_back(s);
   }
-  const std::vector<HandSample> all = tubeplan::plan::Resample(trajectory, 1e-3);
-  tubeplan::plan::TickStream ticks(trajectory, 1e-3);
+  const std::vector<HandSample> all = tubeplan::trajectories::Resample(trajectory, 1e-3);
+  tubeplan::trajectories::TickStream ticks(trajectory, 1e-3);
   REQUIRE(ticks.count() == all.size());
   for (std::size_t k = 0; k < ticks.count(); ++k) {
     const HandSample s = ticks.Tick(k);
@@ -109,7 +109,7 @@ TEST_CASE("TickStream gives Resample's ticks exactly, one at a time", "[trajecto
 namespace {
 
 // The samples of a trajectory in memory, handed out one at a time as a file's rows are.
-class VectorSamples final : public tubeplan::plan::SampleSource {
+class VectorSamples final : public tubeplan::trajectories::SampleSource {
  public:
   explicit VectorSamples(const std::vector<HandSample>& samples) : samples_(samples) {}
   bool Next(HandSample& sample) override {
@@ -141,10 +141,10 @@ TEST_CASE("SampleTicks gives TickStream's ticks bit for bit from samples read in
   }
   for (const double step_s : {3e-4, 1e-3, 2e-3, 5e-3, 0.6}) {
     CAPTURE(step_s);
-    tubeplan::plan::TickStream memory(trajectory, step_s);
+    tubeplan::trajectories::TickStream memory(trajectory, step_s);
     VectorSamples samples(trajectory.samples);
-    tubeplan::plan::SampleTicks streamed(samples, trajectory.samples.front().t_s,
-                                         trajectory.samples.back().t_s, step_s);
+    tubeplan::trajectories::SampleTicks streamed(samples, trajectory.samples.front().t_s,
+                                                 trajectory.samples.back().t_s, step_s);
     REQUIRE(streamed.count() == memory.count());
     for (std::size_t k = 0; k < memory.count(); ++k) {
       const HandSample a = memory.Tick(k);
@@ -165,19 +165,21 @@ TEST_CASE("SampleTicks refuses samples that do not reach the times it was promis
   {
     // Promised 20 ms, given 10 ms: the source ends before the last tick.
     VectorSamples source(samples);
-    tubeplan::plan::SampleTicks ticks(source, 0.0, 0.020, 1e-3);
+    tubeplan::trajectories::SampleTicks ticks(source, 0.0, 0.020, 1e-3);
     CHECK_NOTHROW(ticks.Tick(5));
     CHECK_THROWS_AS(ticks.Tick(15), std::runtime_error);
   }
   {
     // Promised 5 ms as the last: the source goes on past it.
     VectorSamples source(samples);
-    tubeplan::plan::SampleTicks ticks(source, 0.0, 0.005, 1e-3);
+    tubeplan::trajectories::SampleTicks ticks(source, 0.0, 0.005, 1e-3);
     CHECK_THROWS_AS(ticks.Tick(5), std::runtime_error);
   }
   VectorSamples source(samples);
-  CHECK_THROWS_AS(tubeplan::plan::SampleTicks(source, 0.0, 0.0, 1e-3), std::invalid_argument);
-  CHECK_THROWS_AS(tubeplan::plan::SampleTicks(source, 0.0, 0.01, 0.0), std::invalid_argument);
+  CHECK_THROWS_AS(tubeplan::trajectories::SampleTicks(source, 0.0, 0.0, 1e-3),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(tubeplan::trajectories::SampleTicks(source, 0.0, 0.01, 0.0),
+                  std::invalid_argument);
 }
 
 TEST_CASE("A good trajectory file loads with exact values and metadata", "[trajectory]") {

@@ -5,9 +5,9 @@
 
 #include <cstdint>
 
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 
 struct Perturbation {
   double offset_m = 1e-3;   ///< constant hand offset, uniform in a ball of this radius
@@ -27,4 +27,4 @@ struct Interval {
 };
 Interval WilsonInterval(int successes, int trials);
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories

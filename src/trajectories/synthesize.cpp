@@ -4,9 +4,9 @@
 #include <numbers>
 #include <random>
 
-#include <tubeplan/plan/synthesize.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 
 double MinimumJerk(double u) {
   u = std::clamp(u, 0.0, 1.0);
@@ -78,4 +78,4 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
   return trajectory;
 }
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories

@@ -2,9 +2,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 namespace {
 
 HandSample Interpolate(const HandSample& a, const HandSample& b, double t_s) {
@@ -126,4 +126,4 @@ std::vector<HandSample> Resample(const Trajectory& trajectory, double step_s) {
   return out;
 }
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories

@@ -10,9 +10,9 @@
 
 #include <Eigen/Geometry>
 
-#include <tubeplan/plan/trajectory.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
-namespace tubeplan::plan {
+namespace tubeplan::trajectories {
 
 struct SynthesisOptions {
   double peak_speed_m_per_s = 0.08;  ///< a calm insertion; minimum jerk peaks at 1.875 x the mean
@@ -38,4 +38,4 @@ double MinimumJerk(double u);
 Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
                                 const SynthesisOptions& options);
 
-}  // namespace tubeplan::plan
+}  // namespace tubeplan::trajectories
