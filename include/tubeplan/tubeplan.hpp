@@ -2,13 +2,15 @@
 // tubeplan as a library: everything a program calls to do what the commands do. Load a scene
 // and a plan (io), step the core with a hand pose (core), judge a plan's replay or sum up a
 // trajectory's (plan), judge a set of plans and replay a trajectory file (batch), explore and
-// prune the contact-state graph and make candidate plans (graph, plan) and write them (batch),
-// make a hand trajectory through poses or perturb one (trajectories), run the 1 kHz servo
-// against a device (device), write the reports of judged plans and of the graph (report). Each
-// header says what it holds; docs/layout.md says which library each folder is.
+// prune the contact-state graph (graph; batch as the commands do it), make candidate plans
+// (plan) and write them (batch), make a hand trajectory through poses or perturb one
+// (trajectories), run the 1 kHz servo against a device (device), write the reports of judged
+// plans and of the graph (report). Each header says what it holds; docs/layout.md says which
+// library each folder is.
 
 #include <tubeplan/batch/evaluate.hpp>
 #include <tubeplan/batch/evaluation.hpp>
+#include <tubeplan/batch/graph.hpp>
 #include <tubeplan/batch/merge.hpp>
 #include <tubeplan/batch/plans.hpp>
 #include <tubeplan/batch/report.hpp>

@@ -19,14 +19,14 @@
 
 #include "app.hpp"
 #include "commands.hpp"
-#include "graph_build.hpp"
+#include "graph_options.hpp"
 #include "io/text_file.hpp"
 
 namespace tubeplan::cli {
 namespace {
 
 // The files asked for: DOT, its picture by Graphviz, JSON. False after saying why not.
-bool WriteGraphFiles(const GraphOptions& o, const Built& b, std::ostream& err) {
+bool WriteGraphFiles(const GraphOptions& o, const batch::BuiltGraph& b, std::ostream& err) {
   graph::DotOptions dot;
   dot.dropped_arcs = o.unpruned;
   dot.title =
@@ -75,9 +75,9 @@ int RunGraph(const GraphOptions& o, Streams io) {
       return kExitBadInput;
     }
   }
-  std::variant<Built, int> built = BuildGraph(o, io);
+  std::variant<batch::BuiltGraph, int> built = BuildGraph(o, io);
   if (const int* code = std::get_if<int>(&built)) return *code;
-  const Built& b = std::get<Built>(built);
+  const batch::BuiltGraph& b = std::get<batch::BuiltGraph>(built);
   if (!WriteGraphFiles(o, b, io.err)) return kExitBadInput;
 
   // With --check, the graph's completeness measured over motions of another seed.

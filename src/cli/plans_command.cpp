@@ -14,7 +14,7 @@
 
 #include "app.hpp"
 #include "commands.hpp"
-#include "graph_build.hpp"
+#include "graph_options.hpp"
 
 namespace tubeplan::cli {
 namespace {
@@ -71,13 +71,13 @@ int RunPlans(const PlansOptions& o, Streams io) {
                                     .synthesis = *synthesis};
   if (!batch::PlanFilesApart(request, io.err)) return kExitBadInput;
   // A goal the tube starts in leaves nothing to plan: said before any exploration.
-  std::variant<Built, int> built =
+  std::variant<batch::BuiltGraph, int> built =
       BuildGraph(o.graph, io, [&](const scene::Scene& s) -> std::optional<int> {
         if (batch::StartsInGoal(request, s, io.err)) return kExitNegative;
         return std::nullopt;
       });
   if (const int* code = std::get_if<int>(&built)) return *code;
-  const Built& b = std::get<Built>(built);
+  const batch::BuiltGraph& b = std::get<batch::BuiltGraph>(built);
   batch::Plans plans;
   switch (
       batch::MakePlans(request, b.scene, b.graph, b.explore.dwell_s, b.weights, plans, io.err)) {

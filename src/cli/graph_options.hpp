@@ -1,6 +1,6 @@
 #pragma once
-// Private to the cli library: the options `graph` and `plans` share, and the exploration both
-// start from (the scene loaded, explored with the core and pruned).
+// Private to the cli library: the options `graph` and `plans` share, and the graph both start
+// from (batch::BuildGraph: the scene loaded, explored with the core and pruned).
 
 #include <cstdint>
 #include <functional>
@@ -10,7 +10,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/batch/graph.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 #include "commands.hpp"
@@ -35,18 +35,10 @@ struct GraphOptions {
   int check = 0;              // graph only: independent random motions measuring completeness
 };
 
-/// The explored and pruned graph of a scene, with what it was built from.
-struct Built {
-  scene::Scene scene;
-  graph::ContactGraph graph;
-  graph::ExploreOptions explore;
-  graph::PruneWeights weights;
-};
-
-/// Loads the scene, explores and prunes; on bad input reports and returns the exit code.
-/// `before` (may be empty) sees the scene before the exploration and may end the command there
-/// with an exit code.
-std::variant<Built, int> BuildGraph(
+/// batch::BuildGraph with these options, progress shown on a terminal; on bad input the exit
+/// code. `before` (may be empty) sees the scene before the exploration and may end the command
+/// there with an exit code.
+std::variant<batch::BuiltGraph, int> BuildGraph(
     const GraphOptions& o, Streams io,
     const std::function<std::optional<int>(const scene::Scene&)>& before = {});
 
