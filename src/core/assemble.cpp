@@ -245,7 +245,7 @@ void GroupSideSections(Scratch& s) {
     for (int j = k; j < s.sample_count; ++j) {
       const Sample& smp = s.samples[std::size_t(j)];
       if (grouped[std::size_t(j)] || !IsSideSection(smp) || smp.part != first.part ||
-          smp.face_mask != first.face_mask)
+          smp.element != first.element)
         continue;
       grouped[std::size_t(j)] = true;
       s.side_members[std::size_t(members++)] = j;

@@ -18,7 +18,7 @@ using states::TubeElement;
 struct Gathered {
   TubeElement tube = TubeElement::kSide;
   int part = 0;
-  std::uint8_t mask = 0;
+  ElementIndex element = kNoElement;
   int merged_into = -1;
   ContactState pc;
   double s_far_m = 0.0;  ///< arc position of its point farthest from the held end
@@ -55,7 +55,6 @@ bool TubeWithin(TubeElement a, TubeElement b) {
   return a == b ||
          (a == TubeElement::kEndRim && (b == TubeElement::kEndFace || b == TubeElement::kSide));
 }
-bool PartWithin(std::uint8_t a, std::uint8_t b) { return (a & b) == b; }
 
 // The curvature vector of the centreline at arc s [1/m], pointing to the centre of curvature:
 // the turn of the tangent at each inner node over an element's length, interpolated.
@@ -102,7 +101,7 @@ void Classify(const Model& model, Data& data) {
     int at = -1;
     for (int i = 0; i < count && at < 0; ++i)
       if (g[std::size_t(i)].tube == te && g[std::size_t(i)].part == smp.part &&
-          g[std::size_t(i)].mask == smp.face_mask)
+          g[std::size_t(i)].element == smp.element)
         at = i;
     if (at < 0) {
       if (count == int(g.size())) {
@@ -114,9 +113,9 @@ void Classify(const Model& model, Data& data) {
       n = Gathered{};
       n.tube = te;
       n.part = smp.part;
-      n.mask = smp.face_mask;
+      n.element = smp.element;
       n.pc.tube = te;
-      n.pc.part_element = model.parts[std::size_t(smp.part)].element_of[smp.face_mask];
+      n.pc.part_element = model.parts[std::size_t(smp.part)].first_element + smp.element;
       n.pc.distance_m = smp.contact_distance_m;
       n.pc.s_m = ArcOf(model, smp);
       n.pc.normal_W = smp.normal_W;
@@ -148,8 +147,9 @@ void Classify(const Model& model, Data& data) {
     for (int j = 0; j < count && a.merged_into < 0; ++j) {
       const Gathered& b = g[std::size_t(j)];
       if (i == j || b.merged_into >= 0 || a.part != b.part) continue;
-      if (TubeWithin(a.tube, b.tube) && PartWithin(a.mask, b.mask) &&
-          !(a.tube == b.tube && a.mask == b.mask))
+      if (TubeWithin(a.tube, b.tube) &&
+          model.parts[std::size_t(a.part)].geometry.Bounds(a.element, b.element) &&
+          !(a.tube == b.tube && a.element == b.element))
         a.merged_into = j;
     }
   }

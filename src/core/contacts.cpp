@@ -148,8 +148,8 @@ class Finder {
     c = std::min(c, centre_m - m_.rod.outer_radius_m);
   }
 
-  std::uint8_t Entry(int part, int node) const {
-    return d_.state.entry_mask[std::size_t(part * (n_ + 1) + node)];
+  ElementIndex Entry(int part, int node) const {
+    return d_.state.entry_element[std::size_t(part * (n_ + 1) + node)];
   }
 
   Sample* Add() {
@@ -176,7 +176,7 @@ class Finder {
     smp->distance_m = dist.distance_m;
     smp->normal_W = dist.normal_W;
     smp->curvature_per_m = dist.curvature_per_m;
-    smp->face_mask = dist.face_mask;
+    smp->element = dist.element;
     smp->point_W = mp.point_W;
     smp->offset_W = mp.offset_W;
     smp->moving_offset_W = moving_offset_W;
@@ -187,7 +187,7 @@ class Finder {
   // part's distance gradient, seen in the section's plane, points back at the centre. Starts
   // from `guess` (any direction in the plane); a section parallel to a face keeps the guess.
   Vec3 NearestOnCircle(const PartModel& part, const Vec3& c, const Vec3& t, double r,
-                       const Vec3& guess, std::uint8_t entry) const {
+                       const Vec3& guess, ElementIndex entry) const {
     Vec3 rho = guess - guess.dot(t) * t;
     if (rho.norm() < 1e-12) rho = t.unitOrthogonal();
     rho.normalize();
@@ -209,7 +209,7 @@ class Finder {
   // (tangent x direction): found when the section first meets the part in a tick and fixed on
   // the section for the rest of the tick (Material turns them with it).
   void SectionFrame(const PartModel& part, int p, int node, const Vec3& c, const Vec3& t,
-                    std::uint8_t entry, Vec3& rho, Vec3& side) {
+                    ElementIndex entry, Vec3& rho, Vec3& side) {
     Scratch& s = d_.scratch;
     const double r1 = m_.rod.outer_radius_m;
     const std::size_t k = std::size_t(p * (n_ + 1) + node);
@@ -305,7 +305,7 @@ class Finder {
   void Rim(int p, const PartModel& part) {
     const double r1 = m_.rod.outer_radius_m, eps = m_.contact.threshold_m;
     const Vec3& c = x_[std::size_t(n_)];
-    const std::uint8_t entry = Entry(p, n_);
+    const ElementIndex entry = Entry(p, n_);
     const double centre_m = part.geometry.Distance(c, entry).distance_m;
     Clear(n_, centre_m);
     if (centre_m - r1 >= eps) return;
@@ -343,7 +343,7 @@ class Finder {
     at.distance_m = lw - r1 - edge.radius_m;
     at.normal_W = w / lw;
     at.point_W = q + edge.radius_m * at.normal_W;
-    at.face_mask = on_line ? edge.face_mask : u == 0.0 ? edge.a_mask : edge.b_mask;
+    at.element = on_line ? edge.element : u == 0.0 ? edge.a_element : edge.b_element;
     if (on_line) {
       at.curvature_per_m.setZero();
     } else {
@@ -586,7 +586,7 @@ class Finder {
       at.distance_m = ahead_m;
       at.normal_W = -t;
       at.point_W = vertices[std::size_t(v)];
-      at.face_mask = part.geometry.vertex_masks()[std::size_t(v)];
+      at.element = part.geometry.vertex_elements()[std::size_t(v)];
       Record(SampleKind::kEndFace, p, n_, v, 0.0, weight, at,
              Material(Carrier::kEndNode, x_, n_, 0.0, radial, false), radial);
     }

@@ -61,7 +61,7 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   const std::size_t nodes = std::size_t(n) + 1, parts = model.parts.size();
   d.state.x_W.assign(nodes, Eigen::Vector3d::Zero());
   d.state.section_direction_W.assign(parts * nodes, X_WH.linear().col(0));
-  d.state.entry_mask.assign(parts * nodes, 0);
+  d.state.entry_element.assign(parts * nodes, kNoElement);
   d.scratch.x_trial_W.assign(nodes, Eigen::Vector3d::Zero());
   d.scratch.x_start_W.assign(nodes, Eigen::Vector3d::Zero());
   const int unknowns = 3 * (n + 1);
@@ -151,11 +151,9 @@ void BuildModel(const scene::Scene& scene, Model& m, std::vector<scene::PartElem
     if ((g.min_W().array() > hi.array()).any() || (g.max_W().array() < lo.array()).any()) continue;
     part.scene_index = p;
     part.friction = scene::FrictionAt(scene, p);
-    part.element_of.fill(-1);
-    for (std::size_t e = next_element; e < all.size() && all[e].part_index == p; ++e) {
-      part.element_of[all[e].face_mask] = static_cast<int>(elements.size());
+    part.first_element = static_cast<int>(elements.size());
+    for (std::size_t e = next_element; e < all.size() && all[e].part_index == p; ++e)
       elements.push_back(all[e]);
-    }
     thinnest = std::min(thinnest, g.thinnest_m());
     reachable_parts.push_back(p);
     m.parts.push_back(std::move(part));
@@ -238,7 +236,7 @@ bool Core::Restore(const Snapshot& snapshot) {
   if (!snapshot.data_) return false;
   const SnapshotData& s = *snapshot.data_;
   if (s.state.x_W.size() != data_->state.x_W.size() ||
-      s.state.entry_mask.size() != data_->state.entry_mask.size() ||
+      s.state.entry_element.size() != data_->state.entry_element.size() ||
       s.state.section_direction_W.size() != data_->state.section_direction_W.size())
     return false;
   data_->state = s.state;

@@ -34,12 +34,12 @@ enum class SampleKind : std::uint8_t {
 /// was `moving_offset_W` (Material), whose derivatives the assembly takes.
 struct Sample {
   SampleKind kind = SampleKind::kNode;
-  std::uint8_t face_mask = 0;  ///< the part element the nearest point lies on
-  int part = 0;                ///< index into Model::parts
-  int node = 0;                ///< the section's node, or the segment's first node
-  int feature = 0;             ///< ring position (kRim), edge (kSide, kCurve) or vertex (kEndFace)
-  double theta = 0.0;          ///< position along the segment (kSide) or the piece (kCurve), 0..1
-  double weight = 1.0;         ///< share of K it carries
+  ElementIndex element = kNoElement;  ///< the part's element the nearest point lies on
+  int part = 0;                       ///< index into Model::parts
+  int node = 0;                       ///< the section's node, or the segment's first node
+  int feature = 0;      ///< ring position (kRim), edge (kSide, kCurve) or vertex (kEndFace)
+  double theta = 0.0;   ///< position along the segment (kSide) or the piece (kCurve), 0..1
+  double weight = 1.0;  ///< share of K it carries
   /// d weight / d nodes from weight_first on (two or three): a share that fades moves with them.
   Eigen::Matrix<double, 9, 1> weight_gradient = Eigen::Matrix<double, 9, 1>::Zero();
   int weight_first = 0;
@@ -131,9 +131,9 @@ struct CarriedState {
   /// Per (part, node): the direction from the node's section centre to its point nearest the
   /// part, as the last tick found it (a section facing a part squarely keeps it).
   std::vector<Eigen::Vector3d> section_direction_W;
-  /// Per contact point of the last tick: the face it was pressed on, per (kind, node, part), so
+  /// Per contact point of the last tick: the element it was pressed on, per (node, part), so
   /// that a point pushed inside a part keeps being pushed back out the way it came in.
-  std::vector<std::uint8_t> entry_mask;
+  std::vector<ElementIndex> entry_element;
 };
 
 /// The tick's working memory.

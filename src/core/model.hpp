@@ -48,8 +48,8 @@ struct PartModel {
   PartGeometry geometry;
   std::uint32_t scene_index = 0;
   scene::Friction friction;
-  /// Element index (into Core::elements()) of each face mask; -1 where none.
-  std::array<int, 64> element_of{};
+  /// Index into Core::elements() of the part's first element: its element i is first_element + i.
+  int first_element = 0;
 };
 
 struct Model {

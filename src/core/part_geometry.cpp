@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include <tubeplan/scene/elements.hpp>
+
 namespace tubeplan::core {
 namespace {
 
@@ -24,6 +26,12 @@ PartGeometry::PartGeometry(const scene::Part& part)
       R_WP_(part.X_WP.linear()),
       p_WP_(part.X_WP.translation()),
       half_m_(0.5 * part.size_m) {
+  // Element indices are positions among the part's elements, each named by its faces' bits.
+  element_of_mask_.fill(kNoElement);
+  for (const scene::PartElement& e : scene::ElementsOf(part, 0)) {
+    element_of_mask_[e.face_mask] = ElementIndex(mask_of_element_.size());
+    mask_of_element_.push_back(e.face_mask);
+  }
   if (shape_ == scene::PartShape::kCylinder)
     BuildCylinder();
   else
@@ -32,7 +40,8 @@ PartGeometry::PartGeometry(const scene::Part& part)
 
 void PartGeometry::BuildBox() {
   vertices_W_.resize(8);
-  vertex_masks_.resize(8);
+  vertex_elements_.resize(8);
+  std::array<std::uint8_t, 8> vertex_masks{};
   edges_.resize(12);
   min_W_.setConstant(std::numeric_limits<double>::infinity());
   max_W_ = -min_W_;
@@ -40,8 +49,9 @@ void PartGeometry::BuildBox() {
     const Eigen::Vector3d sign(corner & 1 ? 1.0 : -1.0, corner & 2 ? 1.0 : -1.0,
                                corner & 4 ? 1.0 : -1.0);
     vertices_W_[std::size_t(corner)] = p_WP_ + R_WP_ * sign.cwiseProduct(half_m_);
-    vertex_masks_[std::size_t(corner)] =
+    vertex_masks[std::size_t(corner)] =
         FaceOn(0, sign.x()) | FaceOn(1, sign.y()) | FaceOn(2, sign.z());
+    vertex_elements_[std::size_t(corner)] = ElementOfMask(vertex_masks[std::size_t(corner)]);
     min_W_ = min_W_.cwiseMin(vertices_W_[std::size_t(corner)]);
     max_W_ = max_W_.cwiseMax(vertices_W_[std::size_t(corner)]);
   }
@@ -55,9 +65,11 @@ void PartGeometry::BuildBox() {
       PartEdge& edge = edges_[std::size_t(e++)];
       edge.a_W = vertices_W_[std::size_t(corner)];
       edge.b_W = vertices_W_[std::size_t(corner | bit)];
-      edge.a_mask = vertex_masks_[std::size_t(corner)];
-      edge.b_mask = vertex_masks_[std::size_t(corner | bit)];
-      edge.face_mask = edge.a_mask & edge.b_mask;
+      const std::uint8_t a_mask = vertex_masks[std::size_t(corner)];
+      const std::uint8_t b_mask = vertex_masks[std::size_t(corner | bit)];
+      edge.a_element = ElementOfMask(a_mask);
+      edge.b_element = ElementOfMask(b_mask);
+      edge.element = ElementOfMask(a_mask & b_mask);
       edge.min_W = edge.a_W.cwiseMin(edge.b_W);
       edge.max_W = edge.a_W.cwiseMax(edge.b_W);
       for (int k = 1; k <= 2; ++k) {
@@ -93,7 +105,7 @@ void PartGeometry::BuildCylinder() {
       edge.b_W = p_WP_ + R_WP_ * b_P;
       edge.min_W = edge.a_W.cwiseMin(edge.b_W);
       edge.max_W = edge.a_W.cwiseMax(edge.b_W);
-      edge.face_mask = edge.a_mask = edge.b_mask = mask;
+      edge.element = edge.a_element = edge.b_element = ElementOfMask(mask);
       edge.a_bears = false;
       const Eigen::Vector3d mid_P = 0.5 * (a_P + b_P);
       edge.face_normals_W = {sz * z_W,
@@ -108,21 +120,24 @@ void PartGeometry::BuildCylinder() {
   axis.radius_m = radius_m;
   axis.min_W = axis.a_W.cwiseMin(axis.b_W).array() - radius_m;
   axis.max_W = axis.a_W.cwiseMax(axis.b_W).array() + radius_m;
-  axis.face_mask = axis.a_mask = axis.b_mask = side;
+  axis.element = axis.a_element = axis.b_element = ElementOfMask(side);
   axis.a_bears = axis.b_bears = false;
   edges_.push_back(axis);
 }
 
-PartDistance PartGeometry::Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask) const {
+PartDistance PartGeometry::Distance(const Eigen::Vector3d& p_W, ElementIndex entry) const {
   const Eigen::Vector3d p_P = R_WP_.transpose() * (p_W - p_WP_);
-  PartDistance r = shape_ == scene::PartShape::kCylinder ? CylinderDistance(p_P, entry_mask)
-                                                         : BoxDistance(p_P, entry_mask);
+  const std::uint8_t entry_mask = entry == kNoElement ? 0 : mask_of_element_[entry];
+  std::uint8_t mask = 0;
+  PartDistance r = shape_ == scene::PartShape::kCylinder ? CylinderDistance(p_P, entry_mask, mask)
+                                                         : BoxDistance(p_P, entry_mask, mask);
   r.point_W = p_W - r.distance_m * r.normal_W;
+  r.element = ElementOfMask(mask);
   return r;
 }
 
-PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P,
-                                            std::uint8_t entry_mask) const {
+PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
+                                            std::uint8_t& mask) const {
   using scene::CylinderFace;
   const double radius_m = half_m_.x(), h = half_m_.z();
   const double rho = std::hypot(p_P.x(), p_P.y());
@@ -141,19 +156,19 @@ PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P,
     // along it.
     r.distance_m = std::hypot(q_side, q_end);
     n_P = (q_side * u_P + q_end * sz * Eigen::Vector3d::UnitZ()) / r.distance_m;
-    r.face_mask = FaceBit(end) | FaceBit(CylinderFace::kSide);
+    mask = FaceBit(end) | FaceBit(CylinderFace::kSide);
     c_P = (Eigen::Matrix3d::Identity() - n_P * n_P.transpose() - a_P * a_P.transpose()) /
               r.distance_m +
           a_P * a_P.transpose() * (q_side / (r.distance_m * rho));
   } else if (q_side > 0.0) {
     r.distance_m = q_side;
     n_P = u_P;
-    r.face_mask = FaceBit(CylinderFace::kSide);
+    mask = FaceBit(CylinderFace::kSide);
     c_P = a_P * a_P.transpose() / rho;
   } else if (q_end > 0.0) {
     r.distance_m = q_end;
     n_P = sz * Eigen::Vector3d::UnitZ();
-    r.face_mask = FaceBit(end);
+    mask = FaceBit(end);
   } else {
     // Inside: out through the face the point came in by, if it is known, else the nearest.
     const std::array<double, 3> out = {p_P.z() - h, -p_P.z() - h, q_side};
@@ -163,7 +178,7 @@ PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P,
         face = f;
     if (face < 0) face = q_side > q_end ? int(CylinderFace::kSide) : int(end);
     r.distance_m = out[std::size_t(face)];
-    r.face_mask = static_cast<std::uint8_t>(1u << face);
+    mask = static_cast<std::uint8_t>(1u << face);
     n_P = face == int(CylinderFace::kSide)  ? u_P
           : face == int(CylinderFace::kTop) ? Eigen::Vector3d::UnitZ()
                                             : Eigen::Vector3d(-Eigen::Vector3d::UnitZ());
@@ -173,7 +188,8 @@ PartDistance PartGeometry::CylinderDistance(const Eigen::Vector3d& p_P,
   return r;
 }
 
-PartDistance PartGeometry::BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const {
+PartDistance PartGeometry::BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
+                                       std::uint8_t& mask) const {
   const Eigen::Vector3d q = p_P.cwiseAbs() - half_m_;
   PartDistance r;
   const Eigen::Vector3d outside = q.cwiseMax(0.0);
@@ -185,7 +201,7 @@ PartDistance PartGeometry::BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t 
       if (q[a] <= 0.0) continue;
       const double sign = p_P[a] >= 0.0 ? 1.0 : -1.0;
       g_P[a] = sign * q[a] / out_m;
-      r.face_mask |= FaceOn(a, sign);
+      mask |= FaceOn(a, sign);
     }
     r.distance_m = out_m;
     r.normal_W = R_WP_ * g_P;
@@ -220,7 +236,7 @@ PartDistance PartGeometry::BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t 
   Eigen::Vector3d g_P = Eigen::Vector3d::Zero();
   g_P[axis] = sign;
   r.normal_W = R_WP_ * g_P;
-  r.face_mask = FaceOn(axis, sign);
+  mask = FaceOn(axis, sign);
   return r;
 }
 

@@ -16,13 +16,17 @@
 
 namespace tubeplan::core {
 
+/// An element's index within its part (scene::ElementsOf), or none.
+using ElementIndex = std::uint16_t;
+inline constexpr ElementIndex kNoElement = 0xFFFF;
+
 /// The nearest point of a part to a query point.
 struct PartDistance {
   double distance_m = 0.0;  ///< signed: negative inside the part [m]
   /// Unit outward normal at the nearest point: the direction in which the distance grows.
   Eigen::Vector3d normal_W = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();  ///< nearest point on the part's surface
-  std::uint8_t face_mask = 0;  ///< faces the nearest point lies on (BoxFace, CylinderFace bits)
+  ElementIndex element = kNoElement;                  ///< the element the nearest point lies on
   /// The distance's second derivative: (I - n n^T - a a^T) / distance near an edge (a its unit
   /// direction), (I - n n^T) / distance near a vertex, zero near a flat face or inside; near a
   /// cylinder's side, its curving about the axis.
@@ -32,8 +36,8 @@ struct PartDistance {
 struct PartEdge {
   Eigen::Vector3d a_W = Eigen::Vector3d::Zero(), b_W = Eigen::Vector3d::Zero();
   Eigen::Vector3d min_W = Eigen::Vector3d::Zero(), max_W = Eigen::Vector3d::Zero();  ///< its box
-  std::uint8_t face_mask = 0;
-  std::uint8_t a_mask = 0, b_mask = 0;  ///< the vertices it ends in
+  ElementIndex element = kNoElement;
+  ElementIndex a_element = kNoElement, b_element = kNoElement;  ///< the vertices it ends in
   /// Whether a load at an end is this segment's: not where a rim's polygon goes on into its next
   /// segment (that one bears the shared point), not at a round side's axis ends (the rims do).
   bool a_bears = true, b_bears = true;
@@ -50,24 +54,34 @@ class PartGeometry {
   PartGeometry() = default;
   explicit PartGeometry(const scene::Part& part);
 
-  /// Signed distance of p_W to the part. Inside, the distance is to the face given by
-  /// `entry_mask` when it names one (the face the point came in through: a thin part is not
-  /// crossed by pushing a point past its middle), else to the nearest face.
-  PartDistance Distance(const Eigen::Vector3d& p_W, std::uint8_t entry_mask = 0) const;
+  /// Signed distance of p_W to the part. Inside, the distance is to the faces of the element
+  /// `entry` when it names one (where the point came in: a thin part is not crossed by pushing
+  /// a point past its middle), else to the nearest face.
+  PartDistance Distance(const Eigen::Vector3d& p_W, ElementIndex entry = kNoElement) const;
 
   const std::vector<PartEdge>& edges() const { return edges_; }
   const std::vector<Eigen::Vector3d>& vertices_W() const { return vertices_W_; }
-  const std::vector<std::uint8_t>& vertex_masks() const { return vertex_masks_; }
+  const std::vector<ElementIndex>& vertex_elements() const { return vertex_elements_; }
+  /// Whether element a lies on element b's boundary or is b (an edge bounds its faces, a vertex
+  /// its edges and faces).
+  bool Bounds(ElementIndex a, ElementIndex b) const {
+    return (mask_of_element_[a] & mask_of_element_[b]) == mask_of_element_[b];
+  }
   const Eigen::Vector3d& min_W() const { return min_W_; }
   const Eigen::Vector3d& max_W() const { return max_W_; }
   /// The smallest of the part's three extents [m].
   double thinnest_m() const { return 2.0 * half_m_.minCoeff(); }
 
  private:
+  // Boxes and cylinders name their elements by the faces they lie on (BoxFace, CylinderFace
+  // bits): what the shapes' own code works in, turned into element indices at the surface.
   void BuildBox();
   void BuildCylinder();
-  PartDistance BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const;
-  PartDistance CylinderDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask) const;
+  PartDistance BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
+                           std::uint8_t& mask) const;
+  PartDistance CylinderDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
+                                std::uint8_t& mask) const;
+  ElementIndex ElementOfMask(std::uint8_t mask) const { return element_of_mask_[mask]; }
 
   scene::PartShape shape_ = scene::PartShape::kBox;
   Eigen::Matrix3d R_WP_ = Eigen::Matrix3d::Identity();
@@ -75,7 +89,9 @@ class PartGeometry {
   Eigen::Vector3d half_m_ = Eigen::Vector3d::Zero();  ///< half extents in the part's frame
   std::vector<PartEdge> edges_;
   std::vector<Eigen::Vector3d> vertices_W_;
-  std::vector<std::uint8_t> vertex_masks_;
+  std::vector<ElementIndex> vertex_elements_;
+  std::array<ElementIndex, 64> element_of_mask_{};
+  std::vector<std::uint8_t> mask_of_element_;
   Eigen::Vector3d min_W_ = Eigen::Vector3d::Zero(), max_W_ = Eigen::Vector3d::Zero();
 };
 

@@ -173,9 +173,7 @@ std::array<double, 3> CurveWeights(double theta) {
   return {0.5 * (1.0 - theta) * (1.0 - theta), 0.5 + theta - theta * theta, 0.5 * theta * theta};
 }
 
-std::array<double, 3> CurveSlopes(double theta) {
-  return {theta - 1.0, 1.0 - 2.0 * theta, theta};
-}
+std::array<double, 3> CurveSlopes(double theta) { return {theta - 1.0, 1.0 - 2.0 * theta, theta}; }
 
 Vec3 CarrierTangent(Carrier carrier, std::span<const Vec3> x_W, int i) {
   switch (carrier) {

@@ -78,7 +78,7 @@ Limits LimitsOf(const Model& model, const Data& data, const Sample& of) {
   double group_N = 0.0, side_N = 0.0, side_depth_m = 0.0;
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     const Sample& smp = data.scratch.samples[std::size_t(k)];
-    if (smp.part != of.part || smp.face_mask != of.face_mask) continue;
+    if (smp.part != of.part || smp.element != of.element) continue;
     if (smp.distance_m < eps) group_N += smp.normal_force_N;
     if (!IsSideSection(smp)) continue;
     side_N += smp.normal_force_N;

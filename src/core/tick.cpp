@@ -142,17 +142,17 @@ void EndTick(const Model& model, Data& data) {
   // Where each point pressing on a part came in: kept while it is inside, so that it is pushed
   // back out that way; forgotten once it is out of contact.
   const int stride = model.rod.elements + 1;
-  std::vector<std::uint8_t>& entry = st.entry_mask;
+  std::vector<ElementIndex>& entry = st.entry_element;
   std::vector<std::uint8_t>& seen = data.scratch.entry_seen;
   std::fill(seen.begin(), seen.end(), 0);
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     const Sample& smp = data.scratch.samples[std::size_t(k)];
     const std::size_t i = std::size_t(smp.part * stride + smp.node);
     seen[i] = 1;
-    if (smp.distance_m >= 0.0) entry[i] = smp.face_mask;
+    if (smp.distance_m >= 0.0) entry[i] = smp.element;
   }
   for (std::size_t i = 0; i < entry.size(); ++i)
-    if (!seen[i]) entry[i] = 0;
+    if (!seen[i]) entry[i] = kNoElement;
 }
 
 }  // namespace tubeplan::core

@@ -1,4 +1,5 @@
 #include <bit>
+#include <iterator>
 
 #include <tubeplan/scene/elements.hpp>
 
@@ -52,15 +53,22 @@ void AddCylinderElements(const Part& part, std::uint32_t p, std::vector<PartElem
 
 }  // namespace
 
+std::vector<PartElement> ElementsOf(const Part& part, std::uint32_t part_index) {
+  std::vector<PartElement> elements;
+  if (part.shape == PartShape::kCylinder)
+    AddCylinderElements(part, part_index, elements);
+  else
+    AddBoxElements(part, part_index, elements);
+  return elements;
+}
+
 std::vector<PartElement> EnumerateElements(const Scene& scene) {
   std::vector<PartElement> elements;
   elements.reserve(scene.parts.size() * 26);
   for (std::uint32_t p = 0; p < scene.parts.size(); ++p) {
-    const Part& part = scene.parts[p];
-    if (part.shape == PartShape::kCylinder)
-      AddCylinderElements(part, p, elements);
-    else
-      AddBoxElements(part, p, elements);
+    std::vector<PartElement> of_part = ElementsOf(scene.parts[p], p);
+    elements.insert(elements.end(), std::make_move_iterator(of_part.begin()),
+                    std::make_move_iterator(of_part.end()));
   }
   return elements;
 }

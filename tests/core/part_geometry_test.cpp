@@ -5,12 +5,15 @@
 
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <catch2/catch.hpp>
 #include <fcl/geometry/shape/cylinder.h>
 #include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/distance.h>
 
+#include <tubeplan/scene/elements.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 using namespace tubeplan;
@@ -31,6 +34,7 @@ scene::Part TurnedPost() {
 TEST_CASE("A cylinder's distance outside agrees with FCL's GJK, inside with its faces", "[core]") {
   const scene::Part post = TurnedPost();
   const core::PartGeometry g(post);
+  const std::vector<scene::PartElement> elements = scene::ElementsOf(post, 0);
   const double radius = 6e-3, h = 20e-3;
   const fcl::CollisionObjectd cylinder(std::make_shared<fcl::Cylinderd>(radius, 2.0 * h),
                                        post.X_WP);
@@ -58,11 +62,14 @@ TEST_CASE("A cylinder's distance outside agrees with FCL's GJK, inside with its 
       // 1e-7 m: GJK on a cylinder converges to its tolerance on the support mapping, not exactly.
       CHECK(d.distance_m == Approx(result.min_distance).margin(1e-7));
       CHECK((d.point_W - result.nearest_points[0]).norm() < 1e-6);
-      // The faces the nearest point lies on: the side beyond the radius, an end beyond it.
-      const std::uint8_t side = core::FaceBit(scene::CylinderFace::kSide);
-      const std::uint8_t end =
-          core::FaceBit(p_P.z() > 0.0 ? scene::CylinderFace::kTop : scene::CylinderFace::kBottom);
-      CHECK(d.face_mask == ((beyond_side ? side : 0) | (beyond_end ? end : 0)));
+      // The element the nearest point lies on: the side beyond the radius, an end beyond it,
+      // their rim beyond both.
+      const std::string end = p_P.z() > 0.0 ? "top" : "bottom";
+      const std::string expected = beyond_side && beyond_end ? "post." + end + "_side"
+                                   : beyond_side             ? "post.side"
+                                                             : "post." + end;
+      REQUIRE(d.element < elements.size());
+      CHECK(elements[d.element].name == expected);
     } else {
       ++inside;
       // Inside: out through the nearest of the three faces.
@@ -122,7 +129,7 @@ TEST_CASE("A cylinder's rims are closed polygons and its side bears as its axis"
   CHECK((axis.b_W - axis.a_W).norm() == Approx(40e-3).epsilon(1e-12));
   CHECK_FALSE(axis.a_bears);
   CHECK_FALSE(axis.b_bears);
-  CHECK(axis.face_mask == core::FaceBit(scene::CylinderFace::kSide));
+  CHECK(scene::ElementsOf(post, 0)[axis.element].name == "post.side");
   // The tight box: every rim point inside it, and touched along every axis.
   for (int a = 0; a < 3; ++a) {
     double lo = 1.0, hi = -1.0;

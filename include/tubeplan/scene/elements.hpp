@@ -26,6 +26,10 @@ struct PartElement {
 /// Every element of every part, in part order, then faces, edges, vertices.
 std::vector<PartElement> EnumerateElements(const Scene& scene);
 
+/// The elements of one part, `part_index` its index in the scene, in the order of
+/// EnumerateElements: an element's position here is its index within the part.
+std::vector<PartElement> ElementsOf(const Part& part, std::uint32_t part_index);
+
 /// Index into `elements` of the element named `name`, or -1.
 int FindElement(const std::vector<PartElement>& elements, std::string_view name);
 
