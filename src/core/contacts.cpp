@@ -125,9 +125,23 @@ class Finder {
     s.sample_count = 0;
     s.samples_truncated = false;
     std::fill(s.clearance_m.begin(), s.clearance_m.end(), s.far_clearance_m);
+    // The tube's box, grown by what a side point reaches: it holds every element's and curve
+    // piece's box that Side and Curve test an edge against (all space for nodes not finite).
+    Vec3 lo = x_[0], hi = x_[0];
+    bool finite = true;
+    for (const Vec3& x : x_) {
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+      finite = finite && x.allFinite();
+    }
+    const double reach_m = finite ? m_.rod.outer_radius_m + m_.contact.threshold_m
+                                  : std::numeric_limits<double>::infinity();
+    lo.array() -= reach_m;
+    hi.array() += reach_m;
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
+      FindEdgesNear(part, lo, hi);
       // The held end's section, the spheres at the inner nodes, the end elements' outer halves
       // and the smooth side between them against edges, the free end's rim and end face; each
       // notes its node's clearance for the solve's step.
@@ -142,6 +156,21 @@ class Finder {
   }
 
  private:
+  // The part's edges whose boxes meet the box lo..hi, in order: the only ones Side and Curve
+  // can find near a piece of the tube.
+  void FindEdgesNear(const PartModel& part, const Vec3& lo, const Vec3& hi) {
+    edge_count_ = 0;
+    const auto& edges = part.geometry.edges();
+    for (int e = 0; e < int(edges.size()); ++e) {
+      const PartEdge& edge = edges[std::size_t(e)];
+      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
+        continue;
+      edges_near_[std::size_t(edge_count_++)] = e;
+    }
+  }
+
+  std::span<const int> EdgesNear() const { return {edges_near_.data(), std::size_t(edge_count_)}; }
+
   // Notes node i's clearance: its centre's distance to a part, less the radius.
   void Clear(int i, double centre_m) {
     double& c = d_.scratch.clearance_m[std::size_t(i)];
@@ -374,7 +403,7 @@ class Finder {
     const double theta_lo = i == n_ - 1 && n_ > 1 ? 0.5 : 0.0;
     const double theta_hi = i == 0 && n_ > 1 ? 0.5 : 1.0;
     const auto& edges = part.geometry.edges();
-    for (int e = 0; e < int(edges.size()); ++e) {
+    for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
       if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
         continue;
@@ -462,7 +491,7 @@ class Finder {
     // distance from it (the piece's middle).
     const double bulge = 0.5 * (x1 - 0.5 * (m0 + m1)).norm();
     const auto& edges = part.geometry.edges();
-    for (int e = 0; e < int(edges.size()); ++e) {
+    for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
       if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
         continue;
@@ -597,6 +626,8 @@ class Finder {
   Data& d_;
   int n_;
   bool keep_;
+  std::array<int, 12> edges_near_{};  ///< the part's edges FindEdgesNear found
+  int edge_count_ = 0;
 };
 
 }  // namespace
