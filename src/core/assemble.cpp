@@ -80,9 +80,9 @@ void UnknownsOf(const Model& model, std::span<const Vec3> x_W, Eigen::VectorXd& 
 }
 
 MaterialPoint FrictionMaterial(const Model& model, const FrictionPoint& f,
-                               std::span<const Vec3> x_W, bool jacobian) {
+                               std::span<const Vec3> x_W, NodeTangents& tangents, bool jacobian) {
   (void)model;
-  return Material(CarrierOf(f.kind), x_W, f.node, f.theta, f.offset_W, jacobian);
+  return Material(CarrierOf(f.kind), x_W, f.node, f.theta, f.offset_W, jacobian, &tangents);
 }
 
 CouplingTerm Coupling(const Model& model, const Data& data, const Vec3& p_held_W) {
@@ -439,7 +439,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
     const FrictionPoint& f = data.state.friction[std::size_t(k)];
     // A spring that let go (its contact opened) holds nothing.
     if (!(f.limit_N > 0.0)) continue;
-    const MaterialPoint mp = FrictionMaterial(model, f, x_W, a.gradient());
+    const MaterialPoint mp = FrictionMaterial(model, f, x_W, sc.tangents, a.gradient());
     const Mat3 P = Mat3::Identity() - f.normal_W * f.normal_W.transpose();
     const Vec3 u = P * (mp.point_W - f.anchor_W);
     const double lu = u.norm();

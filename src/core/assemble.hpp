@@ -39,8 +39,9 @@ CouplingTerm Coupling(const Model& model, const Data& data, const Eigen::Vector3
 /// The parts of the potential the output reports: the rod's bending energy [J].
 double BendingEnergyOf(const Model& model, const Data& data, std::span<const Eigen::Vector3d> x_W);
 
-/// The material point of a friction point at the nodes x_W.
+/// The material point of a friction point at the nodes x_W (Material, with `tangents`).
 MaterialPoint FrictionMaterial(const Model& model, const FrictionPoint& f,
-                               std::span<const Eigen::Vector3d> x_W, bool jacobian = false);
+                               std::span<const Eigen::Vector3d> x_W, NodeTangents& tangents,
+                               bool jacobian = false);
 
 }  // namespace tubeplan::core

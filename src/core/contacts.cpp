@@ -289,7 +289,7 @@ class Finder {
     Clear(i, at.distance_m);
     if (at.distance_m - r1 >= eps) return;
     MaterialPoint mp = Material(Carrier::kInnerNode, x_, i, 0.0, Vec3::Zero(), false);
-    mp.tangent_W = CarrierTangent(Carrier::kInnerNode, x_, i);
+    mp.tangent_W = d_.scratch.tangents.Tangent(x_, i);
     const double along = at.normal_W.dot(mp.tangent_W);
     const double x = (std::abs(along) - kCapStart) / kCapFade;
     const double weight = 1.0 - SmoothStep(x);
@@ -309,7 +309,7 @@ class Finder {
       // d |n.t| = sign (t^T C dx_i + n^T dt), C the distance's curvature at the node.
       const double slope = -6.0 * x * (1.0 - x) / kCapFade * (along < 0.0 ? -1.0 : 1.0);
       smp->weight_gradient =
-          slope * (TangentJacobian(Carrier::kInnerNode, x_, i).transpose() * at.normal_W);
+          slope * (d_.scratch.tangents.Jacobian(x_, i).transpose() * at.normal_W);
       smp->weight_gradient.segment<3>(3) += slope * (curvature_per_m * mp.tangent_W);
       smp->weight_first = i - 1;
       smp->weight_nodes = 3;

@@ -80,6 +80,7 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.scratch.entry_seen.assign(parts * nodes, 0);
   d.scratch.section_chosen.assign(parts * nodes, 0);
   d.scratch.section_side_W.assign(parts * nodes, Eigen::Vector3d::Zero());
+  d.scratch.tangents.Resize(int(nodes));
   // The tube straight along the held end's z, the hand at the held end.
   for (int k = 0; k <= n; ++k)
     d.state.x_W[std::size_t(k)] =

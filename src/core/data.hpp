@@ -178,6 +178,8 @@ struct Scratch {
   using Capacitance =
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSideGroups, kMaxSideGroups>;
   Eigen::LDLT<Capacitance> capacitance;
+  /// The inner nodes' tangents, kept while their nodes stay the same (Material).
+  NodeTangents tangents;
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace tubeplan::core {
 namespace {
@@ -234,15 +235,51 @@ Eigen::Matrix<double, 3, 9> TangentJacobian(Carrier carrier, std::span<const Vec
   return dt;
 }
 
+void NodeTangents::Resize(int nodes) { entries_.assign(std::size_t(nodes), Entry{}); }
+
+NodeTangents::Entry& NodeTangents::At(std::span<const Vec3> x_W, int i) {
+  Entry& e = entries_[std::size_t(i)];
+  // Bit for bit the same nodes (x_W is contiguous): a -0 or a NaN is a different input.
+  const Vec3* nodes = &x_W[std::size_t(i - 1)];
+  if (std::memcmp(nodes, e.nodes_W.data(), sizeof e.nodes_W) != 0) {
+    std::copy(nodes, nodes + 3, e.nodes_W.begin());
+    e.has_tangent = e.has_jacobian = false;
+  }
+  return e;
+}
+
+const Vec3& NodeTangents::Tangent(std::span<const Vec3> x_W, int i) {
+  Entry& e = At(x_W, i);
+  if (!e.has_tangent) {
+    e.tangent_W = CarrierTangent(Carrier::kInnerNode, x_W, i);
+    e.has_tangent = true;
+  }
+  return e.tangent_W;
+}
+
+const Eigen::Matrix<double, 3, 9>& NodeTangents::Jacobian(std::span<const Vec3> x_W, int i) {
+  Entry& e = At(x_W, i);
+  if (!e.has_jacobian) {
+    e.jacobian = TangentJacobian(Carrier::kInnerNode, x_W, i);
+    e.has_jacobian = true;
+  }
+  return e.jacobian;
+}
+
 MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double theta,
-                       const Vec3& offset0_W, bool jacobian) {
+                       const Vec3& offset0_W, bool jacobian, NodeTangents* tangents) {
+  // kCurve's offset turns with node i's tangent, as kInnerNode's does.
+  const bool kept =
+      tangents != nullptr && (carrier == Carrier::kInnerNode || carrier == Carrier::kCurve);
   // The offset turned with the section: its part along the new tangent removed, length kept,
   // o = |o0| v / |v| with v = (I - t t^T) o0.
   MaterialPoint mp;
   mp.point_W = CarrierCentre(carrier, x_W, i, theta);
   const double l0 = offset0_W.norm();
   // A point on the centre line has no offset to turn.
-  const Vec3 t = l0 > 0.0 ? CarrierTangent(carrier, x_W, i) : Vec3::Zero();
+  const Vec3 t = !(l0 > 0.0) ? Vec3::Zero()
+                 : kept      ? tangents->Tangent(x_W, i)
+                             : CarrierTangent(carrier, x_W, i);
   const Vec3 v = offset0_W - offset0_W.dot(t) * t;
   const double lv = v.norm();
   mp.tangent_W = t;
@@ -277,7 +314,10 @@ MaterialPoint Material(Carrier carrier, std::span<const Vec3> x_W, int i, double
   const Vec3 vh = v / lv;
   const Mat3 across = Mat3::Identity() - vh * vh.transpose();
   const Mat3 do_dt = -(l0 / lv) * (t.dot(offset0_W) * across + t * offset0_W.transpose());
-  mp.jacobian.noalias() += do_dt * TangentJacobian(carrier, x_W, i);
+  if (kept)
+    mp.jacobian.noalias() += do_dt * tangents->Jacobian(x_W, i);
+  else
+    mp.jacobian.noalias() += do_dt * TangentJacobian(carrier, x_W, i);
   return mp;
 }
 

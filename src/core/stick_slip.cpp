@@ -51,7 +51,8 @@ void Match(const Model& model, Data& data) {
     for (int f = 0; f < st.friction_count; ++f) {
       const FrictionPoint& fp = st.friction[std::size_t(f)];
       if (fp.sample >= 0 || fp.part != smp.part) continue;
-      const double d_m = (FrictionMaterial(model, fp, st.x_W).point_W - smp.point_W).norm();
+      const double d_m =
+          (FrictionMaterial(model, fp, st.x_W, s.tangents).point_W - smp.point_W).norm();
       if (d_m < best_m) {
         best_m = d_m;
         best = f;
@@ -93,8 +94,8 @@ Limits LimitsOf(const Model& model, const Data& data, const Sample& of) {
 }
 
 // The spring's stretch of a friction point at the solved nodes, in its tangent plane.
-Vec3 Stretch(const Model& model, const Data& data, const FrictionPoint& f) {
-  const Vec3 p = FrictionMaterial(model, f, data.state.x_W).point_W;
+Vec3 Stretch(const Model& model, Data& data, const FrictionPoint& f) {
+  const Vec3 p = FrictionMaterial(model, f, data.state.x_W, data.scratch.tangents).point_W;
   const Vec3 u = p - f.anchor_W;
   return u - u.dot(f.normal_W) * f.normal_W;
 }
@@ -189,7 +190,7 @@ void CarryFriction(const Model& model, Data& data) {
     nf.feature = smp.feature;
     nf.theta = smp.theta;
     nf.offset_W = smp.offset_W;
-    nf.anchor_W = FrictionMaterial(model, nf, data.state.x_W).point_W - stretch;
+    nf.anchor_W = FrictionMaterial(model, nf, data.state.x_W, s.tangents).point_W - stretch;
     nf.normal_W = smp.normal_W;
     nf.sliding = sliding;
     nf.limit_N = sliding ? lim.kinetic_N : lim.static_N;
