@@ -180,6 +180,18 @@ struct Scratch {
   Eigen::LDLT<Capacitance> capacitance;
   /// The inner nodes' tangents, kept while their nodes stay the same (Material).
   NodeTangents tangents;
+  /// The loads of the part elements the contact points press on, and their friction limits,
+  /// summed once for a friction pass: element_loads[element_of[k]] is contact point k's.
+  struct ElementLoad {
+    int part = 0;
+    ElementIndex element = kNoElement;
+    double group_N = 0.0;                    ///< the normal force of its points within epsilon
+    double side_N = 0.0;                     ///< of the side's sections among them (IsSideSection)
+    double side_depth_m = 0.0;               ///< the side's sections' depths eps - d, summed
+    double static_N = 0.0, kinetic_N = 0.0;  ///< FrictionLimit at group_N
+  };
+  std::array<ElementLoad, kMaxSamples> element_loads{};
+  std::array<int, kMaxSamples> element_of{};
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
 };

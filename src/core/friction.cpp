@@ -19,6 +19,14 @@ double FrictionShare(const scene::Friction& friction, double coefficient, double
   return FrictionLimit(friction, coefficient, pc_normal_N) * (normal_N / pc_normal_N);
 }
 
+double FrictionShare(const scene::Friction& friction, double coefficient, double normal_N,
+                     double pc_normal_N, double pc_limit_N) {
+  if (!(pc_normal_N > normal_N) || friction.exponent == 1.0)
+    return FrictionLimit(friction, coefficient, normal_N);
+  if (!(normal_N > 0.0)) return 0.0;
+  return pc_limit_N * (normal_N / pc_normal_N);
+}
+
 FrictionResult ReturnMap(const scene::Friction& friction, const Eigen::Vector3d& trial_force_N,
                          double normal_N, double pc_normal_N, double tangential_stiffness_N_per_m) {
   FrictionResult result;

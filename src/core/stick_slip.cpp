@@ -69,28 +69,57 @@ struct Limits {
   double static_N = 0.0, kinetic_N = 0.0;
 };
 
-// A contact point's friction limits: its share of its part element's limit (its PC's share rule,
-// friction.hpp) in proportion to its load. Its load is its own normal force, or for one of the
-// side's sections that press as one contact (Assemble) the contact's force shared by their depths
-// eps - d: the smooth minimum puts the force on the deepest section, which changes with every
-// small tilt of a side lying flat; shared by depth, the friction limits do not jump.
-Limits LimitsOf(const Model& model, const Data& data, const Sample& of) {
+// Sums the loads of the part elements the contact points press on (Scratch::ElementLoad), each
+// in the contact points' order, and the friction limits of their totals.
+void SumElementLoads(const Model& model, Data& data) {
+  Scratch& s = data.scratch;
   const double eps = model.contact.threshold_m;
-  double group_N = 0.0, side_N = 0.0, side_depth_m = 0.0;
-  for (int k = 0; k < data.scratch.sample_count; ++k) {
-    const Sample& smp = data.scratch.samples[std::size_t(k)];
-    if (smp.part != of.part || smp.element != of.element) continue;
-    if (smp.distance_m < eps) group_N += smp.normal_force_N;
+  int count = 0;
+  for (int k = 0; k < s.sample_count; ++k) {
+    const Sample& smp = s.samples[std::size_t(k)];
+    int e = 0;
+    while (e < count && (s.element_loads[std::size_t(e)].part != smp.part ||
+                         s.element_loads[std::size_t(e)].element != smp.element))
+      ++e;
+    Scratch::ElementLoad& load = s.element_loads[std::size_t(e)];
+    if (e == count) {
+      load = {smp.part, smp.element};
+      ++count;
+    }
+    s.element_of[std::size_t(k)] = e;
+    if (smp.distance_m < eps) load.group_N += smp.normal_force_N;
     if (!IsSideSection(smp)) continue;
-    side_N += smp.normal_force_N;
-    side_depth_m += std::max(0.0, eps - smp.distance_m);
+    load.side_N += smp.normal_force_N;
+    load.side_depth_m += std::max(0.0, eps - smp.distance_m);
   }
+  for (int e = 0; e < count; ++e) {
+    Scratch::ElementLoad& load = s.element_loads[std::size_t(e)];
+    const scene::Friction& fr = model.parts[std::size_t(load.part)].friction;
+    if (fr.IsFrictionless()) continue;
+    load.static_N = FrictionLimit(fr, fr.static_coefficient, load.group_N);
+    load.kinetic_N = FrictionLimit(fr, fr.kinetic_coefficient, load.group_N);
+  }
+}
+
+// Contact point k's friction limits: its share of its part element's limit (its PC's share rule,
+// friction.hpp) in proportion to its load, with the element's loads of SumElementLoads. Its load
+// is its own normal force, or for one of the side's sections that press as one contact
+// (Assemble) the contact's force shared by their depths eps - d: the smooth minimum puts the
+// force on the deepest section, which changes with every small tilt of a side lying flat; shared
+// by depth, the friction limits do not jump.
+Limits LimitsOf(const Model& model, const Data& data, int k) {
+  const Sample& of = data.scratch.samples[std::size_t(k)];
+  const Scratch::ElementLoad& load =
+      data.scratch.element_loads[std::size_t(data.scratch.element_of[std::size_t(k)])];
+  const double eps = model.contact.threshold_m;
   double own_N = of.normal_force_N;
   if (IsSideSection(of))
-    own_N = side_depth_m > 0.0 ? side_N * std::max(0.0, eps - of.distance_m) / side_depth_m : 0.0;
+    own_N = load.side_depth_m > 0.0
+                ? load.side_N * std::max(0.0, eps - of.distance_m) / load.side_depth_m
+                : 0.0;
   const scene::Friction& fr = model.parts[std::size_t(of.part)].friction;
-  return {FrictionShare(fr, fr.static_coefficient, own_N, group_N),
-          FrictionShare(fr, fr.kinetic_coefficient, own_N, group_N)};
+  return {FrictionShare(fr, fr.static_coefficient, own_N, load.group_N, load.static_N),
+          FrictionShare(fr, fr.kinetic_coefficient, own_N, load.group_N, load.kinetic_N)};
 }
 
 // The spring's stretch of a friction point at the solved nodes, in its tangent plane.
@@ -105,6 +134,7 @@ Vec3 Stretch(const Model& model, Data& data, const FrictionPoint& f) {
 bool ReturnFrictionToLimits(const Model& model, Data& data) {
   if (model.frictionless) return false;
   Match(model, data);
+  SumElementLoads(model, data);
   const double K = model.contact.stiffness_N_per_m;
   bool changed = false;
   for (int f = 0; f < data.state.friction_count; ++f) {
@@ -118,7 +148,7 @@ bool ReturnFrictionToLimits(const Model& model, Data& data) {
       }
       continue;
     }
-    const Limits lim = LimitsOf(model, data, data.scratch.samples[std::size_t(fp.sample)]);
+    const Limits lim = LimitsOf(model, data, fp.sample);
     const double trial_N = K * Stretch(model, data, fp).norm();
     // A point's limit follows its load with a tick's lag unless the load moved it by more than
     // a tenth (a contact closing or opening): then the tick is solved again.
@@ -152,12 +182,13 @@ void CarryFriction(const Model& model, Data& data) {
     return;
   }
   Match(model, data);
+  SumElementLoads(model, data);
   const double K = model.contact.stiffness_N_per_m;
   int next = 0;
   for (int k = 0; k < s.sample_count && next < kMaxFrictionPoints; ++k) {
     Sample& smp = s.samples[std::size_t(k)];
     if (!Active(model, smp)) continue;
-    const Limits lim = LimitsOf(model, data, smp);
+    const Limits lim = LimitsOf(model, data, k);
     Vec3 stretch = Vec3::Zero();
     bool sliding = false;
     if (smp.friction_point >= 0) {

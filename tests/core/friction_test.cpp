@@ -61,6 +61,11 @@ TEST_CASE("A PC's points share its limit: the shares add up to f_max at its norm
     // and the points together less than those would: by up to n^(1 - beta) for equal loads.
     for (int i = 0; i < n; ++i)
       CHECK(FrictionShare(kRubber, 0.7, N[i], total) <= FrictionLimit(kRubber, 0.7, N[i]));
+    // Given the PC's limit found once, each share is the same bits.
+    for (const Friction& law : {kRubber, kCoulomb})
+      for (int i = 0; i < n; ++i)
+        CHECK(FrictionShare(law, 0.7, N[i], total, FrictionLimit(law, 0.7, total)) ==
+              FrictionShare(law, 0.7, N[i], total));
   }
   // Two points of 2 N: limits of their own would hold 2^(1/3) times the PC's 4 N.
   const double own = FrictionLimit(kRubber, 0.7, 2.0);

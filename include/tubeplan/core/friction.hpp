@@ -24,6 +24,10 @@ double FrictionLimit(const scene::Friction& friction, double coefficient, double
 /// (pc_normal_N <= normal_N) and for beta = 1.
 double FrictionShare(const scene::Friction& friction, double coefficient, double normal_N,
                      double pc_normal_N);
+/// FrictionShare with the PC's limit FrictionLimit(friction, coefficient, pc_normal_N) given as
+/// pc_limit_N, found once for all of a PC's points (the same bits).
+double FrictionShare(const scene::Friction& friction, double coefficient, double normal_N,
+                     double pc_normal_N, double pc_limit_N);
 
 struct FrictionResult {
   Eigen::Vector3d force_N = Eigen::Vector3d::Zero();  ///< friction force on the tube [N]
