@@ -165,11 +165,13 @@ class Finder {
       const PartEdge& edge = edges[std::size_t(e)];
       if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
         continue;
-      edges_near_[std::size_t(edge_count_++)] = e;
+      d_.scratch.edges_near[std::size_t(edge_count_++)] = e;
     }
   }
 
-  std::span<const int> EdgesNear() const { return {edges_near_.data(), std::size_t(edge_count_)}; }
+  std::span<const int> EdgesNear() const {
+    return {d_.scratch.edges_near.data(), std::size_t(edge_count_)};
+  }
 
   // Notes node i's clearance: its centre's distance to a part, less the radius.
   void Clear(int i, double centre_m) {
@@ -626,8 +628,7 @@ class Finder {
   Data& d_;
   int n_;
   bool keep_;
-  std::array<int, 12> edges_near_{};  ///< the part's edges FindEdgesNear found
-  int edge_count_ = 0;
+  int edge_count_ = 0;  ///< the part's edges FindEdgesNear found, in Scratch::edges_near
 };
 
 }  // namespace

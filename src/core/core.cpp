@@ -78,6 +78,10 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   d.scratch.parts_near.assign(parts, 0);
   d.scratch.clearance_m.assign(nodes, 0.0);
   d.scratch.entry_seen.assign(parts * nodes, 0);
+  std::size_t most_edges = 0;
+  for (const PartModel& part : model.parts)
+    most_edges = std::max(most_edges, part.geometry.edges().size());
+  d.scratch.edges_near.assign(most_edges, 0);
   d.scratch.section_chosen.assign(parts * nodes, 0);
   d.scratch.section_side_W.assign(parts * nodes, Eigen::Vector3d::Zero());
   d.scratch.tangents.Resize(int(nodes));

@@ -191,6 +191,8 @@ struct Scratch {
     double static_N = 0.0, kinetic_N = 0.0;  ///< FrictionLimit at group_N
   };
   std::array<ElementLoad, kMaxSamples> element_loads{};
+  /// The edges of one part near the tube (contacts.cpp), as many as the part with the most has.
+  std::vector<int> edges_near;
   std::array<int, kMaxSamples> element_of{};
   /// Friction points made at the tick's end, before they replace the carried ones.
   std::array<FrictionPoint, kMaxFrictionPoints> friction_next{};
