@@ -1,4 +1,4 @@
-// Mesh files: OBJ and STL in, a welded mesh out, or every problem at once. The formats as read are documented for users in docs/meshes.md; keep the two in step.
+// Mesh files: OBJ and STL in, a welded, checked mesh out, or every problem at once. The formats as read are documented for users in docs/meshes.md; keep the two in step.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -418,6 +418,30 @@ std::string PlaceText(const RawMesh& raw, int triangle) {
   return "the face at line " + std::to_string(p.line);
 }
 
+// The checks' findings as diagnostics at the triangles' places.
+void ReportProblems(const std::vector<scene::MeshProblem>& problems, const RawMesh& raw,
+                    const std::vector<int>& source, Reporter& report) {
+  for (const scene::MeshProblem& problem : problems) {
+    static constexpr std::array<const char*, 7> kKinds = {
+        "too many triangles", "degenerate triangles", "open edges",        "non-manifold edges",
+        "winding errors",     "inverted bodies",      "self-intersections"};
+    const char* kind = kKinds[std::size_t(problem.kind)];
+    if (problem.triangle < 0) {
+      report.Error(kind, 0, 0, problem.message);
+      continue;
+    }
+    const int t = source[std::size_t(problem.triangle)];
+    std::string message = problem.message;
+    if (problem.other_triangle >= 0)
+      message +=
+          " (the other triangle: " + PlaceText(raw, source[std::size_t(problem.other_triangle)]) +
+          ")";
+    if (raw.binary) message = PlaceText(raw, t) + ": " + message;
+    const MeshPlace& p = raw.places[std::size_t(t)];
+    report.Error(kind, p.line, p.column, message);
+  }
+}
+
 }  // namespace
 
 MeshLoadResult LoadMeshBytes(std::string_view bytes, const std::string& display_name,
@@ -473,6 +497,7 @@ MeshLoadResult LoadMeshBytes(std::string_view bytes, const std::string& display_
                        "two corners of this triangle are one point (within the weld tolerance), "
                        "so it is left out, expected three distinct corners");
   }
+  ReportProblems(scene::CheckMesh(mesh), *raw, source, report);
   report.Finish();
   if (result.diagnostics.HasErrors()) return result;
   result.mesh = std::move(mesh);

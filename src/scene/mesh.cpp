@@ -1,8 +1,11 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <tuple>
 
 #include <tubeplan/scene/mesh.hpp>
+
+#include "scene/mesh_topology.hpp"
 
 namespace tubeplan::scene {
 
@@ -89,6 +92,50 @@ Eigen::Vector3d TriangleNormal(const TriangleMesh& mesh, int t) {
                                 .cross(mesh.vertices_P_m[std::size_t(tri[2])] - a);
   const double length = n.norm();
   return length > 0.0 ? Eigen::Vector3d(n / length) : Eigen::Vector3d::Zero();
+}
+
+MeshTopology BuildTopology(const TriangleMesh& mesh) {
+  const std::size_t n = mesh.triangles.size();
+  // Every triangle side as (low vertex, high vertex, triangle, side), sorted: one run per edge.
+  std::vector<std::tuple<int, int, int, int>> sides;
+  sides.reserve(3 * n);
+  for (std::size_t t = 0; t < n; ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.triangles[t][std::size_t(k)],
+                b = mesh.triangles[t][std::size_t((k + 1) % 3)];
+      sides.emplace_back(std::min(a, b), std::max(a, b), static_cast<int>(t), k);
+    }
+  std::sort(sides.begin(), sides.end());
+  MeshTopology topo;
+  topo.triangle_edge.assign(n, {-1, -1, -1});
+  topo.neighbour.assign(n, {kOpen, kOpen, kOpen});
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i;
+    while (j < sides.size() && std::get<0>(sides[j]) == std::get<0>(sides[i]) &&
+           std::get<1>(sides[j]) == std::get<1>(sides[i]))
+      ++j;
+    const int edge = static_cast<int>(topo.edge_vertices.size());
+    topo.edge_vertices.push_back({std::get<0>(sides[i]), std::get<1>(sides[i])});
+    std::vector<int>& tris = topo.edge_triangles.emplace_back();
+    for (std::size_t s = i; s < j; ++s) {
+      const auto [lo, hi, t, k] = sides[s];
+      tris.push_back(t);
+      topo.triangle_edge[std::size_t(t)][std::size_t(k)] = edge;
+      int across = kOpen;
+      if (j - i == 2) across = std::get<2>(sides[s == i ? i + 1 : i]);
+      if (j - i > 2) across = kNonManifold;
+      topo.neighbour[std::size_t(t)][std::size_t(k)] = across;
+    }
+    i = j;
+  }
+  return topo;
+}
+
+bool RunsFromTo(const TriangleMesh& mesh, int t, int a, int b) {
+  const std::array<int, 3>& tri = mesh.triangles[std::size_t(t)];
+  for (std::size_t k = 0; k < 3; ++k)
+    if (tri[k] == a && tri[(k + 1) % 3] == b) return true;
+  return false;
 }
 
 }  // namespace tubeplan::scene

@@ -39,7 +39,7 @@ TEST_CASE("The file's numbers are scaled to metres", "[mesh]") {
   CHECK_THROWS_AS(LoadMeshBytes("", "cube.obj", 0.0), std::invalid_argument);
 }
 
-TEST_CASE("Vertices within the weld tolerance are one", "[mesh]") {
+TEST_CASE("Vertices within the weld tolerance are one, beyond it two", "[mesh]") {
   // The cube's corner 8 written again as vertex 9, 1e-7 of the diagonal away (within 1e-6), and
   // the top face made with it: one vertex.
   auto with_ninth = [](const std::string& v9) {
@@ -52,6 +52,74 @@ TEST_CASE("Vertices within the weld tolerance are one", "[mesh]") {
   INFO(Text(welded));
   REQUIRE(welded.mesh);
   CHECK(welded.mesh->vertices_P_m.size() == 8);
+  // 1e-5 of the diagonal away: a vertex of its own, and the surface has a crack.
+  const MeshLoadResult cracked = LoadMeshBytes(with_ninth("v 1.00002 1 1\n"), "cube.obj", 1.0);
+  CHECK_FALSE(cracked.mesh);
+  CHECK(Has(cracked, "the mesh has a hole"));
+}
+
+TEST_CASE("Each kind of bad mesh is reported at its place", "[mesh]") {
+  using tubeplan::testing::CubeObj;
+  // The face of kCubeFaces[k] is on line 11 + 2k (mesh_test_meshes.hpp).
+  SECTION("open: a face left out leaves four edges of one triangle each") {
+    const MeshLoadResult r = LoadMeshBytes(CubeObj(4), "open.obj", 1.0);
+    const std::string text = Text(r);
+    // ypos's neighbours: top (11), bottom (13), xpos (15), xneg (17).
+    for (int line : {11, 13, 15, 17})
+      CHECK(Has(r, "open.obj:" + std::to_string(line) + ":1: error: the edge from"));
+    CHECK(std::count(text.begin(), text.end(), '\n') == 4);
+    CHECK(Has(r, "borders this triangle only: the mesh has a hole, expected a closed surface"));
+  }
+  SECTION("non-manifold: a fin on an edge") {
+    const MeshLoadResult r = LoadMeshBytes(CubeObj() + "v 0.5 2 2\nf 7 8 9\n", "fin.obj", 1.0);
+    CHECK(Has(r,
+              "fin.obj:23:1: error: the edge from (1000, 1000, 1000) mm to (0, 1000, 1000) mm "
+              "borders 3 triangles, expected two"));
+  }
+  SECTION("degenerate: three corners on a line") {
+    const MeshLoadResult r = LoadMeshBytes(CubeObj() + "v 0.5 0 0\nf 1 9 2\n", "flat.obj", 1.0);
+    CHECK(Has(r, "flat.obj:23:1: error: this triangle has (nearly) no area: its height is 0 mm"));
+  }
+  SECTION("inconsistent winding: one face reversed") {
+    const MeshLoadResult r = LoadMeshBytes(CubeObj(-1, 5), "wound.obj", 1.0);
+    // yneg (line 21) is the later triangle at each of its four edges.
+    const std::string text = Text(r);
+    CHECK(std::count(text.begin(), text.end(), '\n') == 4);
+    CHECK(Has(r, "wound.obj:21:1: error: this triangle and its neighbour run the edge from"));
+    CHECK(Has(r,
+              "the same way, expected opposite ways (both counter-clockwise seen from "
+              "outside) (the other triangle: the face at line 13)"));
+  }
+  SECTION("inverted: every face reversed") {
+    const MeshLoadResult r = LoadMeshBytes(CubeObj(-1, -1, true), "inside.obj", 1.0);
+    CHECK(Text(r) ==
+          "inside.obj:11:1: error: the closed body of this triangle has a negative volume (-1e+09 "
+          "mm^3): its normals point inwards, expected corners counter-clockwise seen from outside "
+          "(reverse each face's corners, or export with outward normals)\n");
+  }
+  SECTION("self-intersecting: two cubes through each other") {
+    // The second cube shifted by amounts that make no crossing pass through a corner or along a
+    // quad's diagonal (a touch there would not count).
+    const std::string second = CubeObj(-1, -1, false, Eigen::Vector3d(0.31, 0.27, 0.43));
+    std::string obj = CubeObj();
+    // The second cube's indices follow the first's eight vertices.
+    std::istringstream lines(second);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.rfind("f ", 0) == 0) {
+        std::istringstream words(line.substr(2));
+        line = "f";
+        for (int i; words >> i;) line += " " + std::to_string(i + 8);
+      }
+      obj += line + "\n";
+    }
+    const MeshLoadResult r = LoadMeshBytes(obj, "two.obj", 1.0);
+    CHECK(Has(r, "error: this triangle crosses another one that shares no corner with it"));
+    // Only the first cube's top, xpos and ypos meet the second's bottom, xneg and yneg.
+    const std::string text = Text(r);
+    for (const std::string line : {"11", "15", "19"})
+      CHECK(Has(r, "(the other triangle: the face at line " + line + ")"));
+    CHECK_FALSE(Has(r, "(the other triangle: the face at line 13)"));
+  }
 }
 
 TEST_CASE("Bad mesh files are reported at their place, all problems at once", "[mesh]") {

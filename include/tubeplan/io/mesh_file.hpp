@@ -1,6 +1,6 @@
 #pragma once
 // Triangle-mesh files of rigid parts: Wavefront OBJ and STL (ASCII or binary), read, scaled to
-// metres and welded.
+// metres, welded and checked.
 
 #include <filesystem>
 #include <optional>
@@ -32,7 +32,7 @@ struct MeshLoadResult {
 
 /// Reads an OBJ or STL file (told by its extension, .obj or .stl in any case), multiplies its
 /// numbers by `scale` (the file's unit in metres: 0.001 for millimetres; > 0), welds coincident
-/// vertices (scene::kWeldRelativeTolerance). Problems are reported against `path` as given. Throws std::invalid_argument for a bad scale.
+/// vertices (scene::kWeldRelativeTolerance) and checks it (scene::CheckMesh). Problems are reported against `path` as given. Throws std::invalid_argument for a bad scale.
 MeshLoadResult LoadMeshFile(const std::filesystem::path& path, double scale);
 
 /// The same for bytes already in memory; `display_name` is the file name used in diagnostics,
