@@ -1,4 +1,5 @@
-// Mesh files: OBJ and STL in, a welded, checked mesh out, or every problem at once. The formats as read are documented for users in docs/meshes.md; keep the two in step.
+// Mesh files: OBJ and STL in, a welded, checked mesh with its elements out, or every problem at
+// once. The formats as read are documented for users in docs/meshes.md; keep the two in step.
 #include <algorithm>
 #include <array>
 #include <cctype>
@@ -500,6 +501,7 @@ MeshLoadResult LoadMeshBytes(std::string_view bytes, const std::string& display_
   ReportProblems(scene::CheckMesh(mesh), *raw, source, report);
   report.Finish();
   if (result.diagnostics.HasErrors()) return result;
+  result.elements = scene::FindElements(mesh);
   result.mesh = std::move(mesh);
   return result;
 }

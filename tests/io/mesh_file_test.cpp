@@ -20,6 +20,19 @@ namespace {
 
 using tubeplan::io::LoadMeshBytes;
 using tubeplan::io::MeshLoadResult;
+using tubeplan::scene::MeshElements;
+
+std::set<std::string> EdgeNames(const MeshElements& e) {
+  std::set<std::string> names;
+  for (const auto& edge : e.edges) names.insert(edge.name);
+  return names;
+}
+
+std::set<std::string> VertexNames(const MeshElements& e) {
+  std::set<std::string> names;
+  for (const auto& vertex : e.vertices) names.insert(vertex.name);
+  return names;
+}
 
 // The diagnostics' text, one per line, for messages in failures and substring checks.
 std::string Text(const MeshLoadResult& r) { return r.diagnostics.FormatAll(); }
@@ -28,7 +41,165 @@ bool Has(const MeshLoadResult& r, const std::string& text) {
   return Text(r).find(text) != std::string::npos;
 }
 
+// The box "cube" with the cube's extents: its element names are the box's naming rule.
+std::vector<tubeplan::scene::PartElement> BoxElements() {
+  tubeplan::scene::Scene scene;
+  tubeplan::scene::Part box;
+  box.name = "cube";
+  box.size_m = Eigen::Vector3d::Ones();
+  scene.parts.push_back(box);
+  return tubeplan::scene::EnumerateElements(scene);
+}
+
 }  // namespace
+
+TEST_CASE("A cube in OBJ has six planar faces, twelve convex edges, eight vertices", "[mesh]") {
+  const MeshLoadResult r = LoadMeshBytes(tubeplan::testing::CubeObj(), "cube.obj", 1.0);
+  INFO(Text(r));
+  REQUIRE(r.elements);
+  REQUIRE_FALSE(r.diagnostics.HasErrors());
+  const MeshElements& e = *r.elements;
+  CHECK(r.mesh->vertices_P_m.size() == 8);
+  CHECK(r.mesh->triangles.size() == 12);
+  REQUIRE(e.faces.size() == 6);
+  for (std::size_t f = 0; f < 6; ++f) {
+    CHECK(e.faces[f].name == tubeplan::testing::kCubeFaceNames[f]);
+    CHECK(e.faces[f].planar);
+    CHECK(e.faces[f].triangles.size() == 2);
+  }
+  REQUIRE(e.edges.size() == 12);
+  for (const auto& edge : e.edges) {
+    CHECK(edge.convex);
+    CHECK(edge.segments.size() == 1);
+  }
+  REQUIRE(e.vertices.size() == 8);
+  // Names as the box's elements have them, "cube." left off.
+  std::set<std::string> box_edges, box_vertices;
+  for (const auto& element : BoxElements()) {
+    const std::string name = element.name.substr(5);
+    if (element.kind == tubeplan::scene::ElementKind::kEdge) box_edges.insert(name);
+    if (element.kind == tubeplan::scene::ElementKind::kVertex) box_vertices.insert(name);
+  }
+  CHECK(EdgeNames(e) == box_edges);
+  CHECK(VertexNames(e) == box_vertices);
+  // Each vertex sits at the corner its three faces share: top_xpos_ypos at (1, 1, 1).
+  for (const auto& v : e.vertices) {
+    const Eigen::Vector3d expected(v.name.find("xpos") != std::string::npos ? 1.0 : 0.0,
+                                   v.name.find("ypos") != std::string::npos ? 1.0 : 0.0,
+                                   v.name.find("top") != std::string::npos ? 1.0 : 0.0);
+    CHECK(v.position_P_m == expected);
+  }
+}
+
+TEST_CASE("The cube as ASCII and as binary STL has the same elements", "[mesh]") {
+  const auto triangles = tubeplan::testing::CubeTriangles();
+  const MeshLoadResult ascii =
+      LoadMeshBytes(tubeplan::testing::AsciiStl(triangles), "cube.stl", 1.0);
+  // The binary file's header starts with "solid": its size tells it apart.
+  const MeshLoadResult binary =
+      LoadMeshBytes(tubeplan::testing::BinaryStl(triangles), "cube.STL", 1.0);
+  const MeshLoadResult obj = LoadMeshBytes(tubeplan::testing::CubeObj(), "cube.obj", 1.0);
+  INFO(Text(ascii) << Text(binary));
+  REQUIRE(ascii.elements);
+  REQUIRE(binary.elements);
+  // STL shares no vertices: 36 corners welded into the cube's 8.
+  CHECK(ascii.mesh->vertices_P_m.size() == 8);
+  CHECK(binary.mesh->vertices_P_m.size() == 8);
+  for (const MeshLoadResult* r : {&ascii, &binary}) {
+    const MeshElements& e = *r->elements;
+    REQUIRE(e.faces.size() == 6);
+    // Without groups the faces are f0..f5 in the order of their first triangle: the OBJ's order.
+    for (std::size_t f = 0; f < 6; ++f) {
+      CHECK(e.faces[f].name == "f" + std::to_string(f));
+      CHECK(e.faces[f].triangles == obj.elements->faces[f].triangles);
+    }
+    CHECK(e.edges.size() == 12);
+    CHECK(e.vertices.size() == 8);
+    CHECK(r->mesh->vertices_P_m == obj.mesh->vertices_P_m);
+  }
+  CHECK(EdgeNames(*ascii.elements) == EdgeNames(*binary.elements));
+  CHECK(VertexNames(*ascii.elements) == VertexNames(*binary.elements));
+  CHECK(ascii.mesh->triangles == binary.mesh->triangles);
+}
+
+TEST_CASE("A 64-sided cylinder is three faces, two loop edges and no vertex", "[mesh]") {
+  const MeshLoadResult r = LoadMeshBytes(tubeplan::testing::CylinderObj(64), "cyl.obj", 1.0);
+  INFO(Text(r));
+  REQUIRE(r.elements);
+  const MeshElements& e = *r.elements;
+  REQUIRE(e.faces.size() == 3);
+  // The side (its quads come first in the file) is curved; the caps are planar.
+  CHECK_FALSE(e.faces[0].planar);
+  CHECK(e.faces[0].triangles.size() == 128);
+  CHECK(e.faces[1].planar);
+  CHECK(e.faces[2].planar);
+  REQUIRE(e.edges.size() == 2);
+  for (const auto& edge : e.edges) {
+    CHECK(edge.convex);
+    REQUIRE(edge.segments.size() == 64);
+    // Chained: each segment starts where the one before ends, and the loop closes.
+    for (std::size_t s = 0; s < 64; ++s)
+      CHECK(edge.segments[s][1] == edge.segments[(s + 1) % 64][0]);
+  }
+  CHECK(e.vertices.empty());
+}
+
+TEST_CASE("The cylinder's side is one face only while its facets turn less than 20 deg", "[mesh]") {
+  // 17 sides turn 21.2 deg each: every side is a face of its own; 19 turn 18.9 deg.
+  const MeshLoadResult coarse = LoadMeshBytes(tubeplan::testing::CylinderObj(17), "c.obj", 1.0);
+  REQUIRE(coarse.elements);
+  CHECK(coarse.elements->faces.size() == 17 + 2);
+  const MeshLoadResult fine = LoadMeshBytes(tubeplan::testing::CylinderObj(19), "c.obj", 1.0);
+  REQUIRE(fine.elements);
+  CHECK(fine.elements->faces.size() == 3);
+}
+
+TEST_CASE("An L-shaped prism has exactly one concave edge", "[mesh]") {
+  const std::vector<Eigen::Vector2d> l = {{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}};
+  const MeshLoadResult r = LoadMeshBytes(tubeplan::testing::PrismObj(l, 1.0), "l.obj", 1.0);
+  INFO(Text(r));
+  REQUIRE(r.elements);
+  const MeshElements& e = *r.elements;
+  // Six sides and two caps; six upright edges and six on each cap; each profile corner twice.
+  CHECK(e.faces.size() == 8);
+  REQUIRE(e.edges.size() == 18);
+  CHECK(e.vertices.size() == 12);
+  std::vector<const tubeplan::scene::MeshEdge*> concave;
+  for (const auto& edge : e.edges)
+    if (!edge.convex) concave.push_back(&edge);
+  REQUIRE(concave.size() == 1);
+  // The inner corner (1, 1) upright: between side 2 (from (2,1) to (1,1)) and side 3.
+  CHECK(concave[0]->name == "f2_f3");
+  REQUIRE(concave[0]->segments.size() == 1);
+  for (int v : concave[0]->segments[0])
+    CHECK(r.mesh->vertices_P_m[std::size_t(v)].head<2>() == Eigen::Vector2d(1, 1));
+}
+
+TEST_CASE("OBJ faces in every index form, negative indices, polygons and names", "[mesh]") {
+  // The cube again, its faces written with i/t, i//n, i/t/n and negative indices, one face as
+  // two triangles, names by o and g, and statements that do not matter.
+  const std::string obj =
+      "mtllib cube.mtl\no part\n"
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\nv 1 1 1\n"
+      "vt 0 0\nvn 0 0 1\ns off\nusemtl steel\n"
+      "g clip_top\nf 5/1 6/1 8/1 7/1\n"
+      "g\nf -8//1 -6//1 -5//1 -7//1\n"          // bottom: o's name again
+      "g side\nf 2/1/1 4/1/1 8/1/1\nf 2 8 6\n"  // xpos as two triangles
+      "f 1 5 7 3\nf 3 7 8 4\n"                  // xneg, ypos: still the group side
+      "g Cube.001\nf 1 2 6 5\n";                // yneg: a name that is not one
+  const MeshLoadResult r = LoadMeshBytes(obj, "named.obj", 1.0);
+  INFO(Text(r));
+  REQUIRE(r.elements);
+  const MeshElements& e = *r.elements;
+  REQUIRE(e.faces.size() == 6);
+  std::vector<std::string> names;
+  for (const auto& f : e.faces) names.push_back(f.name);
+  // "side" makes three faces (xpos, xneg, ypos), numbered in order of their first triangle.
+  CHECK(names ==
+        std::vector<std::string>{"clip_top", "part", "side_1", "side_2", "side_3", "Cube_001"});
+  CHECK(e.edges.size() == 12);
+  CHECK(Has(r, "named.obj:24:3: warning: 'Cube.001' is not a name"));
+}
 
 TEST_CASE("The file's numbers are scaled to metres", "[mesh]") {
   const MeshLoadResult r = LoadMeshBytes(tubeplan::testing::CubeObj(), "cube.obj", 0.001);

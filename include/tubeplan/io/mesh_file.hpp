@@ -1,6 +1,6 @@
 #pragma once
-// Triangle-mesh files of rigid parts: Wavefront OBJ and STL (ASCII or binary), read, scaled to
-// metres, welded and checked.
+// Triangle-mesh files of rigid parts (docs/meshes.md): Wavefront OBJ and STL (ASCII or binary),
+// read, scaled to metres, welded, checked and cut into named faces, edges and vertices.
 
 #include <filesystem>
 #include <optional>
@@ -27,12 +27,14 @@ struct MeshPlace {
 struct MeshLoadResult {
   /// The welded, checked mesh in the file's frame scaled to metres; set only without errors.
   std::optional<scene::TriangleMesh> mesh;
-  Diagnostics diagnostics;  ///< every error and warning, all at once
+  std::optional<scene::MeshElements> elements;  ///< set with mesh
+  Diagnostics diagnostics;                      ///< every error and warning, all at once
 };
 
 /// Reads an OBJ or STL file (told by its extension, .obj or .stl in any case), multiplies its
 /// numbers by `scale` (the file's unit in metres: 0.001 for millimetres; > 0), welds coincident
-/// vertices (scene::kWeldRelativeTolerance) and checks it (scene::CheckMesh). Problems are reported against `path` as given. Throws std::invalid_argument for a bad scale.
+/// vertices (scene::kWeldRelativeTolerance), checks it (scene::CheckMesh) and finds its elements.
+/// Problems are reported against `path` as given. Throws std::invalid_argument for a bad scale.
 MeshLoadResult LoadMeshFile(const std::filesystem::path& path, double scale);
 
 /// The same for bytes already in memory; `display_name` is the file name used in diagnostics,

@@ -1,7 +1,8 @@
 #pragma once
-// Triangle meshes of rigid parts loaded from CAD: the triangles as read, and the checks that
-// make a mesh a closed solid the contact model can use. Plain data in the part's frame P,
-// metres; files are read by io/mesh_file.hpp.
+// Triangle meshes of rigid parts loaded from CAD (docs/meshes.md): the triangles as read, the
+// checks that make a mesh a closed solid the contact model can use, and its named surface
+// elements (faces, edges, vertices) as the paper's polyhedral contact model needs them. Plain
+// data in the part's frame P, metres; files are read by io/mesh_file.hpp.
 
 #include <array>
 #include <cstdint>
@@ -67,6 +68,56 @@ struct MeshProblem {
 /// facing, non self-intersecting solid. Self-intersection is looked for with a bounding-volume
 /// tree (n log n), and only when the mesh is otherwise sound.
 std::vector<MeshProblem> CheckMesh(const TriangleMesh& mesh);
+
+// --- Elements -------------------------------------------------------------------------------
+
+/// Neighbouring triangles whose normals differ by less than this lie on one face: a tessellated
+/// cylinder of 19 or more segments or a fillet of 5 or more is one face, a box's sides are six.
+inline constexpr double kFeatureAngle_deg = 20.0;
+/// A face is planar when every triangle's normal is within this of the face's mean normal.
+inline constexpr double kPlanarAngle_deg = 1.0;
+
+struct MeshFace {
+  std::string name;
+  bool planar = true;
+  std::vector<int> triangles;                          ///< in mesh order
+  Eigen::Vector3d normal_P = Eigen::Vector3d::Zero();  ///< area-weighted mean, unit
+};
+
+struct MeshEdge {
+  std::string name;            ///< "face_a" + '_' + "face_b"
+  int face_a = 0, face_b = 0;  ///< face_a <= face_b
+  bool convex = true;          ///< the material's angle at the edge is below 180 deg
+  /// Mesh vertex index pairs, in order along the chain where it is one.
+  std::vector<std::array<int, 2>> segments;
+};
+
+struct MeshVertex {
+  std::string name;        ///< the faces' names joined by '_'
+  std::vector<int> faces;  ///< ascending
+  int mesh_vertex = 0;
+  Eigen::Vector3d position_P_m = Eigen::Vector3d::Zero();
+};
+
+/// The named surface elements of a sound mesh, and where each triangle's pieces lie.
+struct MeshElements {
+  std::vector<MeshFace> faces;
+  std::vector<MeshEdge> edges;
+  std::vector<MeshVertex> vertices;
+  /// Per triangle: its face.
+  std::vector<int> triangle_face;
+  /// Per triangle and local edge k (from corner k to k+1): the feature edge it lies on, or -1.
+  std::vector<std::array<int, 3>> triangle_edge;
+  /// Per mesh vertex: the feature vertex it is, or -1.
+  std::vector<int> vertex_element;
+  /// Per mesh vertex that is no feature vertex: a feature edge it lies on, or -1.
+  std::vector<int> vertex_edge;
+};
+
+/// Faces, feature edges and feature vertices of a mesh CheckMesh found no problem in. Faces are
+/// numbered in order of their first triangle, and named after their triangles' group (the first
+/// triangle's; "_1", "_2"... when a group makes several faces) or "f0", "f1"... without one.
+MeshElements FindElements(const TriangleMesh& mesh);
 
 /// Unit normal of triangle t (zero when degenerate).
 Eigen::Vector3d TriangleNormal(const TriangleMesh& mesh, int t);
