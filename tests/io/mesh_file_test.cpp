@@ -268,6 +268,38 @@ TEST_CASE("Each kind of bad mesh is reported at its place", "[mesh]") {
           "mm^3): its normals point inwards, expected corners counter-clockwise seen from outside "
           "(reverse each face's corners, or export with outward normals)\n");
   }
+  SECTION("a cavity faces inwards, and is no error") {
+    // A hollow cube: the inner cube [0.25, 0.75]^3 with every face reversed, its vertices 9-16.
+    std::string obj = CubeObj();
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d p =
+          0.25 * Eigen::Vector3d::Ones() + 0.5 * tubeplan::testing::CubeCorner(i);
+      obj += "v " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " +
+             std::to_string(p.z()) + "\n";
+    }
+    for (const auto& f : tubeplan::testing::kCubeFaces)
+      obj += "f " + std::to_string(f[0] + 9) + " " + std::to_string(f[3] + 9) + " " +
+             std::to_string(f[2] + 9) + " " + std::to_string(f[1] + 9) + "\n";
+    const MeshLoadResult hollow = LoadMeshBytes(obj, "hollow.obj", 1.0);
+    CHECK(Text(hollow).empty());
+    // The same inner cube alone faces inwards: an error.
+    std::string alone;
+    for (std::size_t i = obj.find("v 0.25"); i < obj.size();) {
+      const std::size_t end = obj.find('\n', i) + 1;
+      std::string line = obj.substr(i, end - i);
+      if (line.rfind("f ", 0) == 0) {
+        std::istringstream words(line.substr(2));
+        line = "f";
+        for (int k; words >> k;) line += " " + std::to_string(k - 8);
+        line += "\n";
+      }
+      alone += line;
+      i = end;
+    }
+    const MeshLoadResult inverted = LoadMeshBytes(alone, "inner.obj", 1.0);
+    CHECK(Has(inverted,
+              "inner.obj:9:1: error: the closed body of this triangle has a negative volume"));
+  }
   SECTION("self-intersecting: two cubes through each other") {
     // The second cube shifted by amounts that make no crossing pass through a corner or along a
     // quad's diagonal (a touch there would not count).
