@@ -71,21 +71,6 @@ std::vector<std::string> ReadLoad(const BeamOptions& o, report::BeamAnswer& a) {
   return errors;
 }
 
-// The response and the points' displacements; false when a figure overflows a double.
-bool Answer(report::BeamAnswer& a) {
-  a.section = model::ComputeSection(a.spec);
-  a.response = model::TipResponse(a.model, a.spec, a.f_tip_O_N);
-  const model::TipLoadResponse& r = a.response;
-  bool finite = std::isfinite(r.alpha) && r.tip_displacement_O_m.allFinite() &&
-                std::isfinite(r.tip_angle_rad) && std::isfinite(r.energy_J) &&
-                std::isfinite(r.root_strain);
-  for (const Eigen::Vector3d& p : a.points_O_m) {
-    a.displacements_O_m.push_back(model::PointDisplacement(a.model, a.spec, a.f_tip_O_N, p));
-    finite = finite && a.displacements_O_m.back().allFinite();
-  }
-  return finite;
-}
-
 int RunBeam(const BeamOptions& o, Streams io) {
   report::BeamAnswer a;
   if (!o.scene_path.empty()) {
@@ -110,7 +95,7 @@ int RunBeam(const BeamOptions& o, Streams io) {
            << "), expected a smaller force or a stiffer tube\n";
     return kExitBadInput;
   }
-  if (!Answer(a)) {
+  if (!report::ComputeBeamAnswer(a)) {
     io.err << "tubeplan beam: error: --tip-force: the results overflow a double for this load "
               "(alpha = "
            << alpha << "), expected a smaller force\n";

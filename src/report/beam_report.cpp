@@ -1,3 +1,4 @@
+#include <cmath>
 #include <iomanip>
 #include <numbers>
 #include <sstream>
@@ -21,6 +22,21 @@ std::string Vec(const Eigen::Vector3d& v) {
 nlohmann::json Array(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
+
+bool ComputeBeamAnswer(BeamAnswer& a) {
+  a.section = model::ComputeSection(a.spec);
+  a.response = model::TipResponse(a.model, a.spec, a.f_tip_O_N);
+  const model::TipLoadResponse& r = a.response;
+  bool finite = std::isfinite(r.alpha) && r.tip_displacement_O_m.allFinite() &&
+                std::isfinite(r.tip_angle_rad) && std::isfinite(r.energy_J) &&
+                std::isfinite(r.root_strain);
+  a.displacements_O_m.clear();
+  for (const Eigen::Vector3d& p : a.points_O_m) {
+    a.displacements_O_m.push_back(model::PointDisplacement(a.model, a.spec, a.f_tip_O_N, p));
+    finite = finite && a.displacements_O_m.back().allFinite();
+  }
+  return finite;
+}
 
 nlohmann::json BeamJson(const BeamAnswer& a) {
   const model::TubeSpec& spec = a.spec;

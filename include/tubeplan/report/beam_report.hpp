@@ -25,6 +25,10 @@ struct BeamAnswer {
   std::vector<Eigen::Vector3d> displacements_O_m;  ///< of points_O_m, one each [m]
 };
 
+/// Fills the answer's section, response and the points' displacements from its model, tube, tip
+/// force and points; false when a figure overflows a double.
+bool ComputeBeamAnswer(BeamAnswer& answer);
+
 /// The answer as one JSON document: model, tube, tip_force, the response's figures and points.
 nlohmann::json BeamJson(const BeamAnswer& answer);
 
