@@ -573,7 +573,9 @@ class Finder {
       Sample& q = s.samples[std::size_t(k)];
       if (q.kind == SampleKind::kNode && q.part == p && q.node == i) node = &q;
     }
-    if (node == nullptr) return;
+    // A round side bears all round (no face planes to tell its region): the sphere yields only
+    // when it presses on that side too, not on an end beside it.
+    if (node == nullptr || (edge.radius_m > 0.0 && node->element != edge.element)) return;
     Vec3 d_rho;
     const double rho = InFrontOfFaces(edge, x_[std::size_t(i)], Ramp(), d_rho);
     const double end = std::min(theta, 1.0 - theta) / kPieceEnd;

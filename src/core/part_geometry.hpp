@@ -55,8 +55,10 @@ class PartGeometry {
   explicit PartGeometry(const scene::Part& part);
 
   /// Signed distance of p_W to the part. Inside, the distance is to the faces of the element
-  /// `entry` when it names one (where the point came in: a thin part is not crossed by pushing
-  /// a point past its middle), else to the nearest face.
+  /// `entry` when it names one (where the point came in: a thin box is not crossed by pushing
+  /// a point past its middle), else to the nearest face. A point pushed past a cylinder's axis
+  /// leaves by the side nearest it: a push beyond K (eps + R) can cross a cylinder, as `check`
+  /// warns for thin parts.
   PartDistance Distance(const Eigen::Vector3d& p_W, ElementIndex entry = kNoElement) const;
 
   const std::vector<PartEdge>& edges() const { return edges_; }
