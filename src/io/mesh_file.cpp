@@ -357,6 +357,13 @@ RawMesh ReadBinaryStl(std::string_view bytes, Reporter& report) {
   raw.binary = true;
   scene::TriangleMesh& mesh = raw.mesh;
   const std::uint32_t count = CountAt(bytes, 80);
+  // Refused by its header's count, before a quarter gigabyte of records is parsed.
+  if (count > scene::kMaxTriangles) {
+    report.Error("format errors", 1, 81,
+                 "the header counts " + std::to_string(count) + " triangles, expected at most " +
+                     std::to_string(scene::kMaxTriangles) + " (simplify the mesh in its export)");
+    return raw;
+  }
   static constexpr std::array<char, 3> kAxis = {'x', 'y', 'z'};
   for (std::uint32_t t = 0; t < count; ++t) {
     const std::size_t record = 84 + 50 * std::size_t(t);
@@ -423,9 +430,10 @@ std::string PlaceText(const RawMesh& raw, int triangle) {
 void ReportProblems(const std::vector<scene::MeshProblem>& problems, const RawMesh& raw,
                     const std::vector<int>& source, Reporter& report) {
   for (const scene::MeshProblem& problem : problems) {
-    static constexpr std::array<const char*, 7> kKinds = {
-        "too many triangles", "degenerate triangles", "open edges",        "non-manifold edges",
-        "winding errors",     "inverted bodies",      "self-intersections"};
+    // Indexed by scene::MeshProblemKind.
+    static constexpr std::array<const char*, 8> kKinds = {
+        "too many triangles", "degenerate triangles", "open edges",  "non-manifold edges",
+        "winding errors",     "inverted bodies",      "flat bodies", "self-intersections"};
     const char* kind = kKinds[std::size_t(problem.kind)];
     if (problem.triangle < 0) {
       report.Error(kind, 0, 0, problem.message);

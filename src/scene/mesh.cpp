@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <tuple>
 
@@ -26,11 +27,16 @@ TriangleMesh WeldVertices(const TriangleMesh& mesh, double tolerance_m,
   // Vertices sorted by a grid cell of twice the tolerance: a vertex's partners lie in the 27
   // cells around its own, found by binary search (n log n, whatever the mesh's shape).
   const double cell_m = tolerance_m > 0.0 ? 2.0 * tolerance_m : 1.0;
+  // Cells counted from the mesh's low corner, capped far below the integers' range: a point far
+  // from the origin, or beyond any cell worth telling apart, cannot overflow its key.
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  for (const Eigen::Vector3d& p : v) lo = lo.cwiseMin(p);
   using Key = std::array<long long, 3>;
+  auto cell_of = [&](double x, double x_lo) {
+    return static_cast<long long>(std::min(std::floor((x - x_lo) / cell_m), 1e15));
+  };
   auto key_of = [&](const Eigen::Vector3d& p) {
-    return Key{static_cast<long long>(std::floor(p.x() / cell_m)),
-               static_cast<long long>(std::floor(p.y() / cell_m)),
-               static_cast<long long>(std::floor(p.z() / cell_m))};
+    return Key{cell_of(p.x(), lo.x()), cell_of(p.y(), lo.y()), cell_of(p.z(), lo.z())};
   };
   std::vector<std::pair<Key, int>> sorted(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) sorted[std::size_t(i)] = {key_of(v[std::size_t(i)]), i};

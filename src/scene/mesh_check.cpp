@@ -136,8 +136,10 @@ void CheckSelfIntersections(const TriangleMesh& mesh, double tolerance_m,
   }
 }
 
-// Closed bodies (sets of triangles joined across edges) of negative volume. A body inside the
-// bounding box of one of positive volume is taken for a cavity, which faces inwards rightly.
+// Closed bodies (sets of triangles joined across edges) of negative volume, or of none. A body
+// inside the bounding box of one of positive volume is taken for a cavity, which faces inwards
+// rightly. Volumes are summed about a corner of the body, not the origin: a part far from the
+// origin keeps its digits.
 void CheckOrientation(const TriangleMesh& mesh, const MeshTopology& topo,
                       std::vector<MeshProblem>& problems) {
   const std::size_t n = mesh.triangles.size();
@@ -152,6 +154,7 @@ void CheckOrientation(const TriangleMesh& mesh, const MeshTopology& topo,
   for (std::size_t start = 0; start < n; ++start) {
     if (body[start] >= 0) continue;
     Body b{static_cast<int>(start), 0.0, Corner(mesh, int(start), 0), Corner(mesh, int(start), 0)};
+    const Eigen::Vector3d o = Corner(mesh, int(start), 0);
     body[start] = static_cast<int>(bodies.size());
     stack.assign(1, static_cast<int>(start));
     while (!stack.empty()) {
@@ -159,7 +162,7 @@ void CheckOrientation(const TriangleMesh& mesh, const MeshTopology& topo,
       stack.pop_back();
       const Eigen::Vector3d &p = Corner(mesh, t, 0), &q = Corner(mesh, t, 1),
                             &r = Corner(mesh, t, 2);
-      b.volume_m3 += p.dot(q.cross(r)) / 6.0;
+      b.volume_m3 += (p - o).dot((q - o).cross(r - o)) / 6.0;
       b.lo = b.lo.cwiseMin(p).cwiseMin(q).cwiseMin(r);
       b.hi = b.hi.cwiseMax(p).cwiseMax(q).cwiseMax(r);
       for (int u : topo.neighbour[std::size_t(t)])
@@ -171,6 +174,17 @@ void CheckOrientation(const TriangleMesh& mesh, const MeshTopology& topo,
     bodies.push_back(b);
   }
   for (const Body& b : bodies) {
+    // No volume to speak of: a billionth of its box's diagonal cubed, far below any real part's
+    // (a plate 0.1 mm thick and 100 mm square has 3.5e-4 of it).
+    const double diagonal_m = (b.hi - b.lo).norm();
+    if (std::abs(b.volume_m3) <= 1e-9 * diagonal_m * diagonal_m * diagonal_m) {
+      std::ostringstream m;
+      m.precision(6);
+      m << "the closed body of this triangle encloses no volume (" << b.volume_m3 * 1e9
+        << " mm^3): it is a sheet seen from both sides, expected a solid";
+      problems.push_back({MeshProblemKind::kFlat, b.first, -1, m.str()});
+      continue;
+    }
     if (b.volume_m3 >= 0.0) continue;
     const bool cavity = std::any_of(bodies.begin(), bodies.end(), [&](const Body& outer) {
       return outer.volume_m3 > 0.0 && (outer.lo.array() < b.lo.array()).all() &&

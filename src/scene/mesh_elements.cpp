@@ -139,6 +139,8 @@ void FindEdges(const TriangleMesh& mesh, const MeshTopology& topo,
     const int t = topo.edge_triangles[e][0], u = topo.edge_triangles[e][1];
     if (normals[std::size_t(t)].dot(normals[std::size_t(u)]) > cos_feature) continue;
     const int fa = out.triangle_face[std::size_t(t)], fb = out.triangle_face[std::size_t(u)];
+    // A crease that fades out inside one face (its sides joined round its end) bounds nothing.
+    if (fa == fb) continue;
     by_pair[{std::min(fa, fb), std::max(fa, fb)}].push_back(static_cast<int>(e));
     // Convex when the neighbour's far corner lies below this triangle's plane.
     const std::array<int, 3>& tu = mesh.triangles[std::size_t(u)];

@@ -368,15 +368,20 @@ TEST_CASE("Bad mesh files are reported at their place, all problems at once", "[
           "with 'solid' either, expected an ASCII or a binary STL\n");
   }
   SECTION("too many triangles") {
-    // 200,001 copies of one triangle: refused before welding, at the one too many.
+    // 200,001 copies of one triangle: a binary STL is refused by its header's count, before
+    // its records are parsed; an ASCII one at the one too many, before welding.
     std::vector<std::array<Eigen::Vector3d, 3>> many(
         tubeplan::scene::kMaxTriangles + 1,
         {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)});
     const MeshLoadResult r = LoadMeshBytes(tubeplan::testing::BinaryStl(many), "big.stl", 1.0);
     CHECK(Text(r) ==
-          "big.stl:1:10000085: error: triangle 200001 is one too many: the file has "
-          "200001 triangles, expected at most 200000 (simplify the mesh in its "
-          "export)\n");
+          "big.stl:1:81: error: the header counts 200001 triangles, expected at most 200000 "
+          "(simplify the mesh in its export)\n");
+    std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    for (std::size_t t = 0; t <= tubeplan::scene::kMaxTriangles; ++t) obj += "f 1 2 3\n";
+    CHECK(Text(LoadMeshBytes(obj, "big.obj", 1.0)) ==
+          "big.obj:200004:1: error: triangle 200001 is one too many: the file has 200001 "
+          "triangles, expected at most 200000 (simplify the mesh in its export)\n");
   }
   SECTION("neither format") {
     const MeshLoadResult r = LoadMeshBytes("v 0 0 0\n", "cube.ply", 1.0);
@@ -384,4 +389,17 @@ TEST_CASE("Bad mesh files are reported at their place, all problems at once", "[
           "cube.ply: error: the extension '.ply' names no mesh format, expected .obj "
           "or .stl\n");
   }
+}
+
+TEST_CASE("A mesh far from the origin welds without overflowing its grid", "[mesh]") {
+  // 1e28 mm out, 1 mm across: the weld grid's cell (2e-6 of the diagonal) is 1e31 times finer
+  // than the distance to the origin, so cells are counted from the mesh's own low corner.
+  const std::string obj = "v 1e28 0 0\nv 1e28 1 0\nv 1e28 0 1\nv 1e28 0 0\nf 1 2 3\nf 4 3 2\n";
+  const MeshLoadResult r = LoadMeshBytes(obj, "far.obj", 1e-3);
+  CHECK_FALSE(r.mesh.has_value());
+  // Vertices 1 and 4 weld into one: the two triangles are then one sheet seen from both sides,
+  // closed but holding no volume.
+  CHECK(r.diagnostics.FormatAll() ==
+        "far.obj:5:1: error: the closed body of this triangle encloses no volume (0 mm^3): it is "
+        "a sheet seen from both sides, expected a solid\n");
 }

@@ -52,6 +52,7 @@ enum class MeshProblemKind {
   kNonManifoldEdge,      ///< an edge of more than two triangles
   kInconsistentWinding,  ///< two neighbours that run their shared edge the same way
   kInverted,             ///< a closed body of negative volume: its normals point inwards
+  kFlat,                 ///< a closed body of no volume: a sheet seen from both sides
   kSelfIntersection,     ///< two triangles that share no vertex cross each other
 };
 
