@@ -103,11 +103,6 @@ std::optional<scene::Friction> ReadFriction(Reader& r, const YAML::Node& node,
   return ok ? std::optional(f) : std::nullopt;
 }
 
-bool PointInside(const scene::Part& box, const Eigen::Vector3d& p_W, double tolerance_m) {
-  const Eigen::Vector3d p_P = box.X_WP.inverse() * p_W;
-  return ((box.size_m / 2.0).array() - p_P.cwiseAbs().array() > tolerance_m).all();
-}
-
 constexpr double kGeometryTolerance_m = 1e-9;
 
 // The most parts a scene may hold (docs/scene-format.md): the core compares the tube with every
@@ -502,7 +497,7 @@ void ReadStart(Reader& r, const YAML::Node& st, scene::Scene& s, bool parts_ok,
   if (rpy_ok) start_mark = n.Mark();
   if (!parts_ok) return;
   for (std::size_t i = 0; i < s.parts.size(); ++i) {
-    if (!PointInside(s.parts[i], *p, kGeometryTolerance_m)) continue;
+    if (!scene::Contains(s.parts[i], *p, kGeometryTolerance_m)) continue;
     held_end_inside[i] = true;
     r.Error(n, "start.position is inside part '" + s.parts[i].name +
                    "', expected the held end outside every part");

@@ -217,12 +217,12 @@ std::optional<double> StraightTubeOverlap(const Eigen::Isometry3d& X_WH, double 
   return depth_m;
 }
 
-bool Contains(const Part& part, const Eigen::Vector3d& p_W) {
+bool Contains(const Part& part, const Eigen::Vector3d& p_W, double margin_m) {
   const Eigen::Vector3d p_P = part.X_WP.inverse() * p_W;
+  const Eigen::Vector3d half = 0.5 * part.size_m;
   if (part.shape == PartShape::kCylinder)
-    return p_P.head<2>().norm() < 0.5 * part.size_m.x() &&
-           std::abs(p_P.z()) < 0.5 * part.size_m.z();
-  return (p_P.cwiseAbs().array() < 0.5 * part.size_m.array()).all();
+    return half.x() - p_P.head<2>().norm() > margin_m && half.z() - std::abs(p_P.z()) > margin_m;
+  return (half.array() - p_P.cwiseAbs().array() > margin_m).all();
 }
 
 ElementPoint PointOnElement(const Part& part, std::uint8_t face_mask,

@@ -475,3 +475,23 @@ TEST_CASE("A part's shape is exactly one box or one cylinder of positive size", 
       CHECK_THAT(got, Catch::StartsWith(c.expected));
   }
 }
+
+TEST_CASE("The held end is inside a cylinder by its round side, not by its box", "[scene]") {
+  // A post standing along z, 10 mm round, in place of the wall; the held end beside it, within
+  // its bounding box's corner but 13 mm from its axis, the tube pointing away along +x: valid.
+  // 3.6 mm from the axis instead: inside the post.
+  const auto with_start = [](const std::string& position) {
+    std::string text =
+        WithLine(9, "    cylinder: {radius: 10 mm, length: 20 mm, position: [15 mm, 0, 50 mm]}");
+    text.erase(text.find("start:"));
+    return text + "start: {position: " + position + ", rpy: [0, 90 deg, 0]}\n" +
+           "goal: \"{Fs - floor.top}\"\n";
+  };
+  const auto beside = LoadSceneText(with_start("[24 mm, 9.5 mm, 45 mm]"), "t.yaml");
+  CHECK(beside.diagnostics.FormatAll() == "");
+  CHECK(beside.scene.has_value());
+  const auto inside = LoadSceneText(with_start("[17 mm, 3 mm, 45 mm]"), "t.yaml");
+  CHECK_THAT(inside.diagnostics.FormatAll(),
+             Catch::Contains("start.position is inside part 'wall', expected the held end "
+                             "outside every part"));
+}

@@ -39,8 +39,8 @@ std::vector<std::pair<std::size_t, std::size_t>> OverlappingParts(std::span<cons
 std::optional<double> StraightTubeOverlap(const Eigen::Isometry3d& X_WH, double radius_m,
                                           double length_m, const Part& part, double tolerance_m);
 
-/// Whether p_W lies strictly inside the part.
-bool Contains(const Part& part, const Eigen::Vector3d& p_W);
+/// Whether p_W lies inside the part by more than `margin_m` (0: strictly inside).
+bool Contains(const Part& part, const Eigen::Vector3d& p_W, double margin_m = 0.0);
 
 /// A point on an element of a part and the element's outward direction there.
 struct ElementPoint {
