@@ -51,11 +51,23 @@ void AddCylinderElements(const Part& part, std::uint32_t p, std::vector<PartElem
   }
 }
 
+// A mesh's elements, as its file cut them (scene::FindElements): faces, edges, vertices.
+void AddMeshElements(const Part& part, std::uint32_t p, std::vector<PartElement>& elements) {
+  const MeshElements& m = part.mesh->elements;
+  const std::string prefix = part.name + ".";
+  for (const MeshFace& f : m.faces) elements.push_back({p, ElementKind::kFace, 0, prefix + f.name});
+  for (const MeshEdge& e : m.edges) elements.push_back({p, ElementKind::kEdge, 0, prefix + e.name});
+  for (const MeshVertex& v : m.vertices)
+    elements.push_back({p, ElementKind::kVertex, 0, prefix + v.name});
+}
+
 }  // namespace
 
 std::vector<PartElement> ElementsOf(const Part& part, std::uint32_t part_index) {
   std::vector<PartElement> elements;
-  if (part.shape == PartShape::kCylinder)
+  if (part.shape == PartShape::kMesh)
+    AddMeshElements(part, part_index, elements);
+  else if (part.shape == PartShape::kCylinder)
     AddCylinderElements(part, part_index, elements);
   else
     AddBoxElements(part, part_index, elements);

@@ -28,6 +28,26 @@ Part MakeCylinder(std::string name, double radius_m, double length_m,
   return part;
 }
 
+Eigen::AlignedBox3d BoundsInPart(const Part& part) {
+  if (part.shape == PartShape::kMesh && part.mesh) {
+    Eigen::AlignedBox3d box;
+    for (const Eigen::Vector3d& v : part.mesh->mesh.vertices_P_m) box.extend(v);
+    return box;
+  }
+  return {-0.5 * part.size_m, 0.5 * part.size_m};
+}
+
+Part MakeMeshPart(std::string name, std::shared_ptr<const PartMesh> mesh,
+                  const Eigen::Isometry3d& X_WP) {
+  Part part;
+  part.name = std::move(name);
+  part.shape = PartShape::kMesh;
+  part.mesh = std::move(mesh);
+  part.size_m = BoundsInPart(part).sizes();
+  part.X_WP = X_WP;
+  return part;
+}
+
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index) {
   const auto& own = scene.parts.at(part_index).friction;
   return own ? *own : scene.friction;

@@ -3,7 +3,8 @@
 // is "part.face"; an edge joins its two faces' names with '_' and a vertex its three, in the
 // order of BoxFace (top/bottom, then x faces, then y faces): "left.top", "left.top_xpos",
 // "left.top_xpos_ypos" — or, with the scene's face names, "left.top_inner". A cylinder has 3
-// faces (top, bottom, side) and 2 edges, its rims: "post.top_side", "post.bottom_side".
+// faces (top, bottom, side) and 2 edges, its rims: "post.top_side", "post.bottom_side". A mesh
+// has the faces, edges and vertices its file cuts it into (docs/meshes.md): "clip.floor".
 
 #include <cstdint>
 #include <string>
@@ -19,8 +20,9 @@ enum class ElementKind : unsigned char { kFace, kEdge, kVertex };
 struct PartElement {
   std::uint32_t part_index = 0;
   ElementKind kind = ElementKind::kFace;
-  std::uint8_t face_mask = 0;  ///< bit i set: the element lies on face i (BoxFace, CylinderFace)
-  std::string name;            ///< "part.element"
+  /// Bit i set: the element lies on face i (BoxFace, CylinderFace); 0 on a mesh.
+  std::uint8_t face_mask = 0;
+  std::string name;  ///< "part.element"
 };
 
 /// Every element of every part, in part order, then faces, edges, vertices.

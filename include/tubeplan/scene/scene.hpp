@@ -3,6 +3,7 @@
 // loader (io/scene_yaml.hpp) or in code (tests); defaults in member initialisers.
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
@@ -13,6 +14,7 @@
 
 #include <tubeplan/model/tip_response.hpp>
 #include <tubeplan/model/tube.hpp>
+#include <tubeplan/scene/mesh.hpp>
 #include <tubeplan/states/contact_formation.hpp>
 
 namespace tubeplan::scene {
@@ -47,20 +49,38 @@ inline constexpr std::array<const char*, 3> kCylinderFaceIds = {"top", "bottom",
 enum class PartShape {
   kBox,       ///< six flat faces, twelve edges, eight vertices
   kCylinder,  ///< along its frame's z: a flat top and bottom, a round side, two rims
+  kMesh,      ///< a closed triangle mesh read from a file, cut into faces, edges and vertices
+};
+
+/// A mesh part's surface: the welded, checked mesh in the part's frame P [m] and its elements
+/// (io::LoadMeshFile makes both).
+struct PartMesh {
+  std::string file;  ///< the file as the scene names it
+  TriangleMesh mesh;
+  MeshElements elements;
 };
 
 struct Part {
   std::string name;  ///< [A-Za-z][A-Za-z0-9_]*
   PartShape shape = PartShape::kBox;
   /// Full extents along the part frame's x, y, z [m]: a box's sides; a cylinder's diameter twice,
-  /// then its length.
+  /// then its length; a mesh's bounding box in P (which need not be centred on P's origin).
   Eigen::Vector3d size_m = Eigen::Vector3d::Zero();
   Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();  ///< part centre frame P in world W
   std::optional<Friction> friction;  ///< overrides the scene's friction if set
   /// Name of each face, indexed by BoxFace or CylinderFace: the shape's face ids unless the
   /// scene renames them (a cylinder uses the first three).
   std::array<std::string, 6> face_names = {"top", "bottom", "xpos", "xneg", "ypos", "yneg"};
+  /// A mesh part's surface, shared by copies of the scene; null for the other shapes.
+  std::shared_ptr<const PartMesh> mesh;
 };
+
+/// The part's bounding box in its own frame P: centred on P's origin for a box or a cylinder.
+Eigen::AlignedBox3d BoundsInPart(const Part& part);
+
+/// A mesh part named `name` placed at X_WP: its size is its bounding box's.
+Part MakeMeshPart(std::string name, std::shared_ptr<const PartMesh> mesh,
+                  const Eigen::Isometry3d& X_WP);
 
 /// The ids of a shape's faces, in the order of BoxFace or CylinderFace.
 std::span<const char* const> FaceIds(PartShape shape);
