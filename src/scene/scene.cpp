@@ -37,6 +37,17 @@ Eigen::AlignedBox3d BoundsInPart(const Part& part) {
   return {-0.5 * part.size_m, 0.5 * part.size_m};
 }
 
+std::shared_ptr<const PartMesh> MakePartMesh(std::string file, TriangleMesh mesh,
+                                             MeshElements elements) {
+  auto part_mesh = std::make_shared<PartMesh>();
+  part_mesh->file = std::move(file);
+  part_mesh->mesh = std::move(mesh);
+  part_mesh->elements = std::move(elements);
+  part_mesh->distance_P =
+      MeshGeometry(part_mesh->mesh, part_mesh->elements, Eigen::Isometry3d::Identity());
+  return part_mesh;
+}
+
 Part MakeMeshPart(std::string name, std::shared_ptr<const PartMesh> mesh,
                   const Eigen::Isometry3d& X_WP) {
   Part part;

@@ -15,6 +15,7 @@
 #include <tubeplan/model/tip_response.hpp>
 #include <tubeplan/model/tube.hpp>
 #include <tubeplan/scene/mesh.hpp>
+#include <tubeplan/scene/mesh_distance.hpp>
 #include <tubeplan/states/contact_formation.hpp>
 
 namespace tubeplan::scene {
@@ -52,13 +53,18 @@ enum class PartShape {
   kMesh,      ///< a closed triangle mesh read from a file, cut into faces, edges and vertices
 };
 
-/// A mesh part's surface: the welded, checked mesh in the part's frame P [m] and its elements
-/// (io::LoadMeshFile makes both).
+/// A mesh part's surface: the welded, checked mesh in the part's frame P [m], its elements
+/// (io::LoadMeshFile makes both) and its distance queries in P (MakePartMesh builds them).
 struct PartMesh {
   std::string file;  ///< the file as the scene names it
   TriangleMesh mesh;
   MeshElements elements;
+  MeshGeometry distance_P;  ///< placed at the identity: query it with points in P
 };
+
+/// A PartMesh of a sound mesh (CheckMesh found nothing) and its elements, its queries built.
+std::shared_ptr<const PartMesh> MakePartMesh(std::string file, TriangleMesh mesh,
+                                             MeshElements elements);
 
 struct Part {
   std::string name;  ///< [A-Za-z][A-Za-z0-9_]*
