@@ -160,17 +160,45 @@ class Finder {
   // can find near a piece of the tube.
   void FindEdgesNear(const PartModel& part, const Vec3& lo, const Vec3& hi) {
     edge_count_ = 0;
-    const auto& edges = part.geometry.edges();
-    for (int e = 0; e < int(edges.size()); ++e) {
-      const PartEdge& edge = edges[std::size_t(e)];
-      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
-        continue;
-      d_.scratch.edges_near[std::size_t(edge_count_++)] = e;
-    }
+    part.geometry.EdgesOverlapping(
+        lo, hi, [&](int e) { d_.scratch.edges_near[std::size_t(edge_count_++)] = e; });
+    std::sort(d_.scratch.edges_near.begin(), d_.scratch.edges_near.begin() + edge_count_);
   }
 
   std::span<const int> EdgesNear() const {
     return {d_.scratch.edges_near.data(), std::size_t(edge_count_)};
+  }
+
+  // Of each curved face's ridges near the segment p0..p1 (a piece of the tube's axis), the one
+  // nearest it: the only one of that face to bear on the piece (PartEdge::ridge).
+  void FindNearestRidges(const PartModel& part, const Vec3& p0, const Vec3& p1) {
+    ridge_count_ = 0;
+    const auto& edges = part.geometry.edges();
+    for (const int e : EdgesNear()) {
+      const PartEdge& edge = edges[std::size_t(e)];
+      if (!edge.ridge) continue;
+      double theta = 0.0, u = 0.0;
+      ClosestSegmentPoints(p0, p1, edge.a_W, edge.b_W, theta, u);
+      const double gap_m = (p0 + theta * (p1 - p0) - edge.a_W - u * (edge.b_W - edge.a_W)).norm();
+      int k = 0;
+      while (k < ridge_count_ && nearest_ridges_[std::size_t(k)].element != edge.element) ++k;
+      if (k == ridge_count_) {
+        // More curved faces near one piece than the table holds: their ridges all bear.
+        if (k == int(nearest_ridges_.size())) continue;
+        nearest_ridges_[std::size_t(ridge_count_++)] = {edge.element, e, gap_m};
+      } else if (gap_m < nearest_ridges_[std::size_t(k)].gap_m) {
+        nearest_ridges_[std::size_t(k)] = {edge.element, e, gap_m};
+      }
+    }
+  }
+
+  // Whether edge e may bear on the piece FindNearestRidges looked at.
+  bool Bears(const PartEdge& edge, int e) const {
+    if (!edge.ridge) return true;
+    for (int k = 0; k < ridge_count_; ++k)
+      if (nearest_ridges_[std::size_t(k)].element == edge.element)
+        return nearest_ridges_[std::size_t(k)].edge == e;
+    return true;
   }
 
   // Notes node i's clearance: its centre's distance to a part, less the radius.
@@ -405,9 +433,11 @@ class Finder {
     const double theta_lo = i == n_ - 1 && n_ > 1 ? 0.5 : 0.0;
     const double theta_hi = i == 0 && n_ > 1 ? 0.5 : 1.0;
     const auto& edges = part.geometry.edges();
+    FindNearestRidges(part, a, b);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
+      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any() ||
+          !Bears(edge, e))
         continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
@@ -493,9 +523,11 @@ class Finder {
     // distance from it (the piece's middle).
     const double bulge = 0.5 * (x1 - 0.5 * (m0 + m1)).norm();
     const auto& edges = part.geometry.edges();
+    FindNearestRidges(part, m0, m1);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any())
+      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any() ||
+          !Bears(edge, e))
         continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(m0, m1, edge.a_W, edge.b_W, theta, u);
@@ -631,6 +663,13 @@ class Finder {
   int n_;
   bool keep_;
   int edge_count_ = 0;  ///< the part's edges FindEdgesNear found, in Scratch::edges_near
+  struct NearestRidge {
+    ElementIndex element = kNoElement;
+    int edge = 0;
+    double gap_m = 0.0;
+  };
+  std::array<NearestRidge, 8> nearest_ridges_{};  ///< FindNearestRidges' answer, per face
+  int ridge_count_ = 0;
 };
 
 }  // namespace

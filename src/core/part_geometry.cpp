@@ -1,7 +1,9 @@
 #include "core/part_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <tubeplan/scene/elements.hpp>
 
@@ -26,17 +28,89 @@ PartGeometry::PartGeometry(const scene::Part& part)
       R_WP_(part.X_WP.linear()),
       p_WP_(part.X_WP.translation()),
       half_m_(0.5 * part.size_m) {
-  // Element indices are positions among the part's elements, each named by its faces' bits.
-  element_of_mask_.fill(kNoElement);
-  for (const scene::PartElement& e : scene::ElementsOf(part, 0)) {
-    element_of_mask_[e.face_mask] = ElementIndex(mask_of_element_.size());
-    mask_of_element_.push_back(e.face_mask);
+  if (shape_ == scene::PartShape::kMesh) {
+    mesh_ = part.mesh;
+    BuildMesh();
+  } else {
+    // Element indices are positions among the part's elements, each named by its faces' bits.
+    element_of_mask_.fill(kNoElement);
+    for (const scene::PartElement& e : scene::ElementsOf(part, 0)) {
+      element_of_mask_[e.face_mask] = ElementIndex(mask_of_element_.size());
+      mask_of_element_.push_back(e.face_mask);
+    }
+    if (shape_ == scene::PartShape::kCylinder)
+      BuildCylinder();
+    else
+      BuildBox();
+    thinnest_m_ = 2.0 * half_m_.minCoeff();
   }
-  if (shape_ == scene::PartShape::kCylinder)
-    BuildCylinder();
-  else
-    BuildBox();
+  std::vector<Eigen::Vector3d> lo, hi;
+  for (const PartEdge& edge : edges_) {
+    lo.push_back(edge.min_W);
+    hi.push_back(edge.max_W);
+  }
+  edge_tree_ = scene::AabbTree(lo, hi);
 }
+
+bool PartGeometry::Bounds(ElementIndex a, ElementIndex b) const {
+  if (mesh_ == nullptr) return (mask_of_element_[a] & mask_of_element_[b]) == mask_of_element_[b];
+  const std::vector<int>& fa = faces_of_element_[a];
+  const std::vector<int>& fb = faces_of_element_[b];
+  return std::includes(fa.begin(), fa.end(), fb.begin(), fb.end());
+}
+
+namespace {
+
+// The thickness of a mesh's thinnest wall, seen from each face's largest triangle: how far a
+// point goes in from its centre along the inward normal before it leaves the part. Found by
+// steps of 1/256 of the box's diagonal, then halving the step it leaves in to a micrometre.
+double ThinnestWall_m(const scene::PartMesh& part) {
+  const scene::TriangleMesh& mesh = part.mesh;
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : mesh.vertices_P_m) box.extend(v);
+  const double step_m = box.diagonal().norm() / 256.0;
+  double thinnest_m = std::numeric_limits<double>::infinity();
+  for (const scene::MeshFace& face : part.elements.faces) {
+    int largest = face.triangles.front();
+    double largest_area = 0.0;
+    for (const int t : face.triangles) {
+      const auto& tri = mesh.triangles[std::size_t(t)];
+      const Eigen::Vector3d& a = mesh.vertices_P_m[std::size_t(tri[0])];
+      const double area = (mesh.vertices_P_m[std::size_t(tri[1])] - a)
+                              .cross(mesh.vertices_P_m[std::size_t(tri[2])] - a)
+                              .norm();
+      if (area > largest_area) {
+        largest_area = area;
+        largest = t;
+      }
+    }
+    const auto& tri = mesh.triangles[std::size_t(largest)];
+    const Eigen::Vector3d centre =
+        (mesh.vertices_P_m[std::size_t(tri[0])] + mesh.vertices_P_m[std::size_t(tri[1])] +
+         mesh.vertices_P_m[std::size_t(tri[2])]) /
+        3.0;
+    const Eigen::Vector3d inward = -scene::TriangleNormal(mesh, largest);
+    const auto inside = [&](double t) {
+      return part.distance_P.Distance(centre + t * inward).distance_m < 0.0;
+    };
+    double in_m = 0.0, out_m = step_m;
+    while (out_m < 2.0 * box.diagonal().norm() && inside(out_m)) {
+      in_m = out_m;
+      out_m += step_m;
+    }
+    while (out_m - in_m > 1e-6) {
+      const double mid_m = 0.5 * (in_m + out_m);
+      if (inside(mid_m))
+        in_m = mid_m;
+      else
+        out_m = mid_m;
+    }
+    thinnest_m = std::min(thinnest_m, out_m);
+  }
+  return thinnest_m;
+}
+
+}  // namespace
 
 void PartGeometry::BuildBox() {
   vertices_W_.resize(8);
@@ -125,7 +199,118 @@ void PartGeometry::BuildCylinder() {
   edges_.push_back(axis);
 }
 
+void PartGeometry::BuildMesh() {
+  const scene::MeshElements& el = mesh_->elements;
+  const int faces = int(el.faces.size()), edges = int(el.edges.size());
+  for (int f = 0; f < faces; ++f) faces_of_element_.push_back({f});
+  for (const scene::MeshEdge& edge : el.edges)
+    faces_of_element_.push_back(
+        {std::min(edge.face_a, edge.face_b), std::max(edge.face_a, edge.face_b)});
+  for (const scene::MeshVertex& vertex : el.vertices) faces_of_element_.push_back(vertex.faces);
+  min_W_.setConstant(std::numeric_limits<double>::infinity());
+  max_W_ = -min_W_;
+  for (const Eigen::Vector3d& v_P : mesh_->mesh.vertices_P_m) {
+    const Eigen::Vector3d v_W = p_WP_ + R_WP_ * v_P;
+    min_W_ = min_W_.cwiseMin(v_W);
+    max_W_ = max_W_.cwiseMax(v_W);
+  }
+  AddMeshEdges();
+  // The corners that poke: feature vertices none of whose feature edges is concave.
+  std::vector<char> concave(mesh_->mesh.vertices_P_m.size(), 0);
+  for (const scene::MeshEdge& edge : el.edges)
+    if (!edge.convex)
+      for (const auto& segment : edge.segments)
+        concave[std::size_t(segment[0])] = concave[std::size_t(segment[1])] = 1;
+  for (int v = 0; v < int(el.vertices.size()); ++v) {
+    const scene::MeshVertex& vertex = el.vertices[std::size_t(v)];
+    if (concave[std::size_t(vertex.mesh_vertex)]) continue;
+    vertices_W_.push_back(p_WP_ + R_WP_ * vertex.position_P_m);
+    vertex_elements_.push_back(ElementIndex(faces + edges + v));
+  }
+  thinnest_m_ = ThinnestWall_m(*mesh_);
+}
+
+void PartGeometry::AddMeshEdges() {
+  const scene::TriangleMesh& mesh = mesh_->mesh;
+  const scene::MeshElements& el = mesh_->elements;
+  const int faces = int(el.faces.size()), edges = int(el.edges.size());
+  // The triangles on either side of each mesh edge (the mesh is closed and manifold: two).
+  std::map<std::pair<int, int>, std::vector<int>> sides;
+  for (int t = 0; t < int(mesh.triangles.size()); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.triangles[std::size_t(t)][std::size_t(k)];
+      const int b = mesh.triangles[std::size_t(t)][std::size_t((k + 1) % 3)];
+      sides[{std::min(a, b), std::max(a, b)}].push_back(t);
+    }
+  // A point where segments meet is borne once: at a feature vertex by every edge that ends
+  // there (as a box's corner is), elsewhere by the first segment to reach it.
+  std::vector<int> bearer(mesh.vertices_P_m.size(), -1);
+  const auto add = [&](int va, int vb, ElementIndex element, bool ridge) {
+    const std::vector<int>& ts = sides.at({std::min(va, vb), std::max(va, vb)});
+    const int index = int(edges_.size());
+    PartEdge edge;
+    edge.a_W = p_WP_ + R_WP_ * mesh.vertices_P_m[std::size_t(va)];
+    edge.b_W = p_WP_ + R_WP_ * mesh.vertices_P_m[std::size_t(vb)];
+    edge.min_W = edge.a_W.cwiseMin(edge.b_W);
+    edge.max_W = edge.a_W.cwiseMax(edge.b_W);
+    edge.element = element;
+    edge.ridge = ridge;
+    for (const int v : {va, vb}) {
+      const int feature = el.vertex_element[std::size_t(v)];
+      const bool bears = feature >= 0 || bearer[std::size_t(v)] < 0;
+      if (feature < 0 && bearer[std::size_t(v)] < 0) bearer[std::size_t(v)] = index;
+      const ElementIndex at = feature >= 0 ? ElementIndex(faces + edges + feature) : element;
+      (v == va ? edge.a_bears : edge.b_bears) = bears;
+      (v == va ? edge.a_element : edge.b_element) = at;
+    }
+    edge.face_normals_W = {R_WP_ * scene::TriangleNormal(mesh, ts[0]),
+                           R_WP_ * scene::TriangleNormal(mesh, ts[1])};
+    edges_.push_back(edge);
+  };
+  for (int e = 0; e < edges; ++e) {
+    const scene::MeshEdge& edge = el.edges[std::size_t(e)];
+    if (!edge.convex) continue;
+    for (const auto& segment : edge.segments)
+      add(segment[0], segment[1], ElementIndex(faces + e), false);
+  }
+  // A curved face's ridges: its triangles' edges that turn convex by more than a flat face's
+  // tolerance. They poke as the tessellated surface does, as part of the face.
+  const double flat_cos = std::cos(scene::kPlanarAngle_deg * M_PI / 180.0);
+  for (const auto& [key, ts] : sides) {
+    if (ts.size() != 2) continue;
+    const int t0 = ts[0], t1 = ts[1];
+    const int face = el.triangle_face[std::size_t(t0)];
+    if (face != el.triangle_face[std::size_t(t1)]) continue;
+    const Eigen::Vector3d n0 = scene::TriangleNormal(mesh, t0);
+    if (n0.dot(scene::TriangleNormal(mesh, t1)) > flat_cos) continue;
+    // Convex: the far corner of the second triangle lies behind the first's plane.
+    int far = 0;
+    for (const int v : mesh.triangles[std::size_t(t1)])
+      if (v != key.first && v != key.second) far = v;
+    const Eigen::Vector3d& a = mesh.vertices_P_m[std::size_t(key.first)];
+    if ((mesh.vertices_P_m[std::size_t(far)] - a).dot(n0) >= 0.0) continue;
+    add(key.first, key.second, ElementIndex(face), true);
+  }
+}
+
+PartDistance PartGeometry::MeshDistance(const Eigen::Vector3d& p_W) const {
+  const scene::MeshDistance m = mesh_->distance_P.Distance(R_WP_.transpose() * (p_W - p_WP_));
+  const scene::MeshElements& el = mesh_->elements;
+  PartDistance r;
+  r.distance_m = m.distance_m;
+  r.normal_W = R_WP_ * m.normal_W;
+  r.point_W = p_WP_ + R_WP_ * m.point_W;
+  r.curvature_per_m = R_WP_ * m.curvature_per_m * R_WP_.transpose();
+  const int base = m.feature.kind == scene::MeshFeatureKind::kFace ? 0
+                   : m.feature.kind == scene::MeshFeatureKind::kEdge
+                       ? int(el.faces.size())
+                       : int(el.faces.size() + el.edges.size());
+  r.element = ElementIndex(base + m.feature.index);
+  return r;
+}
+
 PartDistance PartGeometry::Distance(const Eigen::Vector3d& p_W, ElementIndex entry) const {
+  if (mesh_ != nullptr) return MeshDistance(p_W);
   const Eigen::Vector3d p_P = R_WP_.transpose() * (p_W - p_WP_);
   const std::uint8_t entry_mask = entry == kNoElement ? 0 : mask_of_element_[entry];
   std::uint8_t mask = 0;

@@ -1,17 +1,20 @@
 #pragma once
 // The rigid parts as the contact stage sees them: a signed distance with its gradient and the
 // element (face, edge, vertex) the nearest point lies on, and the sharp features (edges as
-// segments, vertices as points) that can poke into the tube between its sections. Boxes and
-// cylinders; a cylinder's rims are polygons of short segments and its side bears on the tube
-// between sections as its axis does, grown by its radius.
+// segments, vertices as points) that can poke into the tube between its sections. Boxes,
+// cylinders and meshes; a cylinder's rims are polygons of short segments and its side bears on
+// the tube between sections as its axis does, grown by its radius. A mesh's convex edges poke
+// as chains of its triangles' edges, its convex corners as points.
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <tubeplan/scene/aabb_tree.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 namespace tubeplan::core {
@@ -44,6 +47,10 @@ struct PartEdge {
   /// A round side is its axis as an edge with the side's radius: the surface lies this far from
   /// the segment [m]; 0 for a sharp edge.
   double radius_m = 0.0;
+  /// A ridge of a curved mesh face, between two of its triangles: of a face's ridges, only the
+  /// one nearest a piece of the tube bears on that piece, as the one nearest point of a smooth
+  /// surface would (parallel ridges within epsilon would otherwise add their stiffnesses).
+  bool ridge = false;
   /// The outward unit normals of the two faces that meet at it (zero for a round side's axis:
   /// it bears all round).
   std::array<Eigen::Vector3d, 2> face_normals_W{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
@@ -57,33 +64,40 @@ class PartGeometry {
   /// Signed distance of p_W to the part. Inside, the distance is to the faces of the element
   /// `entry` when it names one (where the point came in: a thin box is not crossed by pushing
   /// a point past its middle), else to the nearest face. A point pushed past a cylinder's axis
-  /// leaves by the side nearest it: a push beyond K (eps + R) can cross a cylinder, as `check`
-  /// warns for thin parts.
+  /// or a mesh's middle leaves by the surface nearest it: a push beyond K (eps + half the
+  /// thickness) can cross such a part, as `check` warns for thin parts.
   PartDistance Distance(const Eigen::Vector3d& p_W, ElementIndex entry = kNoElement) const;
 
   const std::vector<PartEdge>& edges() const { return edges_; }
+  /// Calls visit(e) for the index of every edge whose box meets [lo_W, hi_W], in no set order.
+  template <class Visit>
+  void EdgesOverlapping(const Eigen::Vector3d& lo_W, const Eigen::Vector3d& hi_W,
+                        Visit&& visit) const {
+    edge_tree_.Overlapping(lo_W, hi_W, visit);
+  }
   const std::vector<Eigen::Vector3d>& vertices_W() const { return vertices_W_; }
   const std::vector<ElementIndex>& vertex_elements() const { return vertex_elements_; }
   /// Whether element a lies on element b's boundary or is b (an edge bounds its faces, a vertex
   /// its edges and faces).
-  bool Bounds(ElementIndex a, ElementIndex b) const {
-    return (mask_of_element_[a] & mask_of_element_[b]) == mask_of_element_[b];
-  }
+  bool Bounds(ElementIndex a, ElementIndex b) const;
   const Eigen::Vector3d& min_W() const { return min_W_; }
   const Eigen::Vector3d& max_W() const { return max_W_; }
-  /// The smallest of the part's three extents [m].
-  double thinnest_m() const { return 2.0 * half_m_.minCoeff(); }
+  /// The smallest of a box's or a cylinder's three extents, a mesh's thinnest wall [m].
+  double thinnest_m() const { return thinnest_m_; }
 
  private:
   // Boxes and cylinders name their elements by the faces they lie on (BoxFace, CylinderFace
   // bits): what the shapes' own code works in, turned into element indices at the surface.
   void BuildBox();
   void BuildCylinder();
+  void BuildMesh();
+  void AddMeshEdges();
   PartDistance BoxDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
                            std::uint8_t& mask) const;
   PartDistance CylinderDistance(const Eigen::Vector3d& p_P, std::uint8_t entry_mask,
                                 std::uint8_t& mask) const;
   ElementIndex ElementOfMask(std::uint8_t mask) const { return element_of_mask_[mask]; }
+  PartDistance MeshDistance(const Eigen::Vector3d& p_W) const;
 
   scene::PartShape shape_ = scene::PartShape::kBox;
   Eigen::Matrix3d R_WP_ = Eigen::Matrix3d::Identity();
@@ -94,6 +108,12 @@ class PartGeometry {
   std::vector<ElementIndex> vertex_elements_;
   std::array<ElementIndex, 64> element_of_mask_{};
   std::vector<std::uint8_t> mask_of_element_;
+  std::shared_ptr<const scene::PartMesh> mesh_;
+  /// A mesh element's faces (indices into MeshElements::faces), ascending: a face's one, an
+  /// edge's two, a vertex's all.
+  std::vector<std::vector<int>> faces_of_element_;
+  scene::AabbTree edge_tree_;
+  double thinnest_m_ = 0.0;
   Eigen::Vector3d min_W_ = Eigen::Vector3d::Zero(), max_W_ = Eigen::Vector3d::Zero();
 };
 
