@@ -125,23 +125,9 @@ class Finder {
     s.sample_count = 0;
     s.samples_truncated = false;
     std::fill(s.clearance_m.begin(), s.clearance_m.end(), s.far_clearance_m);
-    // The tube's box, grown by what a side point reaches: it holds every element's and curve
-    // piece's box that Side and Curve test an edge against (all space for nodes not finite).
-    Vec3 lo = x_[0], hi = x_[0];
-    bool finite = true;
-    for (const Vec3& x : x_) {
-      lo = lo.cwiseMin(x);
-      hi = hi.cwiseMax(x);
-      finite = finite && x.allFinite();
-    }
-    const double reach_m = finite ? m_.rod.outer_radius_m + m_.contact.threshold_m
-                                  : std::numeric_limits<double>::infinity();
-    lo.array() -= reach_m;
-    hi.array() += reach_m;
     for (int p = 0; p < int(m_.parts.size()); ++p) {
       if (!s.parts_near[std::size_t(p)]) continue;
       const PartModel& part = m_.parts[std::size_t(p)];
-      FindEdgesNear(part, lo, hi);
       // The held end's section, the spheres at the inner nodes, the end elements' outer halves
       // and the smooth side between them against edges, the free end's rim and end face; each
       // notes its node's clearance for the solve's step.
@@ -156,8 +142,8 @@ class Finder {
   }
 
  private:
-  // The part's edges whose boxes meet the box lo..hi, in order: the only ones Side and Curve
-  // can find near a piece of the tube.
+  // The part's edges whose boxes meet the box lo..hi of a piece of the tube, in order: the only
+  // ones Side and Curve can find near it.
   void FindEdgesNear(const PartModel& part, const Vec3& lo, const Vec3& hi) {
     edge_count_ = 0;
     part.geometry.EdgesOverlapping(
@@ -433,12 +419,11 @@ class Finder {
     const double theta_lo = i == n_ - 1 && n_ > 1 ? 0.5 : 0.0;
     const double theta_hi = i == 0 && n_ > 1 ? 0.5 : 1.0;
     const auto& edges = part.geometry.edges();
+    FindEdgesNear(part, lo, hi);
     FindNearestRidges(part, a, b);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any() ||
-          !Bears(edge, e))
-        continue;
+      if (!Bears(edge, e)) continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
       if ((u == 0.0 && !edge.a_bears) || (u == 1.0 && !edge.b_bears)) continue;
@@ -523,12 +508,11 @@ class Finder {
     // distance from it (the piece's middle).
     const double bulge = 0.5 * (x1 - 0.5 * (m0 + m1)).norm();
     const auto& edges = part.geometry.edges();
+    FindEdgesNear(part, lo, hi);
     FindNearestRidges(part, m0, m1);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if ((edge.min_W.array() > hi.array()).any() || (edge.max_W.array() < lo.array()).any() ||
-          !Bears(edge, e))
-        continue;
+      if (!Bears(edge, e)) continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(m0, m1, edge.a_W, edge.b_W, theta, u);
       const Vec3 ab = edge.b_W - edge.a_W;
