@@ -467,7 +467,7 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
       RunTool({"bench", "--samples", "10", "--json", "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(r.exit_code == 0);
   const auto doc = nlohmann::json::parse(r.out);
-  REQUIRE(doc["scenarios"].size() == 14);
+  REQUIRE(doc["scenarios"].size() == 16);
   std::map<std::string, int> pcs;
   std::map<std::string, std::string> shape;
   for (const auto& s : doc["scenarios"]) {
@@ -499,6 +499,9 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
   CHECK(pcs["core.two_pcs"] == 2);
   CHECK(pcs["core.three_pcs"] == 3);
   CHECK(pcs["core.three_pcs.linear"] == pcs["core.three_pcs"]);
+  // The floor as a mesh holds the tube as the box does.
+  CHECK(pcs["core.end_stuck.mesh10k"] == 1);
+  CHECK(pcs["core.side_on_floor.mesh10k"] == 1);
   // And the models their names say.
   CHECK(shape["core.end_stuck"] == "rod");
   CHECK(shape["core.end_stuck.linear"] == "linear");
@@ -508,7 +511,7 @@ TEST_CASE("bench prints one finite figure set per scenario", "[cli]") {
                                 "--scene", SourcePath("scenes/groove.yaml")});
   REQUIRE(only.exit_code == 0);
   const auto only_doc = nlohmann::json::parse(only.out);
-  CHECK(only_doc["scenarios"].size() == 3);  // core.end_stuck, .mesh, .linear
+  CHECK(only_doc["scenarios"].size() == 4);  // core.end_stuck, .mesh10k, .mesh, .linear
   const Outcome none =
       RunTool({"bench", "--only", "core.nothing", "--scene", SourcePath("scenes/groove.yaml")});
   CHECK(none.exit_code == 2);
