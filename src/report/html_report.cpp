@@ -1,8 +1,10 @@
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -261,19 +263,68 @@ std::string Plots(const Evaluated& e, const ReplayRecording& r, std::vector<Span
   return svg;
 }
 
-nlohmann::json PlanJson(const HtmlPlan& p) {
+const char* ShapeId(scene::PartShape shape) {
+  return shape == scene::PartShape::kCylinder ? "cylinder"
+         : shape == scene::PartShape::kMesh   ? "mesh"
+                                              : "box";
+}
+
+// The mesh parts' surfaces, each written once for the page however many plans and parts show
+// it: the same file loaded for several plans' scenes is one entry when its mesh is the same.
+class PageMeshes {
+ public:
+  // The index in Json() of `mesh`, added if new.
+  std::size_t IndexOf(const scene::PartMesh& mesh) {
+    for (std::size_t i = 0; i < meshes_.size(); ++i)
+      if (meshes_[i] == &mesh || (meshes_[i]->mesh.vertices_P_m == mesh.mesh.vertices_P_m &&
+                                  meshes_[i]->mesh.triangles == mesh.mesh.triangles))
+        return i;
+    meshes_.push_back(&mesh);
+    return meshes_.size() - 1;
+  }
+
+  // Per mesh: its vertices in the part's frame [mm], rounded as every position on the page, and
+  // flat index lists of its triangles (counter-clockwise from outside) and of its feature edges'
+  // segments (pairs).
+  nlohmann::json Json() const {
+    nlohmann::json out = nlohmann::json::array();
+    for (const scene::PartMesh* m : meshes_) {
+      nlohmann::json vertices = nlohmann::json::array(), triangles = nlohmann::json::array(),
+                     edges = nlohmann::json::array();
+      for (const Eigen::Vector3d& v : m->mesh.vertices_P_m)
+        for (const double c : Mm(v)) vertices.push_back(c);
+      for (const std::array<int, 3>& t : m->mesh.triangles)
+        for (const int i : t) triangles.push_back(i);
+      for (const scene::MeshEdge& e : m->elements.edges)
+        for (const std::array<int, 2>& segment : e.segments)
+          for (const int i : segment) edges.push_back(i);
+      out.push_back({{"file", m->file},
+                     {"vertices_mm", std::move(vertices)},
+                     {"triangles", std::move(triangles)},
+                     {"edges", std::move(edges)}});
+    }
+    return out;
+  }
+
+ private:
+  std::vector<const scene::PartMesh*> meshes_;
+};
+
+nlohmann::json PlanJson(const HtmlPlan& p, PageMeshes& meshes) {
   const ReplayRecording& r = p.recording;
   const scene::Scene& s = *p.scene;
   nlohmann::json parts = nlohmann::json::array();
   for (const scene::Part& b : s.parts) {
     const Eigen::Quaterniond q(b.X_WP.linear());
-    parts.push_back(
-        {{"name", b.name},
-         {"shape", b.shape == scene::PartShape::kCylinder ? "cylinder" : "box"},
-         {"size_mm", Mm(b.size_m)},
-         {"p_mm", Mm(b.X_WP.translation())},
-         {"q_wxyz",
-          {Round(q.w(), 1e-6), Round(q.x(), 1e-6), Round(q.y(), 1e-6), Round(q.z(), 1e-6)}}});
+    nlohmann::json part = {
+        {"name", b.name},
+        {"shape", ShapeId(b.shape)},
+        {"size_mm", Mm(b.size_m)},
+        {"p_mm", Mm(b.X_WP.translation())},
+        {"q_wxyz",
+         {Round(q.w(), 1e-6), Round(q.x(), 1e-6), Round(q.y(), 1e-6), Round(q.z(), 1e-6)}}};
+    if (b.shape == scene::PartShape::kMesh && b.mesh) part["mesh"] = meshes.IndexOf(*b.mesh);
+    parts.push_back(std::move(part));
   }
   nlohmann::json t = nlohmann::json::array(), cf = nlohmann::json::array(),
                  line = nlohmann::json::array(), held = nlohmann::json::array(),
@@ -554,7 +605,9 @@ std::string FormatHtmlReport(const std::vector<HtmlPlan>& plans, const HtmlOptio
        "</footer>\n";
 
   nlohmann::json data = {{"tube_colour", kTubeColour}, {"plans", nlohmann::json::array()}};
-  for (const HtmlPlan& p : plans) data["plans"].push_back(PlanJson(p));
+  PageMeshes meshes;
+  for (const HtmlPlan& p : plans) data["plans"].push_back(PlanJson(p, meshes));
+  data["meshes"] = meshes.Json();
   o << "<script type=\"application/json\" id=\"tubeplan-data\">" << ScriptSafe(data.dump())
     << "</script>\n<script>\n"
     << assets::ThreeJs() << "\n</script>\n<script>\n"

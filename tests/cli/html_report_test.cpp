@@ -13,6 +13,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <tubeplan/io/mesh_file.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/plan/judge.hpp>
 #include <tubeplan/report/html_report.hpp>
@@ -233,6 +234,83 @@ TEST_CASE("evaluate --html writes one self-contained page with every plan", "[cl
   CHECK(page.find("planned transitions") != std::string::npos);
   CHECK(page.find("--html-graph") != std::string::npos);  // the note on how to add the graph
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("The page carries a mesh part's surface once, in its frame, in millimetres",
+          "[cli][html]") {
+  // The groove plan judged, then drawn on its scene with two parts of the clip's mesh, and again
+  // on a copy holding the clip loaded a second time: the page keeps one mesh, every part
+  // pointing at it with its own pose.
+  const io::PlanLoadResult l = io::LoadPlanFile(SourcePath("plans/groove-insert.yaml"));
+  REQUIRE(l.plan);
+  report::ReplayRecorder recorder;
+  batch::Evaluated e;
+  e.file = "plans/groove-insert.yaml";
+  e.plan = *l.plan;
+  e.judgement = plan::Judge(*l.scene, *l.trajectory, l.plan->states, l.plan->limits,
+                            [&](double t, const core::Core& core) { recorder(t, core); });
+  const auto load_clip = [] {
+    io::MeshLoadResult clip = io::LoadMeshFile(SourcePath("scenes/clip.obj"), 1e-3);
+    REQUIRE(clip.mesh);
+    return scene::MakePartMesh("clip.obj", std::move(*clip.mesh), std::move(*clip.elements));
+  };
+  const std::shared_ptr<const scene::PartMesh> clip = load_clip(), clip_again = load_clip();
+  Eigen::Isometry3d X_WP = Eigen::Isometry3d::Identity();
+  X_WP.translation() = Eigen::Vector3d(0.05, 0.02, 0.01);
+  X_WP.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  scene::Scene with_clips = *l.scene, with_clip_again = *l.scene;
+  with_clips.parts.push_back(scene::MakeMeshPart("clip_a", clip, X_WP));
+  with_clips.parts.push_back(scene::MakeMeshPart("clip_b", clip, Eigen::Isometry3d::Identity()));
+  with_clip_again.parts.push_back(scene::MakeMeshPart("clip_c", clip_again, X_WP));
+  const report::ReplayRecording r = recorder.Finish();
+  const std::vector<report::HtmlPlan> plans = {{&e, &with_clips, "groove.yaml", r},
+                                               {&e, &with_clip_again, "groove.yaml", r}};
+  const std::string page = report::FormatHtmlReport(plans, {});
+  const std::size_t start = page.find("<script type=\"application/json\" id=\"tubeplan-data\">");
+  REQUIRE(start != std::string::npos);
+  const std::size_t body = page.find('>', start) + 1;
+  const nlohmann::json data =
+      nlohmann::json::parse(page.substr(body, page.find("</script>", body) - body));
+
+  REQUIRE(data["meshes"].size() == 1);
+  const nlohmann::json& m = data["meshes"][0];
+  const std::size_t vertices = clip->mesh.vertices_P_m.size();
+  const std::size_t triangles = clip->mesh.triangles.size();
+  CHECK(triangles > 100);  // the clip's tessellated arcs
+  CHECK(m["vertices_mm"].size() == 3 * vertices);
+  CHECK(m["triangles"].size() == 3 * triangles);
+  std::size_t segments = 0;
+  for (const scene::MeshEdge& edge : clip->elements.edges) segments += edge.segments.size();
+  CHECK(segments > 0);
+  CHECK(m["edges"].size() == 2 * segments);
+  // Vertices in the part's frame in millimetres, to the page's 0.01 mm; indices as the mesh's.
+  for (std::size_t i = 0; i < vertices; ++i)
+    for (int c = 0; c < 3; ++c)
+      // Half the 0.01 mm rounding step, and the rounding of the printed double.
+      CHECK(m["vertices_mm"][3 * i + std::size_t(c)].get<double>() ==
+            Approx(clip->mesh.vertices_P_m[i][c] * 1e3).margin(0.005 + 1e-9));
+  for (std::size_t t = 0; t < triangles; ++t)
+    for (int k = 0; k < 3; ++k)
+      CHECK(m["triangles"][3 * t + std::size_t(k)] == clip->mesh.triangles[t][std::size_t(k)]);
+
+  // Each mesh part names the mesh and carries its own pose; the boxes stay boxes.
+  REQUIRE(data["plans"].size() == 2);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const nlohmann::json& p = data["plans"][k];
+    REQUIRE(p["parts"].size() == l.scene->parts.size() + (k == 0 ? 2 : 1));
+    for (std::size_t i = 0; i < l.scene->parts.size(); ++i) {
+      CHECK(p["parts"][i]["shape"] == "box");
+      CHECK(!p["parts"][i].contains("mesh"));
+    }
+    const nlohmann::json& clip_part = p["parts"][l.scene->parts.size()];
+    CHECK(clip_part["shape"] == "mesh");
+    CHECK(clip_part["mesh"] == 0);
+    CHECK(clip_part["p_mm"] == nlohmann::json({50.0, 20.0, 10.0}));
+    // q = (cos 0.15, 0, 0, sin 0.15), to the page's 1e-6.
+    CHECK(clip_part["q_wxyz"][0].get<double>() == Approx(std::cos(0.15)).margin(1e-6));
+    CHECK(clip_part["q_wxyz"][3].get<double>() == Approx(std::sin(0.15)).margin(1e-6));
+  }
+  CHECK(data["plans"][0]["parts"][l.scene->parts.size() + 1]["mesh"] == 0);
 }
 
 TEST_CASE("evaluate: --html-graph needs --html", "[cli][html]") {

@@ -1,10 +1,12 @@
 // Opens an HTML report of `tubeplan evaluate --html` in headless Chromium (Debian's `chromium`,
 // driven by playwright-core) with the network off, and checks what a user would see:
-//   node browser-test.mjs [--stretch-frames N] REPORT.html [SCREENSHOT.png [PLAN_SCREENSHOT.png]]
+//   node browser-test.mjs [--stretch-frames N] [--mesh-part D] REPORT.html [SCREENSHOT.png [PLAN_SCREENSHOT.png]]
 // (the screenshots: the top of the page, and the first plan's section with its plots;
 // --stretch-frames N: every plan's frames repeated, 1 ms apart, to N of them as the page parses
 // its data, the arrays of an unbounded recording of N / 50 s at 50 Hz: the page's script must
-// cope with arrays of any length)
+// cope with arrays of any length; --mesh-part D: every plan's first part made a mesh part of its
+// size, each face cut into D x D cells of two triangles, as the page parses its data: the page
+// must draw a mesh part of 12 D^2 triangles, D = 29 giving the 10,092 of a large one)
 // - the page refers to nothing outside itself (no http(s) or protocol-relative src/href/url());
 // - it loads with no console error or warning, no uncaught exception, no request but the file;
 // - the screenshot is not blank (many colours, most of it not the background);
@@ -16,9 +18,10 @@ import { resolve } from 'node:path';
 import { chromium } from 'playwright-core';
 
 const args = process.argv.slice(2);
-let stretchFrames = 0;
-if (args[0] === '--stretch-frames') {
-  stretchFrames = Number(args[1]);
+let stretchFrames = 0, meshDivisions = 0;
+while (args[0] === '--stretch-frames' || args[0] === '--mesh-part') {
+  if (args[0] === '--stretch-frames') stretchFrames = Number(args[1]);
+  else meshDivisions = Number(args[1]);
   args.splice(0, 2);
 }
 const [reportPath, screenshotPath, planShotPath] = args;
@@ -71,6 +74,44 @@ if (stretchFrames > 0) {
     };
   }, stretchFrames);
 }
+if (meshDivisions > 0) {
+  // Before the page's own script: each plan's first part becomes a mesh of its size centred on
+  // its frame, in the page's data format (data.meshes, the part's `mesh` index): vertices [mm]
+  // in the part's frame, triangles counter-clockwise from outside, feature edges as pairs.
+  await context.addInitScript((n) => {
+    const parse = JSON.parse;
+    JSON.parse = function (text, reviver) {
+      const data = parse(text, reviver);
+      for (const p of (data && Array.isArray(data.plans)) ? data.plans : []) {
+        const part = p.parts[0], half = part.size_mm.map((s) => s / 2);
+        const mesh = { file: 'browser-test box', vertices_mm: [], triangles: [], edges: [] };
+        for (const [axis, sign] of [[2, 1], [2, -1], [0, 1], [0, -1], [1, 1], [1, -1]]) {
+          const u = (axis + 1) % 3, v = (axis + 2) % 3, first = mesh.vertices_mm.length / 3;
+          for (let j = 0; j <= n; ++j) for (let i = 0; i <= n; ++i) {
+            const q = [0, 0, 0];
+            q[axis] = sign * half[axis];
+            q[u] = -half[u] + part.size_mm[u] * i / n;
+            q[v] = -half[v] + part.size_mm[v] * j / n;
+            mesh.vertices_mm.push(...q);
+          }
+          const at = (i, j) => first + j * (n + 1) + i;
+          for (let j = 0; j < n; ++j) for (let i = 0; i < n; ++i) {
+            const [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            mesh.triangles.push(...(sign > 0 ? [a, b, c, a, c, d] : [a, c, b, a, d, c]));
+          }
+          for (let k = 0; k < n; ++k)
+            mesh.edges.push(at(k, 0), at(k + 1, 0), at(k, n), at(k + 1, n),
+                            at(0, k), at(0, k + 1), at(n, k), at(n, k + 1));
+        }
+        data.meshes = data.meshes ?? [];
+        part.shape = 'mesh';
+        part.mesh = data.meshes.length;
+        data.meshes.push(mesh);
+      }
+      return data;
+    };
+  }, meshDivisions);
+}
 const page = await context.newPage();
 page.setDefaultTimeout(0);
 const problems = [];
@@ -101,6 +142,11 @@ if (error) {
 // Two animation frames: the first render has happened.
 const frames = () => page.evaluate(() => new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r))));
 await frames();
+if (meshDivisions > 0) {
+  const drawn = await page.evaluate(() => Number(document.getElementById('view').dataset.meshTriangles));
+  check(drawn === 12 * meshDivisions ** 2,
+        `3D view draws the mesh part: ${drawn} triangles (${12 * meshDivisions ** 2} expected)`);
+}
 
 // Pixels of the tube's hue in the WebGL canvas (its drawing buffer is preserved, so it can be
 // copied): hue within 12 degrees of the tube colour's, saturated and not dark (lighting shades

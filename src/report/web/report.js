@@ -15,6 +15,8 @@
   const clock = document.getElementById('clock');
   const speedSelect = document.getElementById('speed');
   let newtonMm = 10;  // arrow length per newton [mm], chosen per plan (niceScale)
+  // Triangles of the mesh parts drawn, on the canvas's data-mesh-triangles for the browser test.
+  let meshTriangles = 0;
 
   const renderer = new THREE.WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
   renderer.setPixelRatio(window.devicePixelRatio || 1);
@@ -76,34 +78,66 @@
     return ring;
   }
 
+  // A part's surface in its own frame. A cylinder's axis is its frame's z; three.js builds one
+  // along y. A mesh part's triangles (data.meshes, written once a page) each get their own
+  // normal: its facets are what the contact model sees, and a box's sides stay flat.
+  function partGeometry(part) {
+    if (part.shape === 'cylinder')
+      return new THREE.CylinderGeometry(part.size_mm[0] / 2, part.size_mm[0] / 2, part.size_mm[2], 48)
+        .rotateX(Math.PI / 2);
+    if (part.shape !== 'mesh') return new THREE.BoxGeometry(...part.size_mm);
+    const m = data.meshes[part.mesh];
+    const indexed = new THREE.BufferGeometry();
+    indexed.setAttribute('position', new THREE.Float32BufferAttribute(m.vertices_mm, 3));
+    indexed.setIndex(m.triangles);
+    const geometry = indexed.toNonIndexed();
+    indexed.dispose();
+    geometry.computeVertexNormals();
+    meshTriangles += m.triangles.length / 3;
+    return geometry;
+  }
+
+  // The lines drawn over a part: a mesh's feature edges (where its faces meet, as its elements
+  // name them), the edges of a box or a cylinder's rims.
+  function partEdges(part, geometry) {
+    if (part.shape !== 'mesh') return new THREE.EdgesGeometry(geometry);
+    const m = data.meshes[part.mesh];
+    const lines = new THREE.BufferGeometry();
+    lines.setAttribute('position', new THREE.Float32BufferAttribute(m.vertices_mm, 3));
+    lines.setIndex(m.edges);
+    return lines;
+  }
+
   function buildWorld(p) {
     if (world) { disposeTree(world); scene.remove(world); }
     world = new THREE.Group();
+    meshTriangles = 0;
     const lo = new THREE.Vector3(Infinity, Infinity, Infinity);
     const hi = new THREE.Vector3(-Infinity, -Infinity, -Infinity);
     for (const part of p.parts) {
-      // A cylinder's axis is its frame's z; three.js builds one along y.
-      const geometry = part.shape === 'cylinder'
-        ? new THREE.CylinderGeometry(part.size_mm[0] / 2, part.size_mm[0] / 2, part.size_mm[2], 48)
-          .rotateX(Math.PI / 2)
-        : new THREE.BoxGeometry(...part.size_mm);
+      const geometry = partGeometry(part);
       const box = new THREE.Mesh(geometry, new THREE.MeshLambertMaterial(
         { color: 0xb9c2cb, transparent: true, opacity: 0.55, depthWrite: false }));
       const [w, x, y, z] = part.q_wxyz;
       box.quaternion.set(x, y, z, w);
       box.position.set(...part.p_mm);
-      const edges = new THREE.LineSegments(new THREE.EdgesGeometry(geometry),
+      const edges = new THREE.LineSegments(partEdges(part, geometry),
                                            new THREE.LineBasicMaterial({ color: 0x56606a }));
       edges.quaternion.copy(box.quaternion);
       edges.position.copy(box.position);
       world.add(box, edges);
-      for (const sx of [-0.5, 0.5]) for (const sy of [-0.5, 0.5]) for (const sz of [-0.5, 0.5]) {
-        const corner = new THREE.Vector3(sx * part.size_mm[0], sy * part.size_mm[1],
-                                         sz * part.size_mm[2]).applyQuaternion(box.quaternion)
-          .add(box.position);
-        lo.min(corner); hi.max(corner);
+      // The part's bounding box in its frame (a mesh's need not be centred on it), in world.
+      geometry.computeBoundingBox();
+      const b = geometry.boundingBox;
+      for (const cx of [b.min.x, b.max.x]) for (const cy of [b.min.y, b.max.y]) {
+        for (const cz of [b.min.z, b.max.z]) {
+          const corner = new THREE.Vector3(cx, cy, cz).applyQuaternion(box.quaternion)
+            .add(box.position);
+          lo.min(corner); hi.max(corner);
+        }
       }
     }
+    canvas.dataset.meshTriangles = String(meshTriangles);
     const tubeLo = new THREE.Vector3(Infinity, Infinity, Infinity);
     const tubeHi = new THREE.Vector3(-Infinity, -Infinity, -Infinity);
     for (const c of p.frames.centreline_mm) for (let i = 0; i < c.length; i += 3) {
