@@ -199,18 +199,11 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
   s.replicas = kReplicas;
   s.state = [runs] {
     const core::Core& core = *(*runs)[0].core;
-    // A PC on an element the core has no name for (a mesh part's, while the core's distance
-    // takes a mesh for its bounding box) is said, not looked up.
-    bool named = true;
-    for (const core::ContactState& c : core.last().Contacts())
-      named = named && c.part_element >= 0 && std::size_t(c.part_element) < core.elements().size();
-    return nlohmann::json{
-        {"cf",
-         named ? core.FormationText() : std::string("(a PC on an element the core does not name)")},
-        {"pcs", core.last().contact_count},
-        {"iterations", core.last().iterations},
-        {"model", scene::ToString(core.scene().model.tube)},
-        {"elements", core.element_count()}};
+    return nlohmann::json{{"cf", core.FormationText()},
+                          {"pcs", core.last().contact_count},
+                          {"iterations", core.last().iterations},
+                          {"model", scene::ToString(core.scene().model.tube)},
+                          {"elements", core.element_count()}};
   };
   return s;
 }
