@@ -324,10 +324,9 @@ Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts)
   Box box;
   for (std::uint32_t p : parts) {
     const scene::Part& part = scene.parts[p];
+    const Eigen::AlignedBox3d bounds_P = scene::BoundsInPart(part);
     for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d c_P((corner & 1 ? 0.5 : -0.5) * part.size_m.x(),
-                                (corner & 2 ? 0.5 : -0.5) * part.size_m.y(),
-                                (corner & 4 ? 0.5 : -0.5) * part.size_m.z());
+      const Eigen::Vector3d c_P = bounds_P.corner(Eigen::AlignedBox3d::CornerType(corner));
       box.lo = box.lo.cwiseMin(part.X_WP * c_P);
       box.hi = box.hi.cwiseMax(part.X_WP * c_P);
     }
@@ -456,9 +455,13 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   for (int e : elements) {
     const scene::PartElement& element = probe.elements()[std::size_t(e)];
     const scene::Part& part = scene.parts[element.part_index];
+    // The element's index within its part: elements come in part order.
+    int first = e;
+    while (first > 0 && probe.elements()[std::size_t(first - 1)].part_index == element.part_index)
+      --first;
     // A round element is aimed at where it faces the start.
-    const scene::ElementPoint at =
-        scene::PointOnElement(part, element.face_mask, f.p0 - part.X_WP.translation());
+    const scene::ElementPoint at = scene::PointOnElement(
+        part, e - first, f.p0 - part.X_WP * scene::BoundsInPart(part).center());
     const Eigen::Vector3d& c_W = at.p_W;
     const Eigen::Vector3d& n_W = at.n_W;
     // An element whose outside is inside another part (a wall's bottom on the floor) cannot be

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <utility>
 
 #include <tubeplan/scene/scene.hpp>
@@ -6,9 +7,50 @@ namespace tubeplan::scene {
 
 const char* ToString(TubeModel model) { return model == TubeModel::kLinear ? "linear" : "rod"; }
 
+namespace {
+
+// A mesh's thinnest wall [m]: from a triangle's centroid straight in (along its inward normal)
+// to where that line leaves the solid, found by sphere tracing (each step is the distance to the
+// nearest surface, so it never steps over one), the least over the triangles. At most 4096
+// triangles, evenly spread, are traced (a wall is many triangles of a fine mesh): about 20
+// distance queries each, 0.2 s for the largest meshes.
+double ThinnestWall_m(const PartMesh& m) {
+  constexpr std::size_t kMaxTraced = 4096;
+  constexpr int kMaxSteps = 64;  // the step at least doubles until the far wall is near
+  const std::size_t n = m.mesh.triangles.size();
+  const std::size_t stride = (n + kMaxTraced - 1) / kMaxTraced;
+  Eigen::AlignedBox3d box;
+  for (const Eigen::Vector3d& v : m.mesh.vertices_P_m) box.extend(v);
+  // Where the trace starts past its own face, and how close to the far one counts as there.
+  const double start_m = 1e-6 * box.diagonal().norm(), reached_m = 1e-9 * box.diagonal().norm();
+  double thinnest_m = box.sizes().minCoeff();
+  for (std::size_t t = 0; t < n; t += stride) {
+    const auto& tri = m.mesh.triangles[t];
+    const Eigen::Vector3d c =
+        (m.mesh.vertices_P_m[std::size_t(tri[0])] + m.mesh.vertices_P_m[std::size_t(tri[1])] +
+         m.mesh.vertices_P_m[std::size_t(tri[2])]) /
+        3.0;
+    const Eigen::Vector3d in = -TriangleNormal(m.mesh, int(t));
+    double s = start_m;
+    for (int step = 0; step < kMaxSteps && s < thinnest_m; ++step) {
+      const double d = m.distance_P.Distance(c + s * in).distance_m;
+      if (d >= -reached_m) break;
+      s -= d;
+    }
+    thinnest_m = std::min(thinnest_m, s);
+  }
+  return thinnest_m;
+}
+
+}  // namespace
+
+double ThinnestSize_m(const Part& part) {
+  if (part.shape == PartShape::kMesh && part.mesh) return ThinnestWall_m(*part.mesh);
+  return part.size_m.minCoeff();
+}
+
 double ContactHoldAtMiddle_N(const Scene& scene, const Part& part) {
-  return scene.contact.stiffness_N_per_m *
-         (scene.contact.threshold_m + 0.5 * part.size_m.minCoeff());
+  return scene.contact.stiffness_N_per_m * (scene.contact.threshold_m + 0.5 * ThinnestSize_m(part));
 }
 
 std::span<const char* const> FaceIds(PartShape shape) {

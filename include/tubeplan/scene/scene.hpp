@@ -154,8 +154,13 @@ struct Scene {
 /// Friction that applies at a part: its own if set, the scene's otherwise.
 const Friction& FrictionAt(const Scene& scene, std::size_t part_index);
 
+/// How thin a part is [m]: a box's or a cylinder's least extent; a mesh's thinnest wall, the
+/// least distance from a triangle straight through the solid to its other side (at most 4096
+/// triangles, evenly spread, are measured).
+double ThinnestSize_m(const Part& part);
+
 /// The force the contact law pushes back with when a point reaches a part's middle,
-/// K (eps + half the part's thinnest size) [N]: below the device's force, a full push can carry
+/// K (eps + half the part's ThinnestSize_m) [N]: below the device's force, a full push can carry
 /// the tube through the part.
 double ContactHoldAtMiddle_N(const Scene& scene, const Part& part);
 
