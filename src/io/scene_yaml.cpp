@@ -19,6 +19,7 @@
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/core/coupling.hpp>
+#include <tubeplan/io/mesh_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/io/units.hpp>
 #include <tubeplan/scene/elements.hpp>
@@ -109,46 +110,129 @@ constexpr double kGeometryTolerance_m = 1e-9;
 // part within its reach each tick, and a scene of a thousand parts is far beyond a task's fixture.
 constexpr std::size_t kMaxParts = 1000;
 
-// A part's shape: exactly one of `box: {size, position, rpy}` and `cylinder: {radius, length,
-// position, rpy}`. Returns the mark of its position, for messages about the part.
+// What the parts of one scene file share: where their mesh files' relative paths start, and
+// the meshes read so far, null where reading failed (a file placed twice at one scale is read,
+// and reported, once).
+struct PartsContext {
+  std::filesystem::path base_dir;
+  std::map<std::pair<std::string, double>, std::shared_ptr<const scene::PartMesh>> meshes;
+};
+
+// A box's `size`.
+void ReadBox(Reader& r, const YAML::Node& shape, const std::string& sw, scene::Part& part) {
+  if (const YAML::Node n = r.Get(shape, "size", sw, true); n.IsDefined()) {
+    if (const auto size = r.Vector(n, sw + ".size", dim::kLength)) {
+      part.size_m = *size;
+      if ((part.size_m.array() <= 0.0).any())
+        r.Error(n, sw + ".size must be greater than zero along every axis");
+    }
+  }
+}
+
+// A cylinder's `radius` and `length`.
+void ReadCylinder(Reader& r, const YAML::Node& shape, const std::string& sw, scene::Part& part) {
+  double radius_m = 0.0, length_m = 0.0;
+  for (const auto& [key, target] : {std::pair<const char*, double*>{"radius", &radius_m},
+                                    std::pair<const char*, double*>{"length", &length_m}}) {
+    if (!r.Field(shape, key, sw, dim::kLength, true, *target)) continue;
+    if (!(*target > 0.0))
+      r.Error(r.Get(shape, key, sw, true),
+              sw + "." + key + " must be greater than zero, expected a length such as 10 mm");
+  }
+  part.size_m = Eigen::Vector3d(2.0 * radius_m, 2.0 * radius_m, length_m);
+}
+
+// A mesh's `file` (relative to the scene file's directory) and `scale` (the file's unit in
+// metres). The mesh file's own problems join the scene's as they are, at their place in it.
+void ReadMesh(Reader& r, const YAML::Node& shape, const std::string& sw, scene::Part& part,
+              PartsContext& context) {
+  std::optional<std::string> file;
+  if (const YAML::Node n = r.Get(shape, "file", sw, true); n.IsDefined()) {
+    file = r.String(n, sw + ".file");
+    if (file && file->empty()) {
+      r.Error(n, sw + ".file must not be empty, expected an OBJ or STL file's path");
+      file.reset();
+    }
+  }
+  std::optional<double> scale;
+  if (const YAML::Node n = r.Get(shape, "scale", sw, false); !n.IsDefined()) {
+    r.Error(shape, "missing key 'scale' in '" + sw +
+                       "', expected the file's unit in metres, such as 0.001 for millimetres");
+  } else if ((scale = r.Quantity(n, sw + ".scale", dim::kLength)) && !(*scale > 0.0)) {
+    r.Error(n, sw + ".scale must be greater than zero, expected the file's unit in metres, such "
+                    "as 0.001 for millimetres");
+    scale.reset();
+  }
+  if (!file || !scale) return;
+  const std::filesystem::path path = context.base_dir / *file;
+  // A file read before is not read again; one that failed was reported then.
+  const auto [at, first_time] = context.meshes.try_emplace({path.string(), *scale}, nullptr);
+  std::shared_ptr<const scene::PartMesh>& mesh = at->second;
+  if (first_time) {
+    const ReadResult read = ReadInputFile(path, kMaxMeshBytes);
+    if (!read.text) {
+      r.Error(r.Get(shape, "file", sw, true), sw + ".file: cannot read '" + path.string() + "' (" +
+                                                  read.error +
+                                                  "), expected a readable OBJ or STL mesh file");
+      return;
+    }
+    MeshLoadResult loaded = LoadMeshBytes(*read.text, path.string(), *scale);
+    r.diagnostics().Append(loaded.diagnostics);
+    if (!loaded.mesh) return;
+    mesh = scene::MakePartMesh(*file, std::move(*loaded.mesh), std::move(*loaded.elements));
+  }
+  if (!mesh) return;
+  part.mesh = mesh;
+  part.size_m = scene::BoundsInPart(part).sizes();
+}
+
+// "a box and a cylinder", "a box, a cylinder and a mesh": the shapes a part names.
+std::string ShapeList(const std::vector<std::string>& shapes) {
+  std::string list;
+  for (std::size_t i = 0; i < shapes.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == shapes.size() ? " and " : ", ") + std::string("a ") + shapes[i];
+  return list;
+}
+
+// A part's shape: exactly one of `box: {size, position, rpy}`, `cylinder: {radius, length,
+// position, rpy}` and `mesh: {file, scale, position, rpy}`. Returns the mark of its position,
+// for messages about the part.
 YAML::Mark ReadShape(Reader& r, const YAML::Node& part_node, const std::string& where,
-                     scene::Part& part) {
-  const YAML::Node box = part_node["box"], cylinder = part_node["cylinder"];
-  if (box.IsDefined() == cylinder.IsDefined()) {
-    r.Error(box.IsDefined() ? cylinder : part_node,
-            where + (box.IsDefined() ? " has both a box and a cylinder" : " has no shape") +
-                ", expected exactly one of 'box' and 'cylinder'");
+                     scene::Part& part, PartsContext& context) {
+  const std::array<const char*, 3> keys = {"box", "cylinder", "mesh"};
+  std::vector<std::string> named;
+  for (const char* key : keys)
+    if (part_node[key].IsDefined()) named.push_back(key);
+  if (named.size() != 1) {
+    r.Error(named.empty() ? part_node : part_node[named[1]],
+            where +
+                (named.empty()       ? " has no shape"
+                 : named.size() == 2 ? " has both " + ShapeList(named)
+                                     : " has " + ShapeList(named)) +
+                ", expected exactly one of 'box', 'cylinder' and 'mesh'");
     return part_node.Mark();
   }
-  const bool is_box = box.IsDefined();
-  const YAML::Node shape = is_box ? box : cylinder;
-  const std::string sw = where + (is_box ? ".box" : ".cylinder");
-  part.shape = is_box ? scene::PartShape::kBox : scene::PartShape::kCylinder;
+  const std::string& key = named[0];
+  const YAML::Node shape = part_node[key];
+  const std::string sw = where + "." + key;
+  part.shape = key == "box"        ? scene::PartShape::kBox
+               : key == "cylinder" ? scene::PartShape::kCylinder
+                                   : scene::PartShape::kMesh;
   const std::span<const char* const> ids = scene::FaceIds(part.shape);
   for (std::size_t f = 0; f < ids.size(); ++f) part.face_names[f] = ids[f];
-  if (!r.ExpectMap(shape, sw,
-                   is_box ? std::vector<std::string>{"size", "position", "rpy"}
-                          : std::vector<std::string>{"radius", "length", "position", "rpy"}))
-    return shape.Mark();
-  if (is_box) {
-    if (const YAML::Node n = r.Get(shape, "size", sw, true); n.IsDefined()) {
-      if (const auto size = r.Vector(n, sw + ".size", dim::kLength)) {
-        part.size_m = *size;
-        if ((part.size_m.array() <= 0.0).any())
-          r.Error(n, sw + ".size must be greater than zero along every axis");
-      }
-    }
-  } else {
-    double radius_m = 0.0, length_m = 0.0;
-    for (const auto& [key, target] : {std::pair<const char*, double*>{"radius", &radius_m},
-                                      std::pair<const char*, double*>{"length", &length_m}}) {
-      if (!r.Field(shape, key, sw, dim::kLength, true, *target)) continue;
-      if (!(*target > 0.0))
-        r.Error(r.Get(shape, key, sw, true),
-                sw + "." + key + " must be greater than zero, expected a length such as 10 mm");
-    }
-    part.size_m = Eigen::Vector3d(2.0 * radius_m, 2.0 * radius_m, length_m);
-  }
+  const std::vector<std::string> size_keys = key == "box" ? std::vector<std::string>{"size"}
+                                             : key == "cylinder"
+                                                 ? std::vector<std::string>{"radius", "length"}
+                                                 : std::vector<std::string>{"file", "scale"};
+  std::vector<std::string> allowed = size_keys;
+  allowed.insert(allowed.end(), {"position", "rpy"});
+  if (!r.ExpectMap(shape, sw, allowed)) return shape.Mark();
+  if (part.shape == scene::PartShape::kBox)
+    ReadBox(r, shape, sw, part);
+  else if (part.shape == scene::PartShape::kCylinder)
+    ReadCylinder(r, shape, sw, part);
+  else
+    ReadMesh(r, shape, sw, part, context);
   Eigen::Vector3d position = Eigen::Vector3d::Zero(), rpy = Eigen::Vector3d::Zero();
   YAML::Mark position_mark = shape.Mark();
   if (const YAML::Node n = r.Get(shape, "position", sw, false); n.IsDefined()) {
@@ -161,7 +245,42 @@ YAML::Mark ReadShape(Reader& r, const YAML::Node& part_node, const std::string& 
   return position_mark;
 }
 
-void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok) {
+// A box's or a cylinder's renamed faces; a mesh's faces are named by its file's groups.
+void ReadFaceNames(Reader& r, const YAML::Node& faces, const std::string& where,
+                   scene::Part& part) {
+  const std::string fw = where + ".faces";
+  if (part.shape == scene::PartShape::kMesh) {
+    r.Error(faces, fw + " cannot rename a mesh's faces, expected the names of the mesh file's "
+                        "groups (docs/meshes.md)");
+    return;
+  }
+  const std::span<const char* const> shape_ids = scene::FaceIds(part.shape);
+  const std::vector<std::string> ids(shape_ids.begin(), shape_ids.end());
+  if (!r.ExpectMap(faces, fw, ids)) return;
+  for (const auto& entry : faces) {
+    const auto it = std::find(ids.begin(), ids.end(), entry.first.Scalar());
+    if (it == ids.end()) continue;  // reported by ExpectMap
+    const auto name = r.String(entry.second, fw + "." + *it);
+    if (!name) continue;
+    // '_' joins face names into edge and vertex names, so a face name cannot hold one.
+    if (!IsName(*name, false)) {
+      r.Error(entry.second, fw + "." + *it + " '" + *name +
+                                "' must start with a letter and hold only letters and "
+                                "digits ('_' joins face names into edge names)");
+      continue;
+    }
+    part.face_names[static_cast<std::size_t>(it - ids.begin())] = *name;
+  }
+  for (std::size_t a = 0; a < ids.size(); ++a)
+    for (std::size_t b = a + 1; b < ids.size(); ++b)
+      if (part.face_names[a] == part.face_names[b])
+        r.Error(faces, fw + ": two faces are named '" + part.face_names[a] +
+                           "', expected a distinct name for each face");
+}
+
+void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_ok,
+               const std::filesystem::path& base_dir) {
+  PartsContext context{base_dir, {}};
   if (!node.IsSequence() || node.size() == 0) {
     r.Error(node, std::string("'parts' must be a non-empty sequence of parts, found ") +
                       (node.IsSequence() ? "an empty sequence" : KindName(node)));
@@ -183,7 +302,7 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
     const YAML::Node part_node = node[i];
     const std::string where = "parts[" + std::to_string(i) + "]";
     const std::size_t errors = r.error_count();
-    if (!r.ExpectMap(part_node, where, {"name", "box", "cylinder", "faces", "friction"})) {
+    if (!r.ExpectMap(part_node, where, {"name", "box", "cylinder", "mesh", "faces", "friction"})) {
       parts_ok = false;
       continue;
     }
@@ -199,33 +318,9 @@ void ReadParts(Reader& r, const YAML::Node& node, scene::Scene& s, bool& parts_o
           r.Error(n, "part name '" + part.name + "' is used twice, expected unique names");
       }
     }
-    YAML::Mark position_mark = ReadShape(r, part_node, where, part);
-    if (const YAML::Node faces = r.Get(part_node, "faces", where, false); faces.IsDefined()) {
-      const std::string fw = where + ".faces";
-      const std::span<const char* const> shape_ids = scene::FaceIds(part.shape);
-      const std::vector<std::string> ids(shape_ids.begin(), shape_ids.end());
-      if (r.ExpectMap(faces, fw, ids)) {
-        for (const auto& entry : faces) {
-          const auto it = std::find(ids.begin(), ids.end(), entry.first.Scalar());
-          if (it == ids.end()) continue;  // reported by ExpectMap
-          const auto name = r.String(entry.second, fw + "." + *it);
-          if (!name) continue;
-          // '_' joins face names into edge and vertex names, so a face name cannot hold one.
-          if (!IsName(*name, false)) {
-            r.Error(entry.second, fw + "." + *it + " '" + *name +
-                                      "' must start with a letter and hold only letters and "
-                                      "digits ('_' joins face names into edge names)");
-            continue;
-          }
-          part.face_names[static_cast<std::size_t>(it - ids.begin())] = *name;
-        }
-        for (std::size_t a = 0; a < ids.size(); ++a)
-          for (std::size_t b = a + 1; b < ids.size(); ++b)
-            if (part.face_names[a] == part.face_names[b])
-              r.Error(faces, fw + ": two faces are named '" + part.face_names[a] +
-                                 "', expected a distinct name for each face");
-      }
-    }
+    YAML::Mark position_mark = ReadShape(r, part_node, where, part, context);
+    if (const YAML::Node faces = r.Get(part_node, "faces", where, false); faces.IsDefined())
+      ReadFaceNames(r, faces, where, part);
     if (const YAML::Node f = r.Get(part_node, "friction", where, false); f.IsDefined())
       part.friction = ReadFriction(r, f, where + ".friction");
     if (r.error_count() != errors) parts_ok = false;
@@ -535,9 +630,10 @@ void WarnContactBand(Reader& r, const YAML::Node& root, const scene::Scene& s) {
 void WarnThinParts(Reader& r, const YAML::Node& root, const scene::Scene& s) {
   for (const scene::Part& part : s.parts) {
     const double hold_N = scene::ContactHoldAtMiddle_N(s, part);
-    if (!(hold_N < s.device.max_force_N) || part.size_m.minCoeff() <= 0.0) continue;
+    const double thinnest_m = scene::ThinnestSize_m(part);
+    if (!(hold_N < s.device.max_force_N) || thinnest_m <= 0.0) continue;
     std::ostringstream m;
-    m << "part " << part.name << " is " << part.size_m.minCoeff() * 1e3
+    m << "part " << part.name << " is " << thinnest_m * 1e3
       << " mm thin: the contact holds K (eps + half of it) = " << hold_N
       << " N at its middle, less than the device's " << s.device.max_force_N
       << " N, so a full push can carry the tube through it; expected a thicker part or a stiffer "
@@ -582,7 +678,8 @@ void ReadWorkspace(Reader& r, const YAML::Node& ws, scene::Scene& s) {
   }
 }
 
-void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
+void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s,
+               const std::filesystem::path& base_dir) {
   const std::vector<std::string> top = {"tubeplan", "name",  "tube",      "contact",
                                         "friction", "parts", "start",     "goal",
                                         "device",   "model", "workspace", "heuristics"};
@@ -603,7 +700,7 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
   }
   bool parts_ok = true;
   if (const YAML::Node p = r.Get(root, "parts", "scene", true); p.IsDefined()) {
-    ReadParts(r, p, s, parts_ok);
+    ReadParts(r, p, s, parts_ok, base_dir);
   } else {
     parts_ok = false;
   }
@@ -630,7 +727,8 @@ void ReadScene(Reader& r, const YAML::Node& root, scene::Scene& s) {
 
 }  // namespace
 
-SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& display_name) {
+SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& display_name,
+                              const std::filesystem::path& base_dir) {
   SceneLoadResult result;
   Reader reader(display_name, result.diagnostics);
   scene::Scene s;
@@ -645,7 +743,7 @@ SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& dis
     return result;
   try {
     const YAML::Node root = LoadOneDocument(reader, std::string(yaml_text), "a scene file");
-    if (CheckYamlShape(reader, root, "a scene file")) ReadScene(reader, root, s);
+    if (CheckYamlShape(reader, root, "a scene file")) ReadScene(reader, root, s, base_dir);
   } catch (const YAML::DeepRecursion& e) {
     // yaml-cpp's own guard of its recursive parser (500 levels); its message is "bad file".
     reader.Error(e.mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +
@@ -671,7 +769,7 @@ SceneLoadResult LoadSceneFile(const std::filesystem::path& path) {
         "cannot read file (" + read.error + "), expected a readable YAML scene file");
     return result;
   }
-  return LoadSceneText(*read.text, path.string());
+  return LoadSceneText(*read.text, path.string(), path.parent_path());
 }
 
 }  // namespace tubeplan::io

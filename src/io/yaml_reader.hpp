@@ -108,6 +108,8 @@ class Reader {
     else
       diag_.Warning(file_, mark.line + 1, mark.column + 1, message);
   }
+  /// The diagnostics this reader adds to, for another file's problems (a scene's mesh file).
+  Diagnostics& diagnostics() { return diag_; }
   std::size_t error_count() const {
     std::size_t n = 0;
     for (const Diagnostic& d : diag_.all()) n += d.severity == Severity::kError;

@@ -1,5 +1,6 @@
 // Scene loading: the shipped scenes load, a good file gives exactly its SI values, and broken
 // files give exactly the diagnostics a user should read (all of them, at the right line:col).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
@@ -13,6 +14,9 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/scene/elements.hpp>
 #include <tubeplan/scene/scene.hpp>
+
+#include "../scratch.hpp"
+#include "mesh_test_meshes.hpp"
 
 namespace {
 
@@ -453,9 +457,10 @@ TEST_CASE("A part's shape is exactly one box or one cylinder of positive size", 
                 "    box: {size: [10 mm, 200 mm, 20 mm]}\n"
                 "    cylinder: {radius: 6 mm, length: 20 mm}"),
        "t.yaml:10:15: error: parts[1] has both a box and a cylinder, expected exactly one of "
-       "'box' and 'cylinder'\n"},
+       "'box', 'cylinder' and 'mesh'\n"},
       {"no shape", WithLine(9, "    friction: {static: 0.7, kinetic: 0.08}"),
-       "t.yaml:8:5: error: parts[1] has no shape, expected exactly one of 'box' and 'cylinder'\n"},
+       "t.yaml:8:5: error: parts[1] has no shape, expected exactly one of 'box', 'cylinder' and "
+       "'mesh'\n"},
       {"zero radius",
        WithLine(9, "    cylinder: {radius: 0 mm, length: 20 mm, position: [15 mm, 0, 10 mm]}"),
        "t.yaml:9:24: error: parts[1].cylinder.radius must be greater than zero, expected a length "
@@ -494,4 +499,159 @@ TEST_CASE("The held end is inside a cylinder by its round side, not by its box",
   CHECK_THAT(inside.diagnostics.FormatAll(),
              Catch::Contains("start.position is inside part 'wall', expected the held end "
                              "outside every part"));
+}
+
+namespace {
+
+// The shipped clip (scenes/clip.obj, millimetres) on a floor of two slabs with a 10 mm gap for
+// its post (radius 3 mm, 5 mm under its base); its channel runs along y from 20 to 40 mm. Line
+// numbers in the messages below are this text's.
+const std::string kClipScene =
+    "tubeplan: 1\n"
+    "name: t\n"
+    "tube: {outer_radius: 5 mm, inner_radius: 4 mm, length: 150 mm, youngs_modulus: 3 MPa, "
+    "poisson_ratio: 0.5}\n"
+    "friction: {static: 0.7, kinetic: 0.08}\n"
+    "parts:\n"
+    "  - name: floor\n"
+    "    box: {size: [25 mm, 200 mm, 10 mm], position: [-17.5 mm, 0, -5 mm]}\n"
+    "  - name: right\n"
+    "    box: {size: [25 mm, 200 mm, 10 mm], position: [17.5 mm, 0, -5 mm]}\n"
+    "  - name: clip\n"
+    "    mesh: {file: clip.obj, scale: 0.001, position: [0, 20 mm, 0]}\n"
+    "start: {position: [0, -90 mm, 40 mm]}\n"
+    "goal: \"{Fs - clip.floor}\"\n";
+
+std::string ClipSceneWith(int line, const std::string& replacement) {
+  std::istringstream in(kClipScene);
+  std::string out, l;
+  for (int i = 1; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("A mesh part loads from its file with its elements named by the file", "[scene]") {
+  const auto loaded = LoadSceneText(kClipScene, "t.yaml", SourcePath("scenes"));
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.scene);
+  const tubeplan::scene::Part& clip = loaded.scene->parts[2];
+  CHECK(clip.shape == tubeplan::scene::PartShape::kMesh);
+  REQUIRE(clip.mesh);
+  CHECK(clip.mesh->file == "clip.obj");
+  // 21 x 20 x 27 mm (post included) in millimetres scaled to metres, placed 20 mm along y.
+  CHECK(clip.size_m.isApprox(Eigen::Vector3d(0.021, 0.020, 0.027), 1e-12));
+  CHECK(clip.X_WP.translation().isApprox(Eigen::Vector3d(0, 0.020, 0), 1e-12));
+  // Its 16 faces, 38 edges and 24 vertices (tests/io/clip_mesh_test.cpp), as "clip.<name>".
+  std::vector<std::string> names;
+  for (const auto& e : tubeplan::scene::EnumerateElements(*loaded.scene))
+    if (e.part_index == 2) names.push_back(e.name);
+  REQUIRE(names.size() == 16 + 38 + 24);
+  CHECK(names.front() == "clip.bottom");
+  CHECK(std::count(names.begin(), names.end(), "clip.right_lip_right_inner") == 1);
+  // The same file as a length, "1 mm": the same part.
+  const auto as_length = LoadSceneText(
+      ClipSceneWith(11, "    mesh: {file: clip.obj, scale: 1 mm, position: [0, 20 mm, 0]}"),
+      "t.yaml", SourcePath("scenes"));
+  REQUIRE(as_length.scene);
+  CHECK(as_length.scene->parts[2].size_m == clip.size_m);
+}
+
+TEST_CASE("A scene file's mesh is read relative to the scene file's directory", "[scene]") {
+  // The scene and a cube (1 m, scale 0.01: 10 mm) in a scratch directory, read from elsewhere.
+  const std::string scene_path = tubeplan::testing::WriteScratch(
+      "mesh-scene", "cube-scene.yaml",
+      WithLine(9, "    mesh: {file: cube.obj, scale: 0.01, position: [15 mm, 0, 0]}"));
+  tubeplan::testing::WriteScratch("mesh-scene", "cube.obj", tubeplan::testing::CubeObj());
+  const auto loaded = LoadSceneFile(scene_path);
+  CHECK(loaded.diagnostics.FormatAll() == "");
+  REQUIRE(loaded.scene);
+  CHECK(loaded.scene->parts[1].size_m.isApprox(Eigen::Vector3d::Constant(0.01), 1e-12));
+  // The cube's faces are named by its groups.
+  CHECK(tubeplan::scene::FindElement(tubeplan::scene::EnumerateElements(*loaded.scene),
+                                     "wall.top_xpos_ypos") >= 0);
+}
+
+TEST_CASE("A mesh part's problems are reported where they are", "[scene]") {
+  const std::string scenes = SourcePath("scenes");
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"no such file", ClipSceneWith(11, "    mesh: {file: nope.obj, scale: 0.001}"),
+       "t.yaml:11:18: error: parts[2].mesh.file: cannot read '" + scenes +
+           "/nope.obj' (no such file), expected a readable OBJ or STL mesh file\n"},
+      {"no scale", ClipSceneWith(11, "    mesh: {file: clip.obj}"),
+       "t.yaml:11:11: error: missing key 'scale' in 'parts[2].mesh', expected the file's unit in "
+       "metres, such as 0.001 for millimetres\n"},
+      {"zero scale", ClipSceneWith(11, "    mesh: {file: clip.obj, scale: 0}"),
+       "t.yaml:11:35: error: parts[2].mesh.scale must be greater than zero, expected the file's "
+       "unit in metres, such as 0.001 for millimetres\n"},
+      {"negative scale", ClipSceneWith(11, "    mesh: {file: clip.obj, scale: -1 mm}"),
+       "t.yaml:11:35: error: parts[2].mesh.scale must be greater than zero, expected the file's "
+       "unit in metres, such as 0.001 for millimetres\n"},
+      {"faces on a mesh",
+       ClipSceneWith(11,
+                     "    mesh: {file: clip.obj, scale: 0.001, position: [0, 20 mm, 0]}\n"
+                     "    faces: {top: lid}"),
+       "t.yaml:12:12: error: parts[2].faces cannot rename a mesh's faces, expected the names of "
+       "the mesh file's groups (docs/meshes.md)\n"},
+      {"a box and a mesh",
+       ClipSceneWith(11,
+                     "    box: {size: [1 mm, 1 mm, 1 mm]}\n"
+                     "    mesh: {file: clip.obj, scale: 0.001}"),
+       "t.yaml:12:11: error: parts[2] has both a box and a mesh, expected exactly one of 'box', "
+       "'cylinder' and 'mesh'\n"},
+      {"a cylinder's key on a mesh",
+       ClipSceneWith(11, "    mesh: {file: clip.obj, scale: 0.001, radius: 1 mm}"),
+       "t.yaml:11:42: error: unknown key 'radius' in 'parts[2].mesh'"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.what, c.text);
+    const auto loaded = LoadSceneText(c.text, "t.yaml", scenes);
+    CHECK_FALSE(loaded.scene);
+    const std::string got = loaded.diagnostics.FormatAll();
+    if (c.expected.back() == '\n')
+      CHECK(got == c.expected);
+    else
+      CHECK_THAT(got, Catch::StartsWith(c.expected));
+  }
+}
+
+TEST_CASE("A clip on a whole floor overlaps it by its post", "[scene]") {
+  // The floor in one piece under the clip: the post (5 mm under the base) goes into it.
+  std::string text =
+      ClipSceneWith(7, "    box: {size: [60 mm, 200 mm, 10 mm], position: [0, 0, -5 mm]}");
+  // The other slab moved out of the way, 20 mm under the floor.
+  text.replace(text.find("[17.5 mm, 0, -5 mm]"), std::string("[17.5 mm, 0, -5 mm]").size(),
+               "[17.5 mm, 0, -25 mm]");
+  const auto loaded = LoadSceneText(text, "t.yaml", SourcePath("scenes"));
+  CHECK_FALSE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll() ==
+        "t.yaml:11:52: error: part 'clip' overlaps part 'floor', expected parts that at most "
+        "touch\n");
+}
+
+TEST_CASE("A broken mesh file's problems join the scene's, at the mesh file's lines", "[scene]") {
+  // A cube with its ypos face left out (tests/io/mesh_test_meshes.hpp): four edges of one
+  // triangle each, on the lines of top, bottom, xpos and xneg (11, 13, 15, 17), once though two
+  // parts name the file. And a scene problem of its own in the same file: all at once.
+  const auto dir = tubeplan::testing::ScratchDir("mesh-broken");
+  tubeplan::testing::WriteScratch("mesh-broken", "open.obj", tubeplan::testing::CubeObj(4));
+  const std::string text =
+      WithLine(9,
+               "    mesh: {file: open.obj, scale: 0.01, position: [15 mm, 0, 0]}\n"
+               "  - name: again\n"
+               "    mesh: {file: open.obj, scale: 0.01, position: [40 mm, 0, 0]}")
+          .replace(0, std::string("tubeplan: 1").size(), "tubeplan: 2");
+  const auto loaded = LoadSceneText(text, "t.yaml", dir);
+  CHECK_FALSE(loaded.scene);
+  const std::string got = loaded.diagnostics.FormatAll();
+  CHECK_THAT(got, Catch::Contains("t.yaml:1:11: error: unsupported format version 2"));
+  for (int line : {11, 13, 15, 17})
+    CHECK_THAT(got, Catch::Contains((dir / "open.obj").string() + ":" + std::to_string(line) +
+                                    ":1: error: the edge from"));
+  CHECK(std::count(got.begin(), got.end(), '\n') == 5);
 }

@@ -16,10 +16,13 @@ struct SceneLoadResult {
   Diagnostics diagnostics;            ///< every error (and warning) found, all at once
 };
 
-/// Reads and validates a scene file; problems are reported against `path` as given.
+/// Reads and validates a scene file; problems are reported against `path` as given. A mesh
+/// part's file is read relative to the scene file's directory (docs/scene-format.md).
 SceneLoadResult LoadSceneFile(const std::filesystem::path& path);
 
-/// The same for text already in memory; `display_name` is the file name used in diagnostics.
-SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& display_name);
+/// The same for text already in memory; `display_name` is the file name used in diagnostics, and
+/// a mesh part's relative file is read relative to `base_dir` (empty: the current directory).
+SceneLoadResult LoadSceneText(std::string_view yaml_text, const std::string& display_name,
+                              const std::filesystem::path& base_dir = {});
 
 }  // namespace tubeplan::io
