@@ -52,13 +52,29 @@ std::string Summary(const io::TrajectoryInfo& t) {
   return out.str();
 }
 
+// Whether each element is a convex mesh edge, for a mesh edge: a mesh's elements are its faces,
+// then its edges, then its vertices (scene::ElementsOf), counted from the part's first element.
+std::vector<std::optional<bool>> MeshEdgeConvexity(
+    const scene::Scene& s, const std::vector<scene::PartElement>& elements) {
+  std::vector<std::optional<bool>> convex(elements.size());
+  for (std::size_t e = 0, first = 0; e < elements.size(); ++e) {
+    if (e > 0 && elements[e].part_index != elements[e - 1].part_index) first = e;
+    const scene::Part& part = s.parts[elements[e].part_index];
+    if (part.shape != scene::PartShape::kMesh || elements[e].kind != scene::ElementKind::kEdge)
+      continue;
+    const std::size_t edge = e - first - part.mesh->elements.faces.size();
+    convex[e] = part.mesh->elements.edges[edge].convex;
+  }
+  return convex;
+}
+
 }  // namespace
 
 CheckedFile CheckFile(const std::string& file) {
   if (std::filesystem::path(file).extension() == ".csv") {
     // Streamed: a recording of hours is checked in the memory of a few lines.
     io::TrajectoryScanResult scanned = io::ScanTrajectoryFile(file);
-    CheckedFile c{"trajectory", std::move(scanned.diagnostics), std::nullopt, {}};
+    CheckedFile c{"trajectory", std::move(scanned.diagnostics), std::nullopt, {}, {}};
     if (scanned.info) c.summary = Summary(*scanned.info);
     return c;
   }
@@ -66,7 +82,7 @@ CheckedFile CheckFile(const std::string& file) {
   if (const std::optional<std::string> text = io::ReadTextFile(file);
       text && (text->rfind("plan:", 0) == 0 || text->find("\nplan:") != std::string::npos)) {
     io::PlanLoadResult plan = io::LoadPlanFile(file, {.trajectory_in_memory = false});
-    CheckedFile c{"plan", std::move(plan.diagnostics), std::nullopt, {}};
+    CheckedFile c{"plan", std::move(plan.diagnostics), std::nullopt, {}, {}};
     if (plan.plan) {
       std::ostringstream out;
       out << "plan \"" << plan.plan->name << "\": " << plan.plan->states.size() << " states, "
@@ -77,10 +93,11 @@ CheckedFile CheckFile(const std::string& file) {
     return c;
   }
   io::SceneLoadResult loaded = io::LoadSceneFile(file);
-  CheckedFile c{"scene", std::move(loaded.diagnostics), std::nullopt, {}};
+  CheckedFile c{"scene", std::move(loaded.diagnostics), std::nullopt, {}, {}};
   if (loaded.scene) {
     c.summary = Summary(*loaded.scene);
     c.elements = scene::EnumerateElements(*loaded.scene);
+    c.convex = MeshEdgeConvexity(*loaded.scene, c.elements);
   }
   return c;
 }

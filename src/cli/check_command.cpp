@@ -41,15 +41,23 @@ int RunCheck(const CheckOptions& o, Streams io) {
       if (valid) entry["summary"] = *checked.summary;
       if (o.elements) {
         entry["elements"] = nlohmann::json::array();
-        for (const scene::PartElement& e : checked.elements)
-          entry["elements"].push_back({{"name", e.name}, {"kind", batch::ToString(e.kind)}});
+        for (std::size_t i = 0; i < checked.elements.size(); ++i) {
+          const scene::PartElement& e = checked.elements[i];
+          nlohmann::json element = {{"name", e.name}, {"kind", batch::ToString(e.kind)}};
+          if (checked.convex[i]) element["convex"] = *checked.convex[i];
+          entry["elements"].push_back(element);
+        }
       }
       files.push_back(entry);
     } else if (valid) {
       io.out << file << ": ok: " << *checked.summary << "\n";
       if (o.elements)
-        for (const scene::PartElement& e : checked.elements)
-          io.out << "  " << batch::ToString(e.kind) << " " << e.name << "\n";
+        for (std::size_t i = 0; i < checked.elements.size(); ++i) {
+          const scene::PartElement& e = checked.elements[i];
+          io.out << "  " << batch::ToString(e.kind) << " " << e.name;
+          if (checked.convex[i]) io.out << (*checked.convex[i] ? " (convex)" : " (concave)");
+          io.out << "\n";
+        }
     }
   }
   if (o.json) io.out << nlohmann::json{{"files", files}}.dump(2) << "\n";

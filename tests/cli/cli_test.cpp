@@ -178,6 +178,62 @@ TEST_CASE("check --elements lists a box's 26 elements and a cylinder's 5 by name
     CHECK(r.out.find(name) != std::string::npos);
 }
 
+TEST_CASE("check --elements lists a mesh's elements, its edges convex or concave", "[cli]") {
+  // The shipped clip on two floor slabs (a gap for its post), the scene and a copy of the clip
+  // in a scratch directory: the mesh is read next to the scene file.
+  const std::filesystem::path dir = tubeplan::testing::ScratchDir("check-clip");
+  std::filesystem::copy_file(SourcePath("scenes/clip.obj"), dir / "clip.obj",
+                             std::filesystem::copy_options::overwrite_existing);
+  const std::string scene = tubeplan::testing::WriteScratch(
+      "check-clip", "clip.yaml",
+      "tubeplan: 1\nname: clip\n"
+      "tube: {outer_radius: 5 mm, inner_radius: 4 mm, length: 150 mm, youngs_modulus: 3 MPa, "
+      "poisson_ratio: 0.5}\n"
+      "parts:\n"
+      "  - name: floor\n"
+      "    box: {size: [25 mm, 200 mm, 10 mm], position: [-17.5 mm, 0, -5 mm]}\n"
+      "  - name: right\n"
+      "    box: {size: [25 mm, 200 mm, 10 mm], position: [17.5 mm, 0, -5 mm]}\n"
+      "  - name: clip\n"
+      "    mesh: {file: clip.obj, scale: 0.001, position: [0, 20 mm, 0]}\n"
+      "start: {position: [0, -90 mm, 40 mm]}\n"
+      "goal: \"{Fs - clip.floor}\"\n");
+  const Outcome r = RunTool({"check", scene, "--elements"});
+  INFO(r.out << r.err);
+  REQUIRE(r.exit_code == 0);
+  // Two boxes' 26 each; the clip's 16 faces, 38 edges (5 concave), 24 vertices
+  // (tests/io/clip_mesh_test.cpp).
+  int faces = 0, edges = 0, vertices = 0, convex = 0, concave = 0;
+  std::istringstream lines(r.out);
+  for (std::string l; std::getline(lines, l);) {
+    faces += l.rfind("  face ", 0) == 0;
+    edges += l.rfind("  edge ", 0) == 0;
+    vertices += l.rfind("  vertex ", 0) == 0;
+    convex += l.find(" (convex)") != std::string::npos;
+    concave += l.find(" (concave)") != std::string::npos;
+  }
+  CHECK(faces == 2 * 6 + 16);
+  CHECK(edges == 2 * 12 + 38);
+  CHECK(vertices == 2 * 8 + 24);
+  CHECK(convex == 33);
+  CHECK(concave == 5);
+  for (const char* name : {"  face clip.floor\n", "  edge clip.right_inner_floor (concave)\n",
+                           "  edge clip.post_post_end (convex)\n", "  edge floor.top_xpos\n"})
+    CHECK(r.out.find(name) != std::string::npos);
+  // In JSON, a mesh edge carries "convex"; no other element does.
+  const Outcome j = RunTool({"check", scene, "--elements", "--json"});
+  REQUIRE(j.exit_code == 0);
+  const auto elements = nlohmann::json::parse(j.out)["files"][0]["elements"];
+  int with_convexity = 0;
+  for (const auto& e : elements) {
+    if (!e.contains("convex")) continue;
+    ++with_convexity;
+    CHECK(e["name"].get<std::string>().rfind("clip.", 0) == 0);
+    CHECK(e["kind"] == "edge");
+  }
+  CHECK(with_convexity == 38);
+}
+
 TEST_CASE("plans: the rail scene gives a verified plan that hangs the tube over a round part",
           "[cli][explore]") {
   // A cylinder met along its curved side: the tube's side laid across a round rail, bent over

@@ -17,6 +17,9 @@ struct CheckedFile {
   io::Diagnostics diagnostics;
   std::optional<std::string> summary;        ///< set when the file is valid
   std::vector<scene::PartElement> elements;  ///< a valid scene's, in EnumerateElements order
+  /// Per element: a mesh edge's convexity (the material's angle there below 180 deg); unset for
+  /// every other element (a box's and a cylinder's edges are all convex).
+  std::vector<std::optional<bool>> convex;
 };
 
 /// Reads and checks `path`: a .csv is a trajectory (streamed: an hours-long recording is checked
