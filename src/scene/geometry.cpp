@@ -168,8 +168,15 @@ double SegmentDepth(const Part& target, const Eigen::Vector3d& a, const Eigen::V
     pieces = int(std::clamp(std::ceil(length / std::max(piece, 1e-12)), 1.0, 64.0));
   }
   constexpr double kGolden = 0.6180339887498949;
+  double d_lo = da;
   for (int i = 0; i < pieces && best <= tolerance_m; ++i) {
     double lo = double(i) / pieces, hi = double(i + 1) / pieces;
+    // A piece whose ends are far enough out is passed over, as the whole segment above.
+    const double d_hi = i + 1 == pieces ? db : depth(hi);
+    best = std::max(best, d_hi);
+    const bool reaches = (length * (hi - lo) + d_lo + d_hi) / 2.0 > tolerance_m;
+    d_lo = d_hi;
+    if (!reaches) continue;
     double x1 = hi - kGolden * (hi - lo), x2 = lo + kGolden * (hi - lo);
     double f1 = depth(x1), f2 = depth(x2);
     // 60 steps shrink the piece by 0.618^60 = 3e-13: the deepest point to 3e-13 of its length.
@@ -180,7 +187,7 @@ double SegmentDepth(const Part& target, const Eigen::Vector3d& a, const Eigen::V
         hi = x2, x2 = x1, f2 = f1, x1 = hi - kGolden * (hi - lo), f1 = depth(x1);
       }
     }
-    best = std::max({best, f1, f2, depth(double(i + 1) / pieces)});
+    best = std::max({best, f1, f2});
   }
   return best;
 }
