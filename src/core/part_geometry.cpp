@@ -42,8 +42,8 @@ PartGeometry::PartGeometry(const scene::Part& part)
       BuildCylinder();
     else
       BuildBox();
-    thinnest_m_ = 2.0 * half_m_.minCoeff();
   }
+  thinnest_m_ = scene::ThinnestSize_m(part);
   std::vector<Eigen::Vector3d> lo, hi;
   for (const PartEdge& edge : edges_) {
     lo.push_back(edge.min_W);
@@ -58,59 +58,6 @@ bool PartGeometry::Bounds(ElementIndex a, ElementIndex b) const {
   const std::vector<int>& fb = faces_of_element_[b];
   return std::includes(fa.begin(), fa.end(), fb.begin(), fb.end());
 }
-
-namespace {
-
-// The thickness of a mesh's thinnest wall, seen from each face's largest triangle: how far a
-// point goes in from its centre along the inward normal before it leaves the part. Found by
-// steps of 1/256 of the box's diagonal, then halving the step it leaves in to a micrometre.
-double ThinnestWall_m(const scene::PartMesh& part) {
-  const scene::TriangleMesh& mesh = part.mesh;
-  Eigen::AlignedBox3d box;
-  for (const Eigen::Vector3d& v : mesh.vertices_P_m) box.extend(v);
-  const double step_m = box.diagonal().norm() / 256.0;
-  double thinnest_m = std::numeric_limits<double>::infinity();
-  for (const scene::MeshFace& face : part.elements.faces) {
-    int largest = face.triangles.front();
-    double largest_area = 0.0;
-    for (const int t : face.triangles) {
-      const auto& tri = mesh.triangles[std::size_t(t)];
-      const Eigen::Vector3d& a = mesh.vertices_P_m[std::size_t(tri[0])];
-      const double area = (mesh.vertices_P_m[std::size_t(tri[1])] - a)
-                              .cross(mesh.vertices_P_m[std::size_t(tri[2])] - a)
-                              .norm();
-      if (area > largest_area) {
-        largest_area = area;
-        largest = t;
-      }
-    }
-    const auto& tri = mesh.triangles[std::size_t(largest)];
-    const Eigen::Vector3d centre =
-        (mesh.vertices_P_m[std::size_t(tri[0])] + mesh.vertices_P_m[std::size_t(tri[1])] +
-         mesh.vertices_P_m[std::size_t(tri[2])]) /
-        3.0;
-    const Eigen::Vector3d inward = -scene::TriangleNormal(mesh, largest);
-    const auto inside = [&](double t) {
-      return part.distance_P.Distance(centre + t * inward).distance_m < 0.0;
-    };
-    double in_m = 0.0, out_m = step_m;
-    while (out_m < 2.0 * box.diagonal().norm() && inside(out_m)) {
-      in_m = out_m;
-      out_m += step_m;
-    }
-    while (out_m - in_m > 1e-6) {
-      const double mid_m = 0.5 * (in_m + out_m);
-      if (inside(mid_m))
-        in_m = mid_m;
-      else
-        out_m = mid_m;
-    }
-    thinnest_m = std::min(thinnest_m, out_m);
-  }
-  return thinnest_m;
-}
-
-}  // namespace
 
 void PartGeometry::BuildBox() {
   vertices_W_.resize(8);
@@ -227,7 +174,6 @@ void PartGeometry::BuildMesh() {
     vertices_W_.push_back(p_WP_ + R_WP_ * vertex.position_P_m);
     vertex_elements_.push_back(ElementIndex(faces + edges + v));
   }
-  thinnest_m_ = ThinnestWall_m(*mesh_);
 }
 
 void PartGeometry::AddMeshEdges() {

@@ -82,7 +82,7 @@ class PartGeometry {
   bool Bounds(ElementIndex a, ElementIndex b) const;
   const Eigen::Vector3d& min_W() const { return min_W_; }
   const Eigen::Vector3d& max_W() const { return max_W_; }
-  /// The smallest of a box's or a cylinder's three extents, a mesh's thinnest wall [m].
+  /// How thin the part is (scene::ThinnestSize_m) [m].
   double thinnest_m() const { return thinnest_m_; }
 
  private:
