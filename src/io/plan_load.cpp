@@ -164,7 +164,9 @@ PlanLoadResult ReadPlanText(std::string_view yaml_text, const std::string& displ
   std::optional<scene::Scene> scene;
   if (const auto named = read_named("scene", "a scene file path relative to the plan file",
                                     kMaxYamlBytes, p.scene)) {
-    SceneLoadResult loaded = LoadSceneText(named->text, named->full);
+    // A mesh the scene names lies relative to the scene file, not to the plan.
+    SceneLoadResult loaded =
+        LoadSceneText(named->text, named->full, std::filesystem::path(named->full).parent_path());
     result.diagnostics.Append(loaded.diagnostics);
     if (!loaded.scene) r.Error(named->node, "scene: '" + named->full + "' has errors (listed)");
     scene = std::move(loaded.scene);
