@@ -22,6 +22,7 @@ namespace tubeplan::core {
 /// An element's index within its part (scene::ElementsOf), or none.
 using ElementIndex = std::uint16_t;
 inline constexpr ElementIndex kNoElement = 0xFFFF;
+static_assert(scene::kMaxElements < kNoElement, "every element of a part has an index");
 
 /// The nearest point of a part to a query point.
 struct PartDistance {

@@ -179,6 +179,17 @@ void ReadMesh(Reader& r, const YAML::Node& shape, const std::string& sw, scene::
     MeshLoadResult loaded = LoadMeshBytes(*read.text, path.string(), *scale);
     r.diagnostics().Append(loaded.diagnostics);
     if (!loaded.mesh) return;
+    const scene::MeshElements& e = *loaded.elements;
+    const std::size_t count = e.faces.size() + e.edges.size() + e.vertices.size();
+    if (count > scene::kMaxElements) {
+      r.Error(r.Get(shape, "file", sw, true),
+              sw + ".file: '" + path.string() + "' has " + std::to_string(count) +
+                  " faces, edges and vertices, expected at most " +
+                  std::to_string(scene::kMaxElements) +
+                  " (export it with fewer sharp features, or smooth curved surfaces finer: "
+                  "docs/meshes.md)");
+      return;
+    }
     mesh = scene::MakePartMesh(*file, std::move(*loaded.mesh), std::move(*loaded.elements));
   }
   if (!mesh) return;

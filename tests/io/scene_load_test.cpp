@@ -572,6 +572,28 @@ TEST_CASE("A scene file's mesh is read relative to the scene file's directory", 
                                      "wall.top_xpos_ypos") >= 0);
 }
 
+TEST_CASE("A mesh of more elements than the core can number is refused at its file", "[scene]") {
+  // 14^3 separate cubes in one file: 2,744 closed bodies of 26 elements each, 71,344 in all.
+  std::ostringstream obj;
+  for (int c = 0; c < 14 * 14 * 14; ++c) {
+    const Eigen::Vector3d at(2.0 * (c % 14), 2.0 * (c / 14 % 14), 2.0 * (c / 196));
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d p = tubeplan::testing::CubeCorner(i) + at;
+      obj << "v " << p.x() << " " << p.y() << " " << p.z() << "\n";
+    }
+    for (const std::array<int, 4>& f : tubeplan::testing::kCubeFaces)
+      obj << "f " << f[0] - 8 << " " << f[1] - 8 << " " << f[2] - 8 << " " << f[3] - 8 << "\n";
+  }
+  const std::string scene_path = tubeplan::testing::WriteScratch(
+      "mesh-many", "many-scene.yaml",
+      WithLine(9, "    mesh: {file: many.obj, scale: 0.0005, position: [15 mm, 0, 0]}"));
+  tubeplan::testing::WriteScratch("mesh-many", "many.obj", obj.str());
+  const auto loaded = LoadSceneFile(scene_path);
+  CHECK_FALSE(loaded.scene);
+  CHECK(loaded.diagnostics.FormatAll().find(
+            "has 71344 faces, edges and vertices, expected at most 65534") != std::string::npos);
+}
+
 TEST_CASE("A mesh part's problems are reported where they are", "[scene]") {
   const std::string scenes = SourcePath("scenes");
   struct Case {

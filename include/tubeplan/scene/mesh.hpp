@@ -5,6 +5,7 @@
 // data in the part's frame P, metres; files are read by io/mesh_file.hpp.
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -71,6 +72,10 @@ struct MeshProblem {
 std::vector<MeshProblem> CheckMesh(const TriangleMesh& mesh);
 
 // --- Elements -------------------------------------------------------------------------------
+
+/// The most faces, edges and vertices a part may have together: the core names a contact's
+/// element by its index within the part in 16 bits (one value kept for none).
+inline constexpr std::size_t kMaxElements = 65534;
 
 /// Neighbouring triangles whose normals differ by less than this lie on one face: a tessellated
 /// cylinder of 19 or more segments or a fillet of 5 or more is one face, a box's sides are six.
