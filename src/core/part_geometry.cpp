@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <stdexcept>
 
 #include <tubeplan/scene/elements.hpp>
 
@@ -54,9 +55,8 @@ PartGeometry::PartGeometry(const scene::Part& part)
 
 bool PartGeometry::Bounds(ElementIndex a, ElementIndex b) const {
   if (mesh_ == nullptr) return (mask_of_element_[a] & mask_of_element_[b]) == mask_of_element_[b];
-  const std::vector<int>& fa = faces_of_element_[a];
-  const std::vector<int>& fb = faces_of_element_[b];
-  return std::includes(fa.begin(), fa.end(), fb.begin(), fb.end());
+  const std::vector<ElementIndex>& on = bounded_[a];
+  return a == b || std::binary_search(on.begin(), on.end(), b);
 }
 
 void PartGeometry::BuildBox() {
@@ -149,11 +149,28 @@ void PartGeometry::BuildCylinder() {
 void PartGeometry::BuildMesh() {
   const scene::MeshElements& el = mesh_->elements;
   const int faces = int(el.faces.size()), edges = int(el.edges.size());
-  for (int f = 0; f < faces; ++f) faces_of_element_.push_back({f});
-  for (const scene::MeshEdge& edge : el.edges)
-    faces_of_element_.push_back(
-        {std::min(edge.face_a, edge.face_b), std::max(edge.face_a, edge.face_b)});
-  for (const scene::MeshVertex& vertex : el.vertices) faces_of_element_.push_back(vertex.faces);
+  if (el.faces.size() + el.edges.size() + el.vertices.size() > scene::kMaxElements)
+    throw std::invalid_argument("a mesh part has more elements than scene::kMaxElements");
+  // What each element lies on: by the faces an edge joins and a vertex is on, and by the chains
+  // that end in a vertex (two chains between the same faces are two edges).
+  bounded_.assign(std::size_t(faces + edges) + el.vertices.size(), {});
+  for (int e = 0; e < edges; ++e) {
+    const scene::MeshEdge& edge = el.edges[std::size_t(e)];
+    std::vector<ElementIndex>& on = bounded_[std::size_t(faces + e)];
+    on = {ElementIndex(edge.face_a), ElementIndex(edge.face_b)};
+    for (const auto& segment : edge.segments)
+      for (const int v : segment)
+        if (const int feature = el.vertex_element[std::size_t(v)]; feature >= 0)
+          bounded_[std::size_t(faces + edges + feature)].push_back(ElementIndex(faces + e));
+  }
+  for (int v = 0; v < int(el.vertices.size()); ++v) {
+    std::vector<ElementIndex>& on = bounded_[std::size_t(faces + edges + v)];
+    for (const int f : el.vertices[std::size_t(v)].faces) on.push_back(ElementIndex(f));
+  }
+  for (std::vector<ElementIndex>& on : bounded_) {
+    std::sort(on.begin(), on.end());
+    on.erase(std::unique(on.begin(), on.end()), on.end());
+  }
   min_W_.setConstant(std::numeric_limits<double>::infinity());
   max_W_ = -min_W_;
   for (const Eigen::Vector3d& v_P : mesh_->mesh.vertices_P_m) {

@@ -4,7 +4,8 @@
 // segments, vertices as points) that can poke into the tube between its sections. Boxes,
 // cylinders and meshes; a cylinder's rims are polygons of short segments and its side bears on
 // the tube between sections as its axis does, grown by its radius. A mesh's convex edges poke
-// as chains of its triangles' edges, its convex corners as points.
+// as chains of its triangles' edges, a curved face's ridges as edges of that face (the nearest
+// one to a piece of the tube only), its convex corners as points.
 
 #include <array>
 #include <cstdint>
@@ -110,9 +111,9 @@ class PartGeometry {
   std::array<ElementIndex, 64> element_of_mask_{};
   std::vector<std::uint8_t> mask_of_element_;
   std::shared_ptr<const scene::PartMesh> mesh_;
-  /// A mesh element's faces (indices into MeshElements::faces), ascending: a face's one, an
-  /// edge's two, a vertex's all.
-  std::vector<std::vector<int>> faces_of_element_;
+  /// Per mesh element, the elements it lies on, itself left out: an edge's two faces; a vertex's
+  /// faces and the edges whose chains end in it. Ascending.
+  std::vector<std::vector<ElementIndex>> bounded_;
   scene::AabbTree edge_tree_;
   double thinnest_m_ = 0.0;
   Eigen::Vector3d min_W_ = Eigen::Vector3d::Zero(), max_W_ = Eigen::Vector3d::Zero();

@@ -161,10 +161,16 @@ TEST_CASE("A box mesh's geometry: the box's distances, edges, corners and thickn
     // Outside and inside alike (inside, the box without an entry face leaves by the nearest
     // face, as the mesh does), to rounding.
     CHECK(m.distance_m == Approx(b.distance_m).margin(1e-12));
+    // The normal is the distance's gradient, the mesh's from its pseudo-normals: rounding of
+    // the nearest point's coordinates (1e-17 m) over distances of 1e-8 m and more.
     CHECK((m.normal_W - b.normal_W).norm() < 1e-9);
-    // Far from a tie between two elements (where either is right), the same element.
-    if (std::abs(b.distance_m) > 1e-6) CHECK(em[m.element].name == eb[b.element].name);
-    CHECK((m.curvature_per_m - b.curvature_per_m).norm() < 1e-6 / std::abs(b.distance_m));
+    // Away from a tie between two elements (either is right there) and from the surface (where
+    // the curvature, C / d, grows without bound): the same element, and the curvature to 1e-6
+    // of its size 1/d.
+    if (std::abs(b.distance_m) > 1e-6) {
+      CHECK(em[m.element].name == eb[b.element].name);
+      CHECK((m.curvature_per_m - b.curvature_per_m).norm() < 1e-6 / std::abs(b.distance_m));
+    }
   }
   // Twelve edges and eight corners, each with the box's elements at its ends.
   REQUIRE(gm.edges().size() == 12);
@@ -193,4 +199,72 @@ TEST_CASE("A box mesh's geometry: the box's distances, edges, corners and thickn
   CHECK_FALSE(gm.Bounds(index("top_xpos"), index("bottom")));
   // The thinnest wall is the box's thinnest side: straight through it from a face, to rounding.
   CHECK(gm.thinnest_m() == Approx(0.01).margin(1e-9));
+}
+
+TEST_CASE("Two edges between the same two faces of a mesh bound neither each other", "[core]") {
+  // A D-shaped bar: a half-round side of 20 flats (one curved face) closed by a flat, which
+  // meets the side along two separate lines: two edges, each ending in its own two corners.
+  const double R = 0.01, h = 0.02;
+  scene::TriangleMesh mesh;
+  mesh.names = {"top", "bottom", "side", "flat"};
+  for (const double z : {h, -h})
+    for (int k = 0; k <= 20; ++k) {
+      const double phi = M_PI * (-0.5 + k / 20.0);
+      mesh.vertices_P_m.emplace_back(R * std::cos(phi), R * std::sin(phi), z);
+    }
+  for (int k = 1; k < 20; ++k) {
+    mesh.triangles.push_back({0, k, k + 1});
+    mesh.triangles.push_back({21, 21 + k + 1, 21 + k});
+    mesh.triangle_names.insert(mesh.triangle_names.end(), {0, 1});
+  }
+  for (int k = 0; k < 20; ++k) testing::AddQuad(mesh, 21 + k, 21 + k + 1, k + 1, k, 2);
+  testing::AddQuad(mesh, 41, 21, 0, 20, 3);
+  REQUIRE(scene::CheckMesh(mesh).empty());
+  const scene::Part part = testing::MeshPart("d", mesh, Eigen::Isometry3d::Identity());
+  const scene::MeshElements& el = part.mesh->elements;
+  const core::PartGeometry g(part);
+  const int faces = int(el.faces.size()), edges = int(el.edges.size());
+  // The two side-flat edges, and the corners at y < 0 and y > 0 on the top.
+  std::vector<int> lines;
+  for (int e = 0; e < edges; ++e) {
+    const scene::MeshEdge& edge = el.edges[std::size_t(e)];
+    if (el.faces[std::size_t(edge.face_a)].name + el.faces[std::size_t(edge.face_b)].name ==
+        "sideflat")
+      lines.push_back(faces + e);
+  }
+  REQUIRE(lines.size() == 2);
+  std::vector<int> corners(2, -1);
+  for (int v = 0; v < int(el.vertices.size()); ++v) {
+    const Eigen::Vector3d& p = el.vertices[std::size_t(v)].position_P_m;
+    if (p.z() > 0.0) corners[p.y() > 0.0 ? 1 : 0] = faces + edges + v;
+  }
+  REQUIRE(corners[0] >= 0);
+  REQUIRE(corners[1] >= 0);
+  // Which line each corner ends: the line whose first segment starts or ends at its height.
+  const auto line_of = [&](int corner) {
+    const int mesh_vertex = el.vertices[std::size_t(corner - faces - edges)].mesh_vertex;
+    for (const int l : lines)
+      for (const auto& segment : el.edges[std::size_t(l - faces)].segments)
+        if (segment[0] == mesh_vertex || segment[1] == mesh_vertex) return l;
+    return -1;
+  };
+  const int l0 = line_of(corners[0]), l1 = line_of(corners[1]);
+  REQUIRE(l0 >= 0);
+  REQUIRE(l1 >= 0);
+  REQUIRE(l0 != l1);
+  const auto bounds = [&](int a, int b) {
+    return g.Bounds(core::ElementIndex(a), core::ElementIndex(b));
+  };
+  CHECK_FALSE(bounds(lines[0], lines[1]));
+  CHECK_FALSE(bounds(lines[1], lines[0]));
+  CHECK(bounds(corners[0], l0));
+  CHECK_FALSE(bounds(corners[0], l1));
+  CHECK(bounds(corners[1], l1));
+  CHECK_FALSE(bounds(corners[0], corners[1]));
+  // Each line lies on both its faces; a corner on its three.
+  const int side = scene::FindElement(scene::ElementsOf(part, 0), "d.side");
+  const int flat = scene::FindElement(scene::ElementsOf(part, 0), "d.flat");
+  CHECK(bounds(l0, side));
+  CHECK(bounds(l0, flat));
+  CHECK(bounds(corners[1], side));
 }
