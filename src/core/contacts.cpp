@@ -165,6 +165,8 @@ class Finder {
       if (!edge.ridge) continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(p0, p1, edge.a_W, edge.b_W, theta, u);
+      // An end the ridge does not bear is the bearer's nearest point too: the bearer stands.
+      if ((u == 0.0 && !edge.a_bears) || (u == 1.0 && !edge.b_bears)) continue;
       const double gap_m = (p0 + theta * (p1 - p0) - edge.a_W - u * (edge.b_W - edge.a_W)).norm();
       int k = 0;
       while (k < ridge_count_ && nearest_ridges_[std::size_t(k)].element != edge.element) ++k;
@@ -420,7 +422,7 @@ class Finder {
     const double theta_hi = i == 0 && n_ > 1 ? 0.5 : 1.0;
     const auto& edges = part.geometry.edges();
     FindEdgesNear(part, lo, hi);
-    FindNearestRidges(part, a, b);
+    FindNearestRidges(part, a + theta_lo * v, a + theta_hi * v);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
       if (!Bears(edge, e)) continue;
