@@ -642,7 +642,7 @@ void WarnThinParts(Reader& r, const YAML::Node& root, const scene::Scene& s) {
   for (const scene::Part& part : s.parts) {
     const double hold_N = scene::ContactHoldAtMiddle_N(s, part);
     if (!(hold_N < s.device.max_force_N)) continue;
-    const double thinnest_m = scene::ThinnestSize_m(part);  // a mesh's walls traced again: rare
+    const double thinnest_m = scene::ThinnestSize_m(part);
     if (thinnest_m <= 0.0) continue;
     std::ostringstream m;
     m << "part " << part.name << " is " << thinnest_m * 1e3

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <stdexcept>
 #include <utility>
 
 #include <tubeplan/scene/scene.hpp>
@@ -45,7 +46,7 @@ double ThinnestWall_m(const PartMesh& m) {
 }  // namespace
 
 double ThinnestSize_m(const Part& part) {
-  if (part.shape == PartShape::kMesh && part.mesh) return ThinnestWall_m(*part.mesh);
+  if (part.shape == PartShape::kMesh && part.mesh) return part.mesh->thinnest_m;
   return part.size_m.minCoeff();
 }
 
@@ -85,8 +86,12 @@ std::shared_ptr<const PartMesh> MakePartMesh(std::string file, TriangleMesh mesh
   part_mesh->file = std::move(file);
   part_mesh->mesh = std::move(mesh);
   part_mesh->elements = std::move(elements);
+  const MeshElements& e = part_mesh->elements;
+  if (e.faces.size() + e.edges.size() + e.vertices.size() > kMaxElements)
+    throw std::invalid_argument("a mesh has more faces, edges and vertices than kMaxElements");
   part_mesh->distance_P =
       MeshGeometry(part_mesh->mesh, part_mesh->elements, Eigen::Isometry3d::Identity());
+  part_mesh->thinnest_m = ThinnestWall_m(*part_mesh);
   return part_mesh;
 }
 

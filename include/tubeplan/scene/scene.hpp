@@ -60,9 +60,12 @@ struct PartMesh {
   TriangleMesh mesh;
   MeshElements elements;
   MeshGeometry distance_P;  ///< placed at the identity: query it with points in P
+  double thinnest_m = 0.0;  ///< its thinnest wall (ThinnestSize_m), measured once [m]
 };
 
-/// A PartMesh of a sound mesh (CheckMesh found nothing) and its elements, its queries built.
+/// A PartMesh of a sound mesh (CheckMesh found nothing) and its elements, its queries built
+/// and its thinnest wall measured. Throws std::invalid_argument for more than kMaxElements
+/// elements.
 std::shared_ptr<const PartMesh> MakePartMesh(std::string file, TriangleMesh mesh,
                                              MeshElements elements);
 
