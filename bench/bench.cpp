@@ -240,8 +240,8 @@ CorePoses PosesFor(const scene::Scene& scene) {
   return p;
 }
 
-// Cells along each edge of a face of the mesh floor: 12 * 29^2 = 10,092 triangles, the size the
-// core's mesh parts are held to (a tick at most twice a box part's).
+// Cells along each edge of a face of the mesh floor: 12 * 29^2 = 10,092 triangles, the size of
+// part a tick on a mesh is compared with its box twin at.
 constexpr int kMeshFloorDivisions = 29;
 
 // The scene with its part named "floor" (a box) made a tessellated mesh of the same size, centred

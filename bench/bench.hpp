@@ -1,5 +1,5 @@
 #pragma once
-// The bench harness (`tubeplan bench`, docs/speed.md): scenarios of the beam models and of the
+// The bench harness (`tubeplan bench`, docs/core.md): scenarios of the beam models and of the
 // core's tick, each timed over samples with std::chrono::steady_clock after a warm-up. Calls far
 // shorter than the clock's overhead (~20 ns) are timed in batches and reported per call. Each
 // core scenario steps kReplicas cores in lockstep (the same scene and hand poses, so the same

@@ -1,5 +1,5 @@
 #pragma once
-// The bench's figures as `tubeplan bench` prints them (docs/speed.md): a table with a row per
+// The bench's figures as `tubeplan bench` prints them (docs/core.md): a table with a row per
 // scenario and a closing line, or each scenario as a JSON entry of one document (times in
 // microseconds).
 

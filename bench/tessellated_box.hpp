@@ -1,6 +1,6 @@
 #pragma once
 // A box as a closed triangle mesh, each face cut into a grid: the mesh twin of a box part, for
-// timing the core on a mesh part against the same box (tubeplan bench, docs/speed.md).
+// timing the core on a mesh part against the same box (tubeplan bench, docs/core.md).
 
 #include <memory>
 

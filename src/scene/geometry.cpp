@@ -155,7 +155,8 @@ Features FeaturesOf(const Part& part, double tolerance_m) {
 // whose ends are far enough out cannot reach in; otherwise a golden-section search for the
 // deepest point, exact for a convex target (the depth is then concave along the segment). A
 // mesh may be concave: the search runs on pieces no longer than a sixteenth of its thinnest
-// box extent, so that each piece crosses at most one of its walls.
+// box extent (64 pieces at most), so walls farther apart than a piece are each seen; two walls
+// within one piece can hide the one the search does not converge to.
 double SegmentDepth(const Part& target, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                     double tolerance_m) {
   const auto depth = [&](double t) { return -SignedDistanceInPart(target, a + t * (b - a)); };
@@ -198,7 +199,7 @@ bool FeatureReaches(const Part& a, const Part& b, double tolerance_m) {
   const Eigen::Isometry3d X_BA = b.X_WP.inverse() * a.X_WP;
   std::vector<Eigen::Vector3d> points_B;
   points_B.reserve(f.points_P.size());
-  // Only what lies in b's bounding box grown by the tolerance can reach into b.
+  // Only what lies in b's bounding box can reach into b deeper than the tolerance.
   Eigen::AlignedBox3d box_B = BoundsInPart(b);
   for (const Eigen::Vector3d& p : f.points_P) {
     points_B.push_back(X_BA * p);
