@@ -15,6 +15,7 @@
 #include <tubeplan/scene/elements.hpp>
 
 #include "core/part_geometry.hpp"
+#include "core_scenes.hpp"
 #include "mesh_parts.hpp"
 
 using namespace tubeplan;
@@ -23,18 +24,8 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The rubber tube of scenes/groove.yaml, held stiffly (as the closed-form tests of the core).
-scene::Scene RubberScene() {
-  scene::Scene s;
-  s.name = "rubber";
-  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
-  s.contact = {1e4, 1e-3, 1e-4};
-  s.device.coupling_stiffness_N_per_m = 400.0;
-  s.device.coupling_damping_Ns_per_m = 0.0;
-  s.device.max_torque_Nm = 100.0;
-  s.device.max_force_N = 50.0;
-  return s;
-}
+using testing::RubberScene;
+using testing::SteelScene;
 
 // A box turned 45 deg about y with its top-xpos edge along world y under the tube's path, and
 // its end (ypos) face across the path: the tube meets a face, an edge and a vertex.
@@ -98,8 +89,7 @@ TEST_CASE("A box written as twelve triangles is felt as the box part, tick by ti
 TEST_CASE("The side on a frictionless bar of 64 flat sides: 3EI/a^3 in series", "[core]") {
   // The round bar's test (core_test.cpp) with the bar written as a prism: its ridges bear on the
   // tube between the sections as the cylinder's side does.
-  scene::Scene s = RubberScene();
-  s.tube = {3e-3, 2.5e-3, 0.3, 200e9, 0.3};
+  scene::Scene s = SteelScene();
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   const double a = 2.0 * l / 3.0, R = 5e-3;
   Eigen::Isometry3d X_WB = Eigen::Isometry3d::Identity();
