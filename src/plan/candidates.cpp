@@ -36,24 +36,31 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     c.plan.scene = options.scene_ref;
     c.plan.limits.max_force_N = scene.device.max_force_N;
     c.plan.limits.dwell_s = options.dwell_s;
-    // The asked speed, then each slower one until a replay is feasible; then the same aiming
-    // the hand at the held end's poses.
+    // At the asked speed, then each slower one until a replay is feasible: the hand aimed at
+    // the witnesses' hand poses and at their held end's poses, the feasible one of least peak
+    // force kept (else the last tried).
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    const std::size_t speeds = options.slower.size() + 1;
     const std::array<std::vector<Eigen::Isometry3d>, 2> aims = {
         Waypoints(scene, graph, *c.path, false), Waypoints(scene, graph, *c.path, true)};
-    for (std::size_t k = 0; k < 2 * speeds; ++k) {
-      const std::vector<Eigen::Isometry3d>& waypoints = aims[k >= speeds ? 1 : 0];
-      synthesis.peak_speed_m_per_s = options.synthesis.peak_speed_m_per_s /
-                                     (k % speeds > 0 ? options.slower[k % speeds - 1] : 1.0);
-      c.trajectory = trajectories::SynthesizeTrajectory(waypoints, synthesis);
-      c.duration_s = c.trajectory.samples.back().t_s;
-      c.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
-      c.held = k >= speeds;
-      c.tries = int(k) + 1;
-      const std::optional<trajectories::Trajectory> read = as_written(c.trajectory);
-      c.judgement = read ? Judge(scene, *read, c.plan.states, c.plan.limits) : Judgement{};
+    int tried = 0;
+    for (std::size_t k = 0; k <= options.slower.size(); ++k) {
+      synthesis.peak_speed_m_per_s =
+          options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
+      for (std::size_t a = 0; a < aims.size(); ++a) {
+        Candidate t = c;
+        t.trajectory = trajectories::SynthesizeTrajectory(aims[a], synthesis);
+        t.duration_s = t.trajectory.samples.back().t_s;
+        t.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
+        t.held = a == 1;
+        t.tries = ++tried;
+        const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
+        t.judgement = read ? Judge(scene, *read, t.plan.states, t.plan.limits) : Judgement{};
+        const bool better =
+            t.judgement.feasible &&
+            (!c.judgement.feasible || t.judgement.peak_force_N < c.judgement.peak_force_N);
+        if (better || !c.judgement.feasible) c = std::move(t);
+      }
       if (c.judgement.feasible) break;
     }
     candidates.push_back(std::move(c));

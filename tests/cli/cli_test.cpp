@@ -68,8 +68,9 @@ TEST_CASE("plans: writes each candidate as a plan file and a trajectory that loa
     REQUIRE(std::filesystem::exists(yaml));
     const std::size_t line = r.out.find(name + ": cost");
     const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
-    // Feasible at the asked speed, with the peak force that evaluate finds on its files.
-    const std::string peak = "; feasible; peak operator force ";
+    // Feasible, with the peak force that evaluate finds on its files.
+    CHECK(said.find("; feasible") != std::string::npos);
+    const std::string peak = "; peak operator force ";
     REQUIRE(said.find(peak) != std::string::npos);
     const std::string newtons = said.substr(said.find(peak) + peak.size());
     CHECK(newtons.ends_with(" N"));
@@ -103,7 +104,7 @@ TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[
   const std::size_t line = r.out.find("shelf-candidate-1: cost");
   REQUIRE(line != std::string::npos);
   const std::string said = r.out.substr(line, r.out.find('\n', line) - line);
-  CHECK(said.find("-> {Fs - shelf.top}; feasible; peak operator force ") != std::string::npos);
+  CHECK(said.find("-> {Fs - shelf.top}; feasible") != std::string::npos);
   const double peak_N = std::stod(said.substr(said.rfind("force ") + 6));
   CHECK(peak_N > 0.0);
   CHECK(peak_N < 8.5);

@@ -26,11 +26,10 @@ struct CandidateOptions {
   double dwell_s = 0.0;   ///< the plans' dwell (the explorer's)
   std::string scene_ref;  ///< the scene as the plan files name it
   /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
-  /// less): the first try is at the asked speed. When none replays feasible, the same speeds
-  /// are tried again aiming the hand at the held end's poses at the witnesses (Node::X_WH) rather
-  /// than the hand's: a witness the explorer reached while the tube held back from the hand (the
-  /// coupling stretched, the tube pushed hard, or still moving) is then approached without the
-  /// push that carried the tube on.
+  /// less): the first tries are at the asked speed. At each speed the hand is aimed at the
+  /// witnesses' hand poses and at their held end's poses (Node::X_WH): a witness the explorer
+  /// reached while the tube held back from the hand (the coupling stretched, the tube pushed
+  /// hard, or still moving) is then approached without the push that carried the tube on.
   std::vector<double> slower = {2.0, 4.0};
 };
 
@@ -41,7 +40,7 @@ struct Candidate {
   double duration_s = 0.0;
   double peak_speed_m_per_s = 0.0;  ///< of the try kept
   bool held = false;                ///< the try kept aims at the held end's poses
-  int tries = 0;                    ///< 1 when the first was kept
+  int tries = 0;                    ///< which try was kept, in the order tried (from 1)
   Judgement judgement;
 };
 
@@ -50,8 +49,9 @@ struct Candidate {
 using AsWritten =
     std::function<std::optional<trajectories::Trajectory>(const trajectories::Trajectory&)>;
 
-/// One candidate for each path (in order), each the first try that replays feasible or else the
-/// last; the feasible come first, each kind in the paths' order.
+/// One candidate for each path (in order): of the two tries at the fastest speed where one
+/// replays feasible, the feasible one of least peak operator force, or else the last try; the
+/// feasible come first, each kind in the paths' order.
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options, const AsWritten& as_written);
