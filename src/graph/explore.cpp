@@ -389,6 +389,17 @@ Move MoveTo(const Eigen::Vector3d& p, const Eigen::Quaterniond& q, double speed,
   return m;
 }
 
+// A move by `d` from wherever the hand is (where a guard stopped the move before), kept in the
+// workspace, guarded against the force that pushes back along d.
+Move MoveBy(const scene::Scene& scene, const Eigen::Vector3d& d, const Eigen::Quaterniond& q,
+            double speed, double guard_N) {
+  Move m = MoveTo(d, q, speed, guard_N, Eigen::Vector3d::Zero());
+  m.relative = true;
+  if (scene.workspace)
+    m.within_W = Eigen::AlignedBox3d(scene.workspace->min_W_m, scene.workspace->max_W_m);
+  return m;
+}
+
 std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const ExploreOptions& o) {
   const Frame f = StartFrame(scene);
   const double r = scene.tube.outer_radius_m;
@@ -412,22 +423,14 @@ std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const Expl
       down.z() = std::min(p.z(), box.lo.z());
       down = ClampToWorkspace(scene, down);
       m.moves.push_back(MoveTo(down, q, 0.5 * o.speed_m_per_s, o.push_N, p));
-      // Sideways both ways, then along the tube's axis: contact moves, at half speed. Each
-      // starts where the last one stopped, which the runner knows and we do not: the guard
-      // direction is set from the nominal path.
+      // Sideways both ways, then along the tube's axis: contact moves, at half speed, each from
+      // where the last one stopped (the friction of the pressed tube stays below its guard).
       const double slide = 2.0 * r;
-      const std::array<Eigen::Vector3d, 3> slides = {Eigen::Vector3d(slide * f.lateral),
-                                                     Eigen::Vector3d(-2.0 * slide * f.lateral),
-                                                     Eigen::Vector3d(2.5 * r * f.axis)};
-      for (const Eigen::Vector3d& d : slides) {
-        const Eigen::Vector3d from = m.moves.back().p_W_m;
-        Move move =
-            MoveTo(ClampToWorkspace(scene, from + d), q, 0.5 * o.speed_m_per_s, o.push_N, from);
-        move.guard_N = 1.5 * o.push_N;  // friction of the pressed tube stays below this
-        m.moves.push_back(move);
-      }
-      m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 5.0 * r * f.up), f.q0,
-                               o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
+      for (const Eigen::Vector3d& d :
+           {Eigen::Vector3d(slide * f.lateral), Eigen::Vector3d(-2.0 * slide * f.lateral),
+            Eigen::Vector3d(2.5 * r * f.axis)})
+        m.moves.push_back(MoveBy(scene, d, q, 0.5 * o.speed_m_per_s, 1.5 * o.push_N));
+      m.moves.push_back(MoveBy(scene, 5.0 * r * f.up, f.q0, o.speed_m_per_s, 0.0));
       motions.push_back(std::move(m));
     }
   }
@@ -503,17 +506,15 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
         m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, above));
         // Onto the surface, stopped by the first light push (the element touched, the tube not
-        // yet bent by it) and held there, then pressed.
-        const Eigen::Vector3d touch = aim.hand + gap * aim.push;
-        m.moves.push_back(MoveTo(touch, q, 0.1 * o.speed_m_per_s, kTouchGuard_N, aim.hand));
-        m.moves.push_back(MoveTo(touch, q, o.speed_m_per_s, 0.0, touch));
+        // yet bent by it) and held where it stopped, then pressed, slid and backed off, each
+        // from where the last move stopped.
+        m.moves.push_back(MoveBy(scene, gap * aim.push, q, 0.1 * o.speed_m_per_s, kTouchGuard_N));
+        m.moves.push_back(MoveBy(scene, Eigen::Vector3d::Zero(), q, o.speed_m_per_s, 0.0));
         m.moves.back().min_ticks = 100;
-        const Eigen::Vector3d pressed = aim.hand + (gap + 3e-3) * aim.push;
-        m.moves.push_back(MoveTo(pressed, q, 0.5 * o.speed_m_per_s, o.push_N, touch));
-        m.moves.push_back(MoveTo(ClampToWorkspace(scene, pressed + 1.5 * r * aim.slide), q,
-                                 0.5 * o.speed_m_per_s, 1.5 * o.push_N, pressed));
-        m.moves.push_back(MoveTo(ClampToWorkspace(scene, m.moves.back().p_W_m + 2.5 * r * n_W), q,
-                                 o.speed_m_per_s, 0.0, m.moves.back().p_W_m));
+        m.moves.push_back(MoveBy(scene, 3e-3 * aim.push, q, 0.5 * o.speed_m_per_s, o.push_N));
+        m.moves.push_back(
+            MoveBy(scene, 1.5 * r * aim.slide, q, 0.5 * o.speed_m_per_s, 1.5 * o.push_N));
+        m.moves.push_back(MoveBy(scene, 2.5 * r * n_W, q, o.speed_m_per_s, 0.0));
         motions.push_back(std::move(m));
         break;  // one tip motion and one side motion per element
       }

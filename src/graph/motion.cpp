@@ -35,6 +35,18 @@ Eigen::Isometry3d MotionRunner::Pose() const {
   return X;
 }
 
+namespace {
+
+// Where a move that starts at p_from_W ends.
+Eigen::Vector3d TargetOf(const Move& move, const Eigen::Vector3d& p_from_W) {
+  if (!move.relative) return move.p_W_m;
+  const Eigen::Vector3d p = p_from_W + move.p_W_m;
+  if (move.within_W.isEmpty()) return p;
+  return p.cwiseMax(move.within_W.min()).cwiseMin(move.within_W.max());
+}
+
+}  // namespace
+
 Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
   while (move_ < moves_.size()) {
     const Move& move = moves_[move_];
@@ -43,7 +55,7 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
       // translation and the rotation, whole ticks, at least one.
       p_from_W_m_ = p_W_m_;
       q_from_W_ = q_W_;
-      const double distance_m = (move.p_W_m - p_from_W_m_).norm();
+      const double distance_m = (TargetOf(move, p_from_W_m_) - p_from_W_m_).norm();
       const double angle_rad = q_from_W_.angularDistance(move.q_W);
       const double duration_s = std::max(distance_m / std::max(move.speed_m_per_s, 1e-6),
                                          angle_rad / std::max(move.turn_rad_per_s, 1e-6));
@@ -60,7 +72,7 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
     }
     ++move_tick_;
     const double u = static_cast<double>(move_tick_) / move_ticks_;
-    p_W_m_ = p_from_W_m_ + u * (move.p_W_m - p_from_W_m_);
+    p_W_m_ = p_from_W_m_ + u * (TargetOf(move, p_from_W_m_) - p_from_W_m_);
     q_W_ = q_from_W_.slerp(u, move.q_W);
     break;
   }

@@ -97,6 +97,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                        {"turn_rad_per_s", mv.turn_rad_per_s},
                        {"guard_dir", {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()}},
                        {"guard_N", mv.guard_N}});
+      if (mv.relative) moves.back()["relative"] = true;
       if (mv.min_ticks > 0) moves.back()["min_ticks"] = mv.min_ticks;
       if (mv.max_ticks > 0) moves.back()["max_ticks"] = mv.max_ticks;
     }

@@ -334,6 +334,65 @@ TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit"
   }
 }
 
+TEST_CASE("A relative move goes on from where a guard stopped the move before",
+          "[graph][explore]") {
+  const scene::Scene s = Groove();
+  // Straight down, far below the floor's top, until the floor pushes back with 1 N; then 10 mm
+  // across from there, and 10 mm further kept inside a box that ends 4 mm on.
+  const Eigen::Vector3d p0 = s.X_WH_start.translation();
+  const Eigen::Quaterniond q0(s.X_WH_start.linear());
+  graph::Motion m;
+  graph::Move down;
+  down.p_W_m = p0 - Eigen::Vector3d(0.0, 0.0, 0.2);
+  down.q_W = q0;
+  down.speed_m_per_s = 0.05;
+  down.guard_dir_W = Eigen::Vector3d::UnitZ();
+  down.guard_N = 1.0;
+  graph::Move across = down;
+  across.relative = true;
+  across.p_W_m = Eigen::Vector3d(0.01, 0.0, 0.0);
+  across.guard_N = 0.0;
+  graph::Move clamped = across;
+  clamped.within_W = Eigen::AlignedBox3d(Eigen::Vector3d::Constant(-1.0),
+                                         Eigen::Vector3d(p0.x() + 0.014, 1.0, 1.0));
+  m.moves = {down, across, clamped};
+  core::Core core(s);
+  core.Reset(s.X_WH_start);
+  graph::MotionRunner runner(m, s.X_WH_start, s.model.time_step_s);
+  std::array<Eigen::Vector3d, 3> end_of{};
+  for (int k = 1; !runner.Done(); ++k) {
+    const Eigen::Isometry3d X = runner.Next(core.last());
+    if (runner.Done()) break;
+    end_of[std::size_t(runner.move())] = X.translation();
+    core.Step(k * s.model.time_step_s, X);
+  }
+  // The guard stopped the descent on the floor, far above its target.
+  CHECK(end_of[0].z() > down.p_W_m.z() + 0.1);
+  CHECK(end_of[0].z() < p0.z());
+  // Across from there at that height, not on towards the descent's target.
+  CHECK((end_of[1] - end_of[0] - across.p_W_m).norm() < 1e-12);
+  // The last move stopped at the box's side, 4 mm on.
+  CHECK(end_of[2].x() == Approx(p0.x() + 0.014).margin(1e-12));
+  CHECK(end_of[2].z() == end_of[0].z());
+}
+
+TEST_CASE("Sweeps over a round rail stay within the device's force", "[graph][explore]") {
+  // Lowered onto the rail until it pushes back, a sweep's slides go on from there: none plunges
+  // on towards its lowering's target and ends where the coupling reaches the device's force.
+  io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/rail.yaml");
+  REQUIRE(loaded.scene);
+  graph::ExploreOptions o;
+  o.random_motions = 0;
+  o.max_motions = 50;  // the sweeps: two tilts at 25 lateral offsets
+  const ContactGraph g = graph::Explore(*loaded.scene, o);
+  REQUIRE(g.motions.size() == 50);
+  for (const graph::Motion& m : g.motions) REQUIRE(m.kind == "sweep");
+  CHECK(g.held_back == 0);
+  CHECK(std::any_of(g.nodes.begin(), g.nodes.end(),
+                    [](const Node& n) { return n.cf.find("rail.side") != std::string::npos; }));
+}
+
 TEST_CASE("Every node's witness, replayed through the core, gives that node's CF",
           "[graph][explore]") {
   const scene::Scene s = ExploredScene();

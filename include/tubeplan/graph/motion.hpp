@@ -23,6 +23,11 @@ namespace tubeplan::graph {
 /// projected on `guard_dir_W` exceeds `guard_N` (guard_N <= 0: unguarded).
 struct Move {
   Eigen::Vector3d p_W_m = Eigen::Vector3d::Zero();
+  /// p_W_m is an offset from where the hand is when the move starts, not a place: a move that
+  /// goes on from wherever a guard stopped the one before. Its target is kept in `within_W`
+  /// (an empty box: anywhere).
+  bool relative = false;
+  Eigen::AlignedBox3d within_W;
   Eigen::Quaterniond q_W = Eigen::Quaterniond::Identity();
   double speed_m_per_s = 0.1;
   double turn_rad_per_s = 1.0;
