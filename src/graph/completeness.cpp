@@ -9,7 +9,8 @@
 namespace tubeplan::graph {
 
 Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
-                               std::span<const Motion> motions, double dwell_s) {
+                               std::span<const Motion> motions, double dwell_s,
+                               double force_limit_N) {
   std::set<std::string> nodes;
   std::set<std::pair<std::string, std::string>> arcs;
   for (const Node& n : graph.nodes) nodes.insert(n.cf);
@@ -35,7 +36,8 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
     std::string counted, current;
     int held = 0;
     for (int k = 1; !runner.Done(); ++k) {
-      if (core.Step(k * step_s, runner.Next(core.last())).flags & core::kProxySeparated) break;
+      const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
+      if ((out.flags & core::kProxySeparated) || out.force_W_N.norm() > force_limit_N) break;
       const std::string cf = core.FormationText();
       ++ticks_in[cf];
       held = cf == current ? held + 1 : 1;
@@ -79,7 +81,8 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
                                const ExploreOptions& explore, int count) {
   const std::vector<Motion> motions =
       RandomMotions(scene, explore.seed + 1000003, 0, count, explore);
-  return CheckCompleteness(scene, graph, motions, explore.dwell_s);
+  return CheckCompleteness(scene, graph, motions, explore.dwell_s,
+                           ExploreForceLimit(scene, explore));
 }
 
 }  // namespace tubeplan::graph

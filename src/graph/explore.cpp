@@ -107,7 +107,7 @@ struct MotionResult {
   std::vector<Change> changes;
   long ticks = 0;
   int refinements = 0;
-  bool held_back = false;  // cut where the coupling reached the device's force
+  bool held_back = false;  // cut at the explorer's force limit or the device's
   bool timed_out = false;  // stopped by the time limit before its end: not a result
   // Per stay: the run's point at or before its witness, from which its CF's probe can start,
   // kept for the first stay of each CF (refined or not) that could become that probe's start
@@ -157,6 +157,7 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   const double step_s = core.scene().model.time_step_s;
   const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
   const Eigen::Isometry3d X_start = MotionStart(core.scene());
+  const double force_limit_N = ExploreForceLimit(core.scene(), options);
   MotionRunner runner(motion, X_start, step_s);
   // Ticks up to here replay another motion to a witness: nothing new there, nothing recorded.
   const int prefix = motion.prefix_ticks;
@@ -256,10 +257,10 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
       return result;
     }
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
-    if (out.flags & core::kProxySeparated) {
-      // The coupling is stretched beyond the device's force: the tube no longer follows the
-      // hand, and what the motion would reach beyond here no operator could, so it ends (the
-      // tick is not recorded).
+    if ((out.flags & core::kProxySeparated) || out.force_W_N.norm() > force_limit_N) {
+      // The operator force passed the explorer's limit, or the coupling is stretched beyond
+      // the device's force and the tube no longer follows the hand: the motion ends (the tick
+      // is not recorded).
       result.held_back = true;
       ++k;
       break;
@@ -881,6 +882,10 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
 
 }  // namespace
 
+double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& options) {
+  return options.witness_force_N > 0.0 ? options.witness_force_N : 0.5 * scene.device.max_force_N;
+}
+
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
                      const std::function<void(const SaturationPoint&)>& progress) {
   const auto clock_start = Clock::now();
@@ -889,8 +894,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
                                     std::chrono::duration<double>(o.time_limit_s));
   ContactGraph graph;
-  Merger merger(graph,
-                o.witness_force_N > 0.0 ? o.witness_force_N : 0.5 * scene.device.max_force_N);
+  Merger merger(graph, ExploreForceLimit(scene, o));
   std::vector<std::unique_ptr<core::Core>> cores;
   cores.push_back(std::make_unique<core::Core>(scene));
   core::Core& probe = *cores.front();

@@ -376,9 +376,9 @@ TEST_CASE("A relative move goes on from where a guard stopped the move before",
   CHECK(end_of[2].z() == end_of[0].z());
 }
 
-TEST_CASE("Sweeps over a round rail stay within the device's force", "[graph][explore]") {
+TEST_CASE("Sweeps over a round rail stay within the explorer's force limit", "[graph][explore]") {
   // Lowered onto the rail until it pushes back, a sweep's slides go on from there: none plunges
-  // on towards its lowering's target and ends where the coupling reaches the device's force.
+  // on towards its lowering's target until the operator force passes half the device's.
   io::SceneLoadResult loaded =
       io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/rail.yaml");
   REQUIRE(loaded.scene);
@@ -528,7 +528,8 @@ TEST_CASE("Independent random motions stay inside the explored graph", "[graph][
   const graph::ExploreOptions o;
   const ContactGraph& g = DefaultGraph(2);
   const std::vector<graph::Motion> motions = graph::RandomMotions(s, 1234567, 0, 30, o);
-  const graph::Completeness c = graph::CheckCompleteness(s, g, motions, o.dwell_s);
+  const graph::Completeness c =
+      graph::CheckCompleteness(s, g, motions, o.dwell_s, graph::ExploreForceLimit(s, o));
   for (const std::string& n : c.missing_states) UNSCOPED_INFO("CF not in the graph: " << n);
   for (const auto& [a, taken] : c.missing_transitions)
     UNSCOPED_INFO("transition not in the graph: "

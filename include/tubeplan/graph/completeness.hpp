@@ -28,12 +28,14 @@ struct Completeness {
   std::vector<std::pair<std::pair<std::string, std::string>, int>> missing_transitions;
 };
 
-/// Runs each of `motions` through a core from the scene's start (each ends where the coupling
-/// reaches the device's force, as the explorer's do), counts a state once the core has kept it
-/// `dwell_s`, and compares the states and transitions counted with `graph`'s. A transition that
-/// changes two PCs at once is in the graph when it records the change through a state between.
+/// Runs each of `motions` through a core from the scene's start (each ends where the operator
+/// force passes `force_limit_N` or the coupling reaches the device's force, as the explorer's
+/// do), counts a state once the core has kept it `dwell_s`, and compares the states and
+/// transitions counted with `graph`'s. A transition that changes two PCs at once is in the graph
+/// when it records the change through a state between.
 Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
-                               std::span<const Motion> motions, double dwell_s);
+                               std::span<const Motion> motions, double dwell_s,
+                               double force_limit_N);
 
 /// The same over `count` random guarded motions of another seed than the explorer's
 /// (RandomMotions from explore.seed + 1000003): motions it did not make, counted after its dwell.

@@ -78,8 +78,8 @@ struct ContactGraph {
   std::vector<std::string> unreached_elements;  ///< reachable parts' elements never seen
   long ticks = 0;                               ///< core ticks run, refinements included
   int refinements = 0;                          ///< multi-PC steps that were sub-stepped
-  /// Motions ended where the coupling reached the device's force (kProxySeparated): the tube
-  /// no longer followed the hand.
+  /// Motions ended where the operator force passed the explorer's limit (ExploreForceLimit) or
+  /// the coupling reached the device's force (kProxySeparated: the tube no longer followed).
   int held_back = 0;
   double seconds = 0.0;    ///< wall time of the exploration
   int probed = 0;          ///< nodes whose neighbour probes ran (the first `probed` nodes)

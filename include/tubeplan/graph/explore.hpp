@@ -58,9 +58,9 @@ struct ExploreOptions {
   double status_interval_s = 1.0;
   int jobs = 1;
   double push_N = 2.0;  ///< guard force of the probing moves
-  /// A node's witness is a stay whose operator force is at most this [N] wherever the node has
-  /// one (0: half the device's maximum force, 4.25 N for the PHANToM Premium): plans start from
-  /// states an operator reaches well within the device.
+  /// An exploring motion ends where the operator force passes this [N] (0: half the device's
+  /// maximum force, 4.25 N for the PHANToM Premium), so every witness is a state an operator
+  /// reaches well within the device (ExploreForceLimit).
   double witness_force_N = 0.0;
   double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)
   int substeps = 16;            ///< sub-ticks per tick when refining a multi-PC change
@@ -86,6 +86,10 @@ inline constexpr int kProbesPerNode = 2 * 3 + 2 * 2;
 /// keeps one of its elements and changes the other (Ee -> Fe on the same face, a rim sliding
 /// from a face onto its edge) counts one.
 int PcChanges(const states::ContactFormation& a, const states::ContactFormation& b);
+
+/// The operator force [N] past which an exploring motion ends: options.witness_force_N, else
+/// half the scene's device's maximum force.
+double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& options);
 
 /// Explores `scene` and returns the unpruned graph. `progress` (may be empty) is called after
 /// each merged motion.
