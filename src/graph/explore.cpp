@@ -158,6 +158,7 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
   const int dwell = std::max(1, static_cast<int>(std::lround(options.dwell_s / step_s)));
   const Eigen::Isometry3d X_start = MotionStart(core.scene());
   const double force_limit_N = ExploreForceLimit(core.scene(), options);
+  const bool probe = motion.kind.starts_with("probe");
   MotionRunner runner(motion, X_start, step_s);
   // Ticks up to here replay another motion to a witness: nothing new there, nothing recorded.
   const int prefix = motion.prefix_ticks;
@@ -257,10 +258,10 @@ MotionResult RunMotion(core::Core& core, core::Core& refine_core, const Motion& 
       return result;
     }
     const core::StepOutput& out = core.Step(k * step_s, runner.Next(core.last()));
-    if ((out.flags & core::kProxySeparated) || out.force_W_N.norm() > force_limit_N) {
-      // The operator force passed the explorer's limit, or the coupling is stretched beyond
-      // the device's force and the tube no longer follows the hand: the motion ends (the tick
-      // is not recorded).
+    if ((out.flags & core::kProxySeparated) || (!probe && out.force_W_N.norm() > force_limit_N)) {
+      // The operator force passed the explorer's limit (a probe's step stops there and goes
+      // back), or the coupling is stretched beyond the device's force and the tube no longer
+      // follows the hand: the motion ends (the tick is not recorded).
       result.held_back = true;
       ++k;
       break;
@@ -603,16 +604,19 @@ std::vector<Move> Probes(const scene::Scene& scene, const Eigen::Isometry3d& X_W
           {p, (Eigen::Quaterniond(Eigen::AngleAxisd(sign * o.probe_turn_rad, axis)) * q)
                   .normalized()});
   std::vector<Move> moves;
-  auto go = [&](const Eigen::Vector3d& to_p, const Eigen::Quaterniond& to_q) {
+  auto go = [&](const Eigen::Vector3d& to_p, const Eigen::Quaterniond& to_q, double limit_N) {
     Move move = MoveTo(to_p, to_q, kProbeSpeed_m_per_s, 0.0, to_p);
     move.turn_rad_per_s = kProbeTurn_rad_per_s;
+    move.force_limit_N = limit_N;
     moves.push_back(move);
     move.min_ticks = hold;  // the same pose again: held still
     moves.push_back(move);
   };
+  // Out, stopped where the operator force passes the explorer's limit, and back.
+  const double limit_N = ExploreForceLimit(scene, o);
   for (const auto& [to_p, to_q] : targets) {
-    go(to_p, to_q);
-    go(p, q);
+    go(to_p, to_q, limit_N);
+    go(p, q, 0.0);
   }
   return moves;
 }

@@ -64,8 +64,10 @@ Eigen::Isometry3d MotionRunner::Next(const core::StepOutput& last) {
       move_tick_ = 0;
     }
     const bool guarded = move.guard_N > 0.0 && move_tick_ > 0;
+    const bool limited = move.force_limit_N > 0.0 && move_tick_ > 0;
     if (move_tick_ == move_ticks_ || (move.max_ticks > 0 && move_tick_ >= move.max_ticks) ||
-        (guarded && last.force_W_N.dot(move.guard_dir_W) > move.guard_N)) {
+        (guarded && last.force_W_N.dot(move.guard_dir_W) > move.guard_N) ||
+        (limited && last.force_W_N.norm() > move.force_limit_N)) {
       ++move_;
       move_ticks_ = 0;
       continue;

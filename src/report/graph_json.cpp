@@ -98,6 +98,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                        {"guard_dir", {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()}},
                        {"guard_N", mv.guard_N}});
       if (mv.relative) moves.back()["relative"] = true;
+      if (mv.force_limit_N > 0.0) moves.back()["force_limit_N"] = mv.force_limit_N;
       if (mv.min_ticks > 0) moves.back()["min_ticks"] = mv.min_ticks;
       if (mv.max_ticks > 0) moves.back()["max_ticks"] = mv.max_ticks;
     }

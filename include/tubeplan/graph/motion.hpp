@@ -33,6 +33,8 @@ struct Move {
   double turn_rad_per_s = 1.0;
   Eigen::Vector3d guard_dir_W = Eigen::Vector3d::Zero();
   double guard_N = 0.0;
+  /// > 0: the move also stops once the operator force's magnitude exceeds this [N].
+  double force_limit_N = 0.0;
   /// > 0: the move lasts at least this many ticks (a move to where the hand is holds it still).
   int min_ticks = 0;
   /// > 0: the move ends after this many ticks, on the path it would have followed whole (how a
