@@ -21,8 +21,8 @@ void PrintFound(std::ostream& t, const std::string& scene_path, const graph::Con
   for (const auto& [kind, n] : counts.motions_by_kind)
     t << (first ? "" : ", ") << n << " " << kind, first = false;
   t << "), " << g.ticks << " core ticks, " << g.refinements << " steps refined, " << g.held_back
-    << " motions ended where the operator force passed the explorer's limit (half the device's) "
-       "or the tube no longer followed the hand; "
+    << " motions ended where the operator force passed the explorer's limit or the tube no "
+       "longer followed the hand; "
     << g.seconds << " s on " << explore.jobs << " thread" << (explore.jobs > 1 ? "s" : "") << "\n";
 }
 

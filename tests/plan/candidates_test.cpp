@@ -114,8 +114,10 @@ TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept
       plan::MakeCandidates(scene, pressed, paths, options, as_is);
   REQUIRE(c.size() == 1);
   REQUIRE(p.size() == 1);
-  // Aimed at the hand's pose the replay is feasible, pressing harder.
+  // Aimed at the hand's pose the replay is feasible at the asked speed, pressing harder.
   REQUIRE(p[0].judgement.feasible);
+  REQUIRE(p[0].tries == 1);
+  REQUIRE(p[0].peak_speed_m_per_s == 0.08);
   CHECK(c[0].judgement.feasible);
   CHECK(c[0].held);
   CHECK(c[0].tries == 2);

@@ -1,8 +1,8 @@
 #pragma once
 // Candidate plans from paths through the contact-state graph: the hand moves by minimum jerk
 // through the witnesses of each path's states, and every candidate is replayed through the same
-// judge as `evaluate`. A candidate that replays infeasible is tried again at slower speeds, then
-// aiming at the held end's poses, before it is given up (docs/graph.md, "Plans").
+// judge as `evaluate`, aimed at the witnesses' hand poses and at their held end's poses, slower
+// while neither is feasible; the feasible try of least force is kept (docs/graph.md, "Plans").
 
 #include <functional>
 #include <optional>
