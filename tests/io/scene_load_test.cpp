@@ -50,12 +50,17 @@ const std::string kMinimal =
     "start: {position: [0, -90 mm, 40 mm]}\n"
     "goal: \"{Fs - floor.top}\"\n";
 
-// kMinimal with its line `line` (1-based) replaced.
-std::string WithLine(int line, const std::string& replacement) {
-  std::istringstream in(kMinimal);
+// `text` with its line `line` (1-based) replaced.
+std::string ReplaceLine(const std::string& text, int line, const std::string& replacement) {
+  std::istringstream in(text);
   std::string out, l;
   for (int i = 1; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
   return out;
+}
+
+// kMinimal with its line `line` (1-based) replaced.
+std::string WithLine(int line, const std::string& replacement) {
+  return ReplaceLine(kMinimal, line, replacement);
 }
 
 }  // namespace
@@ -523,10 +528,7 @@ const std::string kClipScene =
     "goal: \"{Fs - clip.floor}\"\n";
 
 std::string ClipSceneWith(int line, const std::string& replacement) {
-  std::istringstream in(kClipScene);
-  std::string out, l;
-  for (int i = 1; std::getline(in, l); ++i) out += (i == line ? replacement : l) + "\n";
-  return out;
+  return ReplaceLine(kClipScene, line, replacement);
 }
 
 }  // namespace
