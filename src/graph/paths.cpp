@@ -126,4 +126,14 @@ std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<do
   return found;
 }
 
+std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
+                                             const Path& path, bool held) {
+  std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
+  for (std::size_t j = 1; j < path.nodes.size(); ++j) {
+    const Node& node = graph.nodes[std::size_t(path.nodes[j])];
+    waypoints.push_back(held ? node.X_WH : node.X_W_hand);
+  }
+  return waypoints;
+}
+
 }  // namespace tubeplan::graph

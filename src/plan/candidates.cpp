@@ -7,23 +7,6 @@
 
 namespace tubeplan::plan {
 
-namespace {
-
-// The hand's poses: the scene's start, then the hand at each later state's witness, or with
-// `held` the held end's pose there (the hand no longer pulling the coupling out).
-std::vector<Eigen::Isometry3d> Waypoints(const scene::Scene& scene,
-                                         const graph::ContactGraph& graph, const graph::Path& path,
-                                         bool held) {
-  std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
-  for (std::size_t j = 1; j < path.nodes.size(); ++j) {
-    const graph::Node& node = graph.nodes[std::size_t(path.nodes[j])];
-    waypoints.push_back(held ? node.X_WH : node.X_W_hand);
-  }
-  return waypoints;
-}
-
-}  // namespace
-
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options,
@@ -42,7 +25,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
     const std::array<std::vector<Eigen::Isometry3d>, 2> aims = {
-        Waypoints(scene, graph, *c.path, false), Waypoints(scene, graph, *c.path, true)};
+        graph::PathWaypoints(scene, graph, *c.path, false),
+        graph::PathWaypoints(scene, graph, *c.path, true)};
     int tried = 0;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =

@@ -6,7 +6,10 @@
 
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include <tubeplan/graph/contact_graph.hpp>
+#include <tubeplan/scene/scene.hpp>
 
 namespace tubeplan::graph {
 
@@ -22,5 +25,11 @@ std::vector<double> ArcCosts(const ContactGraph& graph, const PruneWeights& weig
 /// first (ties: the lexicographically smaller node sequence), none when there is no goal.
 std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<double>& arc_cost,
                                  int k);
+
+/// The hand's poses along a path: the scene's start, then the hand at each later state's
+/// witness, or with `held` the held end's pose there (the hand no longer pulling the coupling
+/// out). A candidate plan's trajectory goes through them.
+std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
+                                             const Path& path, bool held);
 
 }  // namespace tubeplan::graph
