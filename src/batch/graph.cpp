@@ -71,6 +71,7 @@ GraphEnd BuildGraph(const GraphRequest& request, BuiltGraph& built, std::ostream
     weights.tolerance = *request.tolerance;
   }
   graph::ExploreOptions explore = request.explore;
+  explore.weights = weights;
   if (explore.jobs <= 0)
     explore.jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::optional<std::vector<graph::ReplayedPlan>> verdicts;

@@ -8,6 +8,7 @@
 #include <ostream>
 #include <string>
 #include <variant>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -81,7 +82,7 @@ int RunGraph(const GraphOptions& o, Streams io) {
   if (!WriteGraphFiles(o, b, io.err)) return kExitBadInput;
 
   // With --check, the graph's completeness measured over motions of another seed.
-  std::optional<graph::Completeness> completeness;
+  std::vector<graph::Completeness> completeness;
   if (o.check > 0) completeness = graph::CheckCompleteness(b.scene, b.graph, b.explore, o.check);
   report::PrintGraph(io.out, o.scene_path, b.scene, b.graph, b.explore, o.verdicts_path,
                      completeness, {o.dot_path, o.svg_path, o.json_path});
@@ -108,8 +109,9 @@ Command AddGraphCommand(CLI::App& app, Streams streams) {
                 "DOT: draw every arc, the dropped ones dashed with their reason (default: the "
                 "pruned graph only)");
   sub->add_option("--check", options->check,
-                  "after exploring, run N random guarded motions of another seed and report the "
-                  "states and transitions they reach that the graph lacks (docs/graph.md)")
+                  "after exploring, run N random guarded motions and about N perturbed replays of "
+                  "the candidate plans, of another seed, and report the states and transitions "
+                  "they reach that the graph lacks (docs/graph.md)")
       ->check(CLI::Range(0, 100000));
   AddGraphOptions(sub, *options);
   return {sub, [options, streams] { return RunGraph(*options, streams); }};

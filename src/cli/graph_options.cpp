@@ -26,6 +26,7 @@ std::variant<batch::BuiltGraph, int> BuildGraph(
   request.explore.seed = o.seed;
   request.explore.random_motions = o.random;
   request.explore.closing_motions = o.closing;
+  request.explore.replay_copies = o.replays;
   request.explore.max_motions = o.budget;
   request.explore.time_limit_s = o.time_limit_s;
   request.explore.jobs = o.jobs;
@@ -71,6 +72,12 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
                   "followed by probing what it found, until a round adds no state and no "
                   "transition (0: none; docs/graph.md)")
       ->check(CLI::Range(0, 10000))
+      ->capture_default_str();
+  sub->add_option("--replays", o.replays,
+                  "closing rounds also replay this many copies of each candidate plan's "
+                  "trajectory (as `plans` makes them from the graph so far), each moved by up to "
+                  "4 mm, with tremor and 0.8-1.25x the speed (0: none; docs/graph.md)")
+      ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,
                   "run at most this many motions in all (a motion: one list of guarded moves of "

@@ -26,6 +26,7 @@ struct GraphOptions {
   std::uint64_t seed = 1;
   int random = 120;
   int closing = 30;  // random motions per closing round (plans: none; see plans_command.cpp)
+  int replays = 4;   // perturbed copies of each candidate plan per closing round (plans: none)
   int budget = 3000;
   double time_limit_s = 0.0;  // 0: none
   int jobs = 0;               // 0: the machine's cores

@@ -120,6 +120,7 @@ Command AddPlansCommand(CLI::App& app, Streams streams) {
   // Plans need paths to the goal, which probing finds: no closing rounds unless asked for (they
   // make the graph complete and take several times as long).
   options->graph.closing = 0;
+  options->graph.replays = 0;
   AddGraphOptions(sub, options->graph);
   return {sub, [options, streams] { return RunPlans(*options, streams); }};
 }

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <vector>
 
 #include <tubeplan/core/core.hpp>
 #include <tubeplan/graph/completeness.hpp>
@@ -52,6 +53,7 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
   }
 
   Completeness c;
+  c.motions_of = "motions";
   c.motions = static_cast<int>(motions.size());
   for (const auto& [cf, ticks] : ticks_in) {
     c.ticks += ticks;
@@ -77,12 +79,23 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
   return c;
 }
 
-Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
-                               const ExploreOptions& explore, int count) {
-  const std::vector<Motion> motions =
-      RandomMotions(scene, explore.seed + 1000003, 0, count, explore);
-  return CheckCompleteness(scene, graph, motions, explore.dwell_s,
-                           ExploreForceLimit(scene, explore));
+std::vector<Completeness> CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
+                                            const ExploreOptions& explore, int count) {
+  const std::uint64_t seed = explore.seed + 1000003;
+  const double limit_N = ExploreForceLimit(scene, explore);
+  std::vector<Completeness> found;
+  found.push_back(CheckCompleteness(scene, graph, RandomMotions(scene, seed, 0, count, explore),
+                                    explore.dwell_s, limit_N));
+  found.back().motions_of = "random guarded motions";
+  const int trajectories =
+      static_cast<int>(CandidateReplays(scene, graph, explore, seed, 0, 1).size());
+  if (trajectories == 0) return found;
+  const int copies = (count + trajectories - 1) / trajectories;
+  found.push_back(CheckCompleteness(scene, graph,
+                                    CandidateReplays(scene, graph, explore, seed, 0, copies),
+                                    explore.dwell_s, limit_N));
+  found.back().motions_of = "perturbed candidate replays";
+  return found;
 }
 
 }  // namespace tubeplan::graph

@@ -16,7 +16,10 @@
 #include <utility>
 
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/paths.hpp>
 #include <tubeplan/scene/geometry.hpp>
+#include <tubeplan/trajectories/perturb.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
 
 namespace tubeplan::graph {
 
@@ -29,6 +32,9 @@ constexpr int kMaxTicksPerMotion = 30000;
 // probes are most of the exploration's ticks.
 constexpr double kProbeSpeed_m_per_s = 0.15;
 constexpr double kProbeTurn_rad_per_s = 2.0;
+// A replayed trajectory moves the hand along chords of this many ticks (10 ms: within 0.02 mm of a
+// minimum-jerk reach of 0.1 m in 0.4 s).
+constexpr int kReplayTicksPerMove = 10;
 // A motion's run keeps a checkpoint every this many ticks (a core snapshot is ~70 kB, copied in
 // about the time of a tick or two): a refinement or a probe starts from the one before its tick
 // and replays at most this many ticks, not the whole motion up to it.
@@ -863,9 +869,8 @@ std::vector<Motion> RandomMotions(const scene::Scene& scene, std::uint64_t seed,
 
 namespace {
 
-// Marks the start and goal nodes, each node's distance to the goal and the part elements reached.
-void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
-                           ContactGraph& graph) {
+// Marks the start and goal nodes and each node's distance to the goal.
+void MarkStartAndGoal(const scene::Scene& scene, ContactGraph& graph) {
   graph.goal = graph.FindNode(states::ToString(scene.goal));
   if (graph.start >= 0) graph.nodes[std::size_t(graph.start)].start = true;
   if (graph.goal >= 0) {
@@ -878,6 +883,12 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
           half_length * Eigen::AngleAxisd(goal.X_WH.linear().transpose() * n.X_WH.linear()).angle();
     }
   }
+}
+
+// MarkStartAndGoal, and the part elements reached.
+void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
+                           ContactGraph& graph) {
+  MarkStartAndGoal(scene, graph);
   const std::set<std::string> reached = ReachedElements(graph);
   graph.reached_elements.assign(reached.begin(), reached.end());
   for (const scene::PartElement& e : probe.elements())
@@ -885,6 +896,41 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
 }
 
 }  // namespace
+
+std::vector<Motion> CandidateReplays(const scene::Scene& scene, const ContactGraph& graph,
+                                     const ExploreOptions& options, std::uint64_t seed,
+                                     int first_replicate, int copies) {
+  // The candidate paths of the graph as it stands, pruned as `plans` prunes it.
+  ContactGraph marked;
+  marked.nodes = graph.nodes;
+  marked.arcs = graph.arcs;
+  marked.start = graph.start;
+  MarkStartAndGoal(scene, marked);
+  if (marked.start < 0 || marked.goal < 0 || marked.goal == marked.start) return {};
+  const PruneWeights weights =
+      options.weights.value_or(PruneWeights{scene.heuristics.friction, scene.heuristics.energy,
+                                            scene.heuristics.distance, scene.heuristics.tolerance});
+  Prune(marked, weights);
+  const std::vector<Path> paths =
+      KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths);
+  trajectories::SynthesisOptions synthesis;
+  synthesis.peak_speed_m_per_s = options.speed_m_per_s;
+  trajectories::Perturbation perturbation;
+  perturbation.offset_m = options.replay_offset_m;
+  std::vector<Motion> motions;
+  int replicate = first_replicate;
+  for (const Path& path : paths) {
+    for (const bool held : {false, true}) {
+      const trajectories::Trajectory nominal =
+          trajectories::SynthesizeTrajectory(PathWaypoints(scene, marked, path, held), synthesis);
+      for (int c = 0; c < copies; ++c)
+        motions.push_back(MotionAlong(
+            trajectories::Perturb(nominal, perturbation, seed, replicate++),
+            scene.model.time_step_s, kReplayTicksPerMove, options.speed_m_per_s, "replay"));
+    }
+  }
+  return motions;
+}
 
 double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& options) {
   return options.witness_force_N > 0.0 ? options.witness_force_N : 0.5 * scene.device.max_force_N;
@@ -1005,14 +1051,19 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     }
   };
   probe_new_nodes();
-  // Closing rounds: more random motions of the same seed, each round merged and its new nodes
-  // probed, until a round adds no node and no arc (saturated), or a limit ends it.
-  int next_random = o.random_motions;
-  while (!stopped && o.closing_motions > 0) {
+  // Closing rounds: more random motions of the same seed and perturbed replays of the candidate
+  // plans as the graph stands, each round merged and its new nodes probed, until a round adds no
+  // node and no arc (saturated), or a limit ends it.
+  int next_random = o.random_motions, next_replicate = 0;
+  while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();
     phase = "closing rounds";
     run(RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o), {});
     next_random += o.closing_motions;
+    std::vector<Motion> replays =
+        CandidateReplays(scene, graph, o, o.seed, next_replicate, o.replay_copies);
+    next_replicate += static_cast<int>(replays.size());
+    run(std::move(replays), {});
     ++graph.closing_rounds;
     probe_new_nodes();
     if (graph.nodes.size() == nodes_before && graph.arcs.size() == arcs_before) break;

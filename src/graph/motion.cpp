@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <tubeplan/graph/motion.hpp>
 
@@ -91,6 +92,33 @@ std::vector<Move> Prefix(const Motion& motion, int move, int move_tick) {
     moves.push_back(cut);
   }
   return moves;
+}
+
+Motion MotionAlong(const trajectories::Trajectory& trajectory, double time_step_s,
+                   int ticks_per_move, double speed_m_per_s, std::string kind) {
+  const std::vector<trajectories::HandSample> ticks =
+      trajectories::Resample(trajectory, time_step_s);
+  Motion motion;
+  motion.kind = std::move(kind);
+  Move first;
+  first.p_W_m = ticks.front().p_WH_m;
+  first.q_W = ticks.front().q_WH;
+  first.speed_m_per_s = speed_m_per_s;
+  motion.moves.push_back(first);
+  const std::size_t every = std::size_t(std::max(1, ticks_per_move));
+  for (std::size_t from = 0; from + 1 < ticks.size();) {
+    const std::size_t to = std::min(from + every, ticks.size() - 1);
+    Move move;
+    move.p_W_m = ticks[to].p_WH_m;
+    move.q_W = ticks[to].q_WH;
+    // The ticks set the pace: no speed limit slows the hand below the trajectory's.
+    move.speed_m_per_s = 1e3;
+    move.turn_rad_per_s = 1e3;
+    move.min_ticks = static_cast<int>(to - from);
+    motion.moves.push_back(move);
+    from = to;
+  }
+  return motion;
 }
 
 Eigen::Isometry3d MotionStart(const scene::Scene& scene) { return scene.X_WH_start; }

@@ -34,6 +34,7 @@ bool GraphSections(const std::vector<batch::Evaluated>& results,
     explore.jobs = jobs;
     // The picture of the states, as `plans` explores: probing, without the closing rounds.
     explore.closing_motions = 0;
+    explore.replay_copies = 0;
     graph::ContactGraph g = graph::Explore(s, explore);
     graph::Prune(g, {s.heuristics.friction, s.heuristics.energy, s.heuristics.distance,
                      s.heuristics.tolerance});

@@ -41,12 +41,17 @@ void PrintSaturation(std::ostream& t, const graph::ContactGraph& g,
       << graph::kProbesPerNode << " small motions (" << explore.probe_step_m * 1e3
       << " mm along and against 3 directions, " << explore.probe_turn_rad * 180.0 / std::numbers::pi
       << " deg about 2 axes); ";
-    if (explore.closing_motions > 0)
+    if (g.closing_rounds > 0) {
       t << "then " << g.closing_rounds << " closing round" << (g.closing_rounds == 1 ? "" : "s")
-        << " of " << explore.closing_motions
-        << " random motions, the last adding no state and no transition)\n";
-    else
+        << " of ";
+      if (explore.closing_motions > 0) t << explore.closing_motions << " random motions";
+      if (explore.closing_motions > 0 && explore.replay_copies > 0) t << " and ";
+      if (explore.replay_copies > 0)
+        t << explore.replay_copies << " perturbed replays of each candidate plan";
+      t << ", the last adding no state and no transition)\n";
+    } else {
       t << "the last round found no new state; no closing rounds)\n";
+    }
   } else if (g.end == graph::ExploreEnd::kTimeLimit) {
     t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
       << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
@@ -84,8 +89,8 @@ void PrintVerdictCounts(std::ostream& t, const std::string& verdicts_path,
 // first few it lacks.
 void PrintCompleteness(std::ostream& t, const graph::Completeness& c) {
   const auto percent = [](long part, long all) { return all > 0 ? 100.0 * part / all : 100.0; };
-  t << "completeness: " << c.motions << " independent random motions counted " << c.states_seen
-    << " states, " << c.states_in_graph << " in the graph ("
+  t << "completeness: " << c.motions << " independent " << c.motions_of << " counted "
+    << c.states_seen << " states, " << c.states_in_graph << " in the graph ("
     << percent(c.states_in_graph, c.states_seen) << " %), and " << c.transitions_seen
     << " transitions, " << c.transitions_in_graph << " in it ("
     << percent(c.transitions_in_graph, c.transitions_seen) << " %); by use, "
@@ -114,8 +119,8 @@ void PrintWritten(std::ostream& t, const GraphFiles& written) {
 
 void PrintGraph(std::ostream& out, const std::string& scene_path, const scene::Scene& scene,
                 const graph::ContactGraph& graph, const graph::ExploreOptions& explore,
-                const std::string& verdicts_path,
-                const std::optional<graph::Completeness>& completeness, const GraphFiles& written) {
+                const std::string& verdicts_path, std::span<const graph::Completeness> completeness,
+                const GraphFiles& written) {
   const graph::GraphCounts counts = graph::CountGraph(graph);
   std::ostringstream t;
   t << std::setprecision(3);
@@ -123,7 +128,7 @@ void PrintGraph(std::ostream& out, const std::string& scene_path, const scene::S
   PrintSaturation(t, graph, explore);
   PrintReach(t, graph, scene);
   if (!verdicts_path.empty()) PrintVerdictCounts(t, verdicts_path, counts);
-  if (completeness) PrintCompleteness(t, *completeness);
+  for (const graph::Completeness& c : completeness) PrintCompleteness(t, c);
   PrintWritten(t, written);
   out << t.str();
 }

@@ -115,18 +115,19 @@ TEST_CASE("plans: the shelf scene from its file alone gives a verified plan", "[
 }
 
 TEST_CASE("graph --check measures the graph against motions it did not make", "[cli][explore]") {
-  // A budget of 40 motions leaves the shelf's graph unsaturated: 30 motions of another seed
-  // then find what it lacks, and the line's figures agree with each other.
+  // A budget of 40 motions leaves the shelf's graph unsaturated: 30 random motions of another
+  // seed then find what it lacks, and the line's figures agree with each other. The graph
+  // reaches the goal, so perturbed replays of its candidate plans are counted too.
   const Outcome r = RunTool(
       {"graph", SourcePath("scenes/shelf.yaml"), "--budget", "40", "--jobs", "2", "--check", "30"});
   INFO(r.out << r.err);
   REQUIRE(r.exit_code != 2);
-  const std::size_t at = r.out.find("completeness: 30 independent random motions counted ");
+  const std::size_t at = r.out.find("completeness: 30 independent random guarded motions counted ");
   REQUIRE(at != std::string::npos);
   long states = 0, states_in = 0, arcs = 0, arcs_in = 0;
   REQUIRE(std::sscanf(r.out.c_str() + at,
-                      "completeness: 30 independent random motions counted %ld states, %ld in the "
-                      "graph (%*f %%), and %ld transitions, %ld in it",
+                      "completeness: 30 independent random guarded motions counted %ld states, %ld "
+                      "in the graph (%*f %%), and %ld transitions, %ld in it",
                       &states, &states_in, &arcs, &arcs_in) == 4);
   CHECK(states_in <= states);
   CHECK(arcs_in <= arcs);
@@ -134,6 +135,14 @@ TEST_CASE("graph --check measures the graph against motions it did not make", "[
   // An unsaturated graph lacks something those motions reach, and each missing one is listed.
   CHECK(states_in + arcs_in < states + arcs);
   CHECK(r.out.find("  missing ") != std::string::npos);
+  const std::size_t replays = r.out.find(" independent perturbed candidate replays counted ", at);
+  REQUIRE(replays != std::string::npos);
+  int copies = 0;
+  REQUIRE(std::sscanf(r.out.c_str() + r.out.rfind("completeness: ", replays),
+                      "completeness: %d independent perturbed", &copies) == 1);
+  // As many copies of each candidate's two trajectories as make at least 30.
+  CHECK(copies >= 30);
+  CHECK(copies % 2 == 0);
 }
 
 // Runs `plans` on a shipped scene with 300 motions and checks its best candidate: it replays

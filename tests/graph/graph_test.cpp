@@ -19,6 +19,7 @@
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/trajectories/synthesize.hpp>
 
 namespace {
 
@@ -433,6 +434,7 @@ TEST_CASE("Resuming runs from snapshots explores the same graph as replaying the
   o.random_motions = 0;
   // Probing alone: closing rounds resume their runs the same way and would only add time.
   o.closing_motions = 0;
+  o.replay_copies = 0;
   o.jobs = 2;
   const ContactGraph resumed = graph::Explore(floor, o);
   o.resume_runs = false;
@@ -504,11 +506,19 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
 
 TEST_CASE("Closing rounds go on until one adds no state and no transition", "[graph][explore]") {
   const ContactGraph& g = DefaultGraph(1);
-  const int round = graph::ExploreOptions{}.closing_motions;
+  const graph::ExploreOptions o;
+  const int round = o.closing_motions;
   REQUIRE(g.saturated);
   REQUIRE(g.closing_rounds >= 1);
-  // The last round's motions (nothing new: no probes after them) are the graph's last ones.
-  const std::size_t last = g.saturation.size();
+  // The last round's motions (nothing new: no probes after them) are the graph's last ones: its
+  // random motions, then its perturbed replays of each candidate plan, aimed two ways.
+  std::size_t replays = 0;
+  while (replays < g.motions.size() && g.motions[g.motions.size() - 1 - replays].kind == "replay")
+    ++replays;
+  CHECK(replays > 0);
+  CHECK(replays % std::size_t(2 * o.replay_copies) == 0);
+  CHECK(replays <= std::size_t(2 * o.replay_copies * o.replay_paths));
+  const std::size_t last = g.saturation.size() - replays;
   REQUIRE(last > std::size_t(round));
   const graph::SaturationPoint& before = g.saturation[last - 1 - std::size_t(round)];
   CHECK(before.nodes == static_cast<int>(g.nodes.size()));
@@ -519,6 +529,77 @@ TEST_CASE("Closing rounds go on until one adds no state and no transition", "[gr
   int random = 0;
   for (const graph::Motion& m : g.motions) random += m.kind == "random";
   CHECK(random == graph::ExploreOptions{}.random_motions + round * g.closing_rounds);
+}
+
+TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[graph][motion]") {
+  const scene::Scene s = Groove();
+  const double T = s.model.time_step_s;
+  Eigen::Isometry3d to = s.X_WH_start;
+  to.translation() += Eigen::Vector3d(0.02, 0.0, -0.03);
+  to.linear() = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix() * to.linear();
+  const std::array<Eigen::Isometry3d, 2> waypoints = {s.X_WH_start, to};
+  const trajectories::Trajectory t =
+      trajectories::SynthesizeTrajectory(waypoints, trajectories::SynthesisOptions{});
+  const std::vector<trajectories::HandSample> ticks = trajectories::Resample(t, T);
+  const graph::Motion m = graph::MotionAlong(t, T, 10, 0.08, "replay");
+  CHECK(m.kind == "replay");
+  // The start is the trajectory's first pose: no move to it takes time; then one move per 10
+  // ticks, the last one shorter.
+  REQUIRE(m.moves.size() == 1 + (ticks.size() - 1 + 9) / 10);
+  graph::MotionRunner runner(m, s.X_WH_start, T);
+  core::StepOutput rest;
+  std::size_t k = 0;
+  double chord_m = 0.0;
+  while (!runner.Done()) {
+    const Eigen::Isometry3d X = runner.Next(rest);
+    if (runner.Done()) break;
+    ++k;
+    const trajectories::HandSample& want = ticks[std::min(k - 1, ticks.size() - 1)];
+    chord_m = std::max(chord_m, (X.translation() - want.p_WH_m).norm());
+    if ((k - 1) % 10 == 0 || k == ticks.size()) {
+      INFO("tick " << k);
+      CHECK((X.translation() - want.p_WH_m).norm() < 1e-12);
+      CHECK(Eigen::Quaterniond(X.linear()).angularDistance(want.q_WH) < 1e-9);
+    }
+  }
+  // The first tick holds the start (a move to where the hand is), then one tick per sample.
+  CHECK(k == ticks.size());
+  // Between, the hand is on the chord: within the stated 0.02 mm of a 36 mm reach in 0.4 s.
+  CHECK(chord_m < 2e-5);
+}
+
+TEST_CASE("Perturbed replays of the candidate plans stay inside the explored graph",
+          "[graph][explore]") {
+  const scene::Scene s = ExploredScene();
+  const graph::ExploreOptions o;
+  const ContactGraph& g = DefaultGraph(1);
+  // The closing rounds' own replays, run again as the check runs motions: every state they kept
+  // for the dwell, and every transition between two such states, was merged into the graph.
+  std::vector<graph::Motion> own;
+  for (const graph::Motion& m : g.motions)
+    if (m.kind == "replay") own.push_back(m);
+  REQUIRE(own.size() >= std::size_t(2 * o.replay_copies));
+  const graph::Completeness mine =
+      graph::CheckCompleteness(s, g, own, o.dwell_s, graph::ExploreForceLimit(s, o));
+  CHECK(mine.states_seen >= 3);
+  CHECK(mine.states_in_graph == mine.states_seen);
+  CHECK(mine.transitions_in_graph == mine.transitions_seen);
+
+  // The completeness check's second measure: replays of another seed, counted after the same
+  // dwell. Offsets of up to 4 mm near the floor's edge reach rare states the closing rounds'
+  // copies did not (the end on the top and the side face at once); the share by use, the ticks
+  // an operator following the plans spends in states the graph has, must stay high.
+  const std::vector<graph::Completeness> found = graph::CheckCompleteness(s, g, o, 24);
+  REQUIRE(found.size() == 2);
+  const graph::Completeness& c = found[1];
+  CHECK(c.motions_of == "perturbed candidate replays");
+  CHECK(c.motions >= 24);
+  for (const std::string& n : c.missing_states) UNSCOPED_INFO("CF not in the graph: " << n);
+  CHECK(c.states_seen >= 3);
+  CHECK(double(c.ticks_in_graph) >= 0.95 * double(c.ticks));
+
+  // Without a goal there is no plan to replay.
+  CHECK(graph::CandidateReplays(s, graph::ContactGraph{}, o, 1, 0, 4).empty());
 }
 
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph][explore]") {

@@ -1,8 +1,8 @@
 #pragma once
 // How complete an explored graph is, measured (docs/graph.md, "Completeness"): motions the
-// explorer did not make (random guarded motions of another seed) are run through the core, their
-// states counted after the same dwell as the explorer's, and what they reach that the graph lacks
-// is listed.
+// explorer did not make (random guarded motions and perturbed replays of the candidate plans, of
+// another seed) are run through the core, their states counted after the same dwell as the
+// explorer's, and what they reach that the graph lacks is listed.
 
 #include <span>
 #include <string>
@@ -17,6 +17,7 @@
 namespace tubeplan::graph {
 
 struct Completeness {
+  std::string motions_of;  ///< what the motions were, e.g. "random guarded motions"
   int motions = 0;
   long states_seen = 0, states_in_graph = 0;
   long transitions_seen = 0, transitions_in_graph = 0;
@@ -37,9 +38,11 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
                                std::span<const Motion> motions, double dwell_s,
                                double force_limit_N);
 
-/// The same over `count` random guarded motions of another seed than the explorer's
-/// (RandomMotions from explore.seed + 1000003): motions it did not make, counted after its dwell.
-Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
-                               const ExploreOptions& explore, int count);
+/// The same over motions the explorer did not make, counted after its dwell: `count` random
+/// guarded motions of another seed (RandomMotions from explore.seed + 1000003), then about
+/// `count` perturbed replays of the candidate plans of `graph` (CandidateReplays from that seed,
+/// as many copies of each candidate trajectory as make `count`; none without a path to the goal).
+std::vector<Completeness> CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
+                                            const ExploreOptions& explore, int count);
 
 }  // namespace tubeplan::graph

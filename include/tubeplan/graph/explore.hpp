@@ -9,7 +9,8 @@
 //  4. neighbour probes: from a stay of each node (its motion resumed there), small moves
 //     of the hand along and against three directions and small turns, each held and undone;
 //     every node found is probed in turn until all have been;
-//  5. closing rounds: more random motions, each round's new nodes probed as in 4, until a round
+//  5. closing rounds: more random motions and perturbed replays of the candidate plans'
+//     trajectories as the graph then stands, each round's new nodes probed as in 4, until a round
 //     adds no node and no arc (saturated), or until the budget of motions or the time limit is
 //     spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
@@ -19,9 +20,12 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <tubeplan/graph/contact_graph.hpp>
+#include <tubeplan/graph/motion.hpp>
 #include <tubeplan/scene/scene.hpp>
 
 namespace tubeplan::graph {
@@ -43,6 +47,17 @@ struct ExploreOptions {
   /// sequence, continued) run, each followed by probing the nodes it found, until a round adds
   /// no node and no arc (0: none).
   int closing_motions = 30;
+  /// Each closing round also replays this many perturbed copies (0: none) of each candidate
+  /// plan's trajectory as the graph then stands: the `replay_paths` cheapest start -> goal paths
+  /// of the graph pruned with `weights`, the hand aimed at the witnesses' hand poses and at their
+  /// held end's poses (as `plans` makes them), moved as a whole by up to `replay_offset_m`, with
+  /// 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a
+  /// plan meets is then in the graph. None run before the goal is reached.
+  int replay_copies = 4;
+  int replay_paths = 3;
+  double replay_offset_m = 0.004;
+  /// The heuristics' weights of the candidate paths (nothing: the scene's).
+  std::optional<PruneWeights> weights;
   /// At most this many motions run, whatever happens (sweeps, aims, random and probe motions
   /// together, in that order: a group is cut where the budget ends). A motion is one entry of
   /// ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
@@ -95,6 +110,13 @@ double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& option
 /// each merged motion.
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& options,
                      const std::function<void(const SaturationPoint&)>& progress = {});
+
+/// The perturbed replays of a closing round (ExploreOptions::replay_copies), of kind "replay":
+/// copies of the candidate trajectories of `graph` with Perturb's replicates `first_replicate`
+/// on, from `seed`. Empty when the graph has no goal or no path to it.
+std::vector<Motion> CandidateReplays(const scene::Scene& scene, const ContactGraph& graph,
+                                     const ExploreOptions& options, std::uint64_t seed,
+                                     int first_replicate, int copies);
 
 /// `count` random motions from `seed` as the explorer makes them (for independent checks).
 std::vector<Motion> RandomMotions(const scene::Scene& scene, std::uint64_t seed, int first,

@@ -15,6 +15,7 @@
 #include <Eigen/Geometry>
 
 #include <tubeplan/core/core.hpp>
+#include <tubeplan/trajectories/trajectory.hpp>
 
 namespace tubeplan::graph {
 
@@ -110,6 +111,13 @@ struct Checkpoint {
 /// move_tick() after some tick k): run, they put the hand where `motion` had it at tick k, bit for
 /// bit, and moves appended to them go on from there.
 std::vector<Move> Prefix(const Motion& motion, int move, int move_tick);
+
+/// A motion that follows `trajectory` on the core's step `time_step_s`: from the scene's start to
+/// its first pose at `speed_m_per_s`, then a move every `ticks_per_move` ticks to where the
+/// trajectory is then, so that the hand is on it at the end of every move and on the chord
+/// between (a replay of a plan's trajectory the explorer can cut and resume as its own motions).
+Motion MotionAlong(const trajectories::Trajectory& trajectory, double time_step_s,
+                   int ticks_per_move, double speed_m_per_s, std::string kind);
 
 /// The held-end pose a motion's start puts the hand at (the scene's start pose).
 Eigen::Isometry3d MotionStart(const scene::Scene& scene);

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <ostream>
+#include <span>
 #include <string>
 
 #include <tubeplan/graph/completeness.hpp>
@@ -28,7 +29,7 @@ struct GraphFiles {
 /// (when given) and the files written.
 void PrintGraph(std::ostream& out, const std::string& scene_path, const scene::Scene& scene,
                 const graph::ContactGraph& graph, const graph::ExploreOptions& explore,
-                const std::string& verdicts_path,
-                const std::optional<graph::Completeness>& completeness, const GraphFiles& written);
+                const std::string& verdicts_path, std::span<const graph::Completeness> completeness,
+                const GraphFiles& written);
 
 }  // namespace tubeplan::report
