@@ -87,12 +87,12 @@ std::vector<Completeness> CheckCompleteness(const scene::Scene& scene, const Con
   found.push_back(CheckCompleteness(scene, graph, RandomMotions(scene, seed, 0, count, explore),
                                     explore.dwell_s, limit_N));
   found.back().motions_of = "random guarded motions";
-  const int trajectories =
-      static_cast<int>(CandidateReplays(scene, graph, explore, seed, 0, 1).size());
-  if (trajectories == 0) return found;
-  const int copies = (count + trajectories - 1) / trajectories;
+  const std::vector<std::vector<Eigen::Isometry3d>> aims =
+      CandidateWaypoints(scene, graph, explore);
+  if (aims.empty()) return found;
+  const int copies = (count + static_cast<int>(aims.size()) - 1) / static_cast<int>(aims.size());
   found.push_back(CheckCompleteness(scene, graph,
-                                    CandidateReplays(scene, graph, explore, seed, 0, copies),
+                                    PerturbedReplays(scene, aims, explore, seed, 0, copies),
                                     explore.dwell_s, limit_N));
   found.back().motions_of = "perturbed candidate replays";
   return found;

@@ -32,9 +32,9 @@ constexpr int kMaxTicksPerMotion = 30000;
 // probes are most of the exploration's ticks.
 constexpr double kProbeSpeed_m_per_s = 0.15;
 constexpr double kProbeTurn_rad_per_s = 2.0;
-// A replayed trajectory moves the hand along chords of this many ticks (10 ms: within 0.02 mm of a
-// minimum-jerk reach of 0.1 m in 0.4 s).
-constexpr int kReplayTicksPerMove = 10;
+// A replayed trajectory moves the hand along chords of this many ticks (20 ms: within 0.05 mm of
+// the quickest minimum-jerk reach at 80 mm/s, sped up 1.25 times).
+constexpr int kReplayTicksPerMove = 20;
 // A motion's run keeps a checkpoint every this many ticks (a core snapshot is ~70 kB, copied in
 // about the time of a tick or two): a refinement or a probe starts from the one before its tick
 // and replays at most this many ticks, not the whole motion up to it.
@@ -758,6 +758,14 @@ class Merger {
   std::vector<Entry> entry_;
 };
 
+// Whether two lists of poses are the same, bit for bit.
+bool SamePoses(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
+                      return x.matrix() == y.matrix();
+                    });
+}
+
 std::set<std::string> ReachedElements(const ContactGraph& graph) {
   std::set<std::string> reached;
   for (const Node& n : graph.nodes) {
@@ -897,9 +905,9 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
 
 }  // namespace
 
-std::vector<Motion> CandidateReplays(const scene::Scene& scene, const ContactGraph& graph,
-                                     const ExploreOptions& options, std::uint64_t seed,
-                                     int first_replicate, int copies) {
+std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
+                                                               const ContactGraph& graph,
+                                                               const ExploreOptions& options) {
   // The candidate paths of the graph as it stands, pruned as `plans` prunes it.
   ContactGraph marked;
   marked.nodes = graph.nodes;
@@ -911,23 +919,28 @@ std::vector<Motion> CandidateReplays(const scene::Scene& scene, const ContactGra
       options.weights.value_or(PruneWeights{scene.heuristics.friction, scene.heuristics.energy,
                                             scene.heuristics.distance, scene.heuristics.tolerance});
   Prune(marked, weights);
-  const std::vector<Path> paths =
-      KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths);
+  std::vector<std::vector<Eigen::Isometry3d>> aims;
+  for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
+    for (const bool held : {false, true}) aims.push_back(PathWaypoints(scene, marked, path, held));
+  return aims;
+}
+
+std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
+                                     std::span<const std::vector<Eigen::Isometry3d>> waypoints,
+                                     const ExploreOptions& options, std::uint64_t seed,
+                                     int first_replicate, int copies) {
   trajectories::SynthesisOptions synthesis;
   synthesis.peak_speed_m_per_s = options.speed_m_per_s;
   trajectories::Perturbation perturbation;
   perturbation.offset_m = options.replay_offset_m;
   std::vector<Motion> motions;
   int replicate = first_replicate;
-  for (const Path& path : paths) {
-    for (const bool held : {false, true}) {
-      const trajectories::Trajectory nominal =
-          trajectories::SynthesizeTrajectory(PathWaypoints(scene, marked, path, held), synthesis);
-      for (int c = 0; c < copies; ++c)
-        motions.push_back(MotionAlong(
-            trajectories::Perturb(nominal, perturbation, seed, replicate++),
-            scene.model.time_step_s, kReplayTicksPerMove, options.speed_m_per_s, "replay"));
-    }
+  for (const std::vector<Eigen::Isometry3d>& aim : waypoints) {
+    const trajectories::Trajectory nominal = trajectories::SynthesizeTrajectory(aim, synthesis);
+    for (int c = 0; c < copies; ++c)
+      motions.push_back(MotionAlong(trajectories::Perturb(nominal, perturbation, seed, replicate++),
+                                    scene.model.time_step_s, kReplayTicksPerMove,
+                                    options.speed_m_per_s, "replay"));
   }
   return motions;
 }
@@ -1052,18 +1065,30 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   };
   probe_new_nodes();
   // Closing rounds: more random motions of the same seed and perturbed replays of the candidate
-  // plans as the graph stands, each round merged and its new nodes probed, until a round adds no
-  // node and no arc (saturated), or a limit ends it.
+  // plans, those of the graph as the round starts and those `plans` makes (of the graph as it is
+  // here, before the first round: the one `plans` explores), each round merged and its new nodes
+  // probed, until a round adds no node and no arc (saturated), or a limit ends it.
+  const std::vector<std::vector<Eigen::Isometry3d>> planned =
+      o.replay_copies > 0 ? CandidateWaypoints(scene, graph, o)
+                          : std::vector<std::vector<Eigen::Isometry3d>>{};
   int next_random = o.random_motions, next_replicate = 0;
   while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();
     phase = "closing rounds";
-    run(RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o), {});
+    std::vector<std::vector<Eigen::Isometry3d>> aims;
+    if (o.replay_copies > 0) aims = CandidateWaypoints(scene, graph, o);
+    for (const std::vector<Eigen::Isometry3d>& p : planned)
+      if (std::none_of(aims.begin(), aims.end(), [&](const auto& a) { return SamePoses(a, p); }))
+        aims.push_back(p);
+    std::vector<Motion> round =
+        RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o);
     next_random += o.closing_motions;
     std::vector<Motion> replays =
-        CandidateReplays(scene, graph, o, o.seed, next_replicate, o.replay_copies);
+        PerturbedReplays(scene, aims, o, o.seed, next_replicate, o.replay_copies);
     next_replicate += static_cast<int>(replays.size());
-    run(std::move(replays), {});
+    round.insert(round.end(), std::make_move_iterator(replays.begin()),
+                 std::make_move_iterator(replays.end()));
+    run(std::move(round), {});
     ++graph.closing_rounds;
     probe_new_nodes();
     if (graph.nodes.size() == nodes_before && graph.arcs.size() == arcs_before) break;

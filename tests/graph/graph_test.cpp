@@ -511,13 +511,14 @@ TEST_CASE("Closing rounds go on until one adds no state and no transition", "[gr
   REQUIRE(g.saturated);
   REQUIRE(g.closing_rounds >= 1);
   // The last round's motions (nothing new: no probes after them) are the graph's last ones: its
-  // random motions, then its perturbed replays of each candidate plan, aimed two ways.
+  // random motions, then its perturbed replays of each candidate plan, aimed two ways: those of
+  // the graph as the round started and those of the graph before the first round.
   std::size_t replays = 0;
   while (replays < g.motions.size() && g.motions[g.motions.size() - 1 - replays].kind == "replay")
     ++replays;
   CHECK(replays > 0);
   CHECK(replays % std::size_t(2 * o.replay_copies) == 0);
-  CHECK(replays <= std::size_t(2 * o.replay_copies * o.replay_paths));
+  CHECK(replays <= std::size_t(2 * 2 * o.replay_copies * o.replay_paths));
   const std::size_t last = g.saturation.size() - replays;
   REQUIRE(last > std::size_t(round));
   const graph::SaturationPoint& before = g.saturation[last - 1 - std::size_t(round)];
@@ -541,11 +542,11 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
   const trajectories::Trajectory t =
       trajectories::SynthesizeTrajectory(waypoints, trajectories::SynthesisOptions{});
   const std::vector<trajectories::HandSample> ticks = trajectories::Resample(t, T);
-  const graph::Motion m = graph::MotionAlong(t, T, 10, 0.08, "replay");
+  const graph::Motion m = graph::MotionAlong(t, T, 20, 0.08, "replay");
   CHECK(m.kind == "replay");
-  // The start is the trajectory's first pose: no move to it takes time; then one move per 10
+  // The start is the trajectory's first pose: no move to it takes time; then one move per 20
   // ticks, the last one shorter.
-  REQUIRE(m.moves.size() == 1 + (ticks.size() - 1 + 9) / 10);
+  REQUIRE(m.moves.size() == 1 + (ticks.size() - 1 + 19) / 20);
   graph::MotionRunner runner(m, s.X_WH_start, T);
   core::StepOutput rest;
   std::size_t k = 0;
@@ -556,7 +557,7 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
     ++k;
     const trajectories::HandSample& want = ticks[std::min(k - 1, ticks.size() - 1)];
     chord_m = std::max(chord_m, (X.translation() - want.p_WH_m).norm());
-    if ((k - 1) % 10 == 0 || k == ticks.size()) {
+    if ((k - 1) % 20 == 0 || k == ticks.size()) {
       INFO("tick " << k);
       CHECK((X.translation() - want.p_WH_m).norm() < 1e-12);
       CHECK(Eigen::Quaterniond(X.linear()).angularDistance(want.q_WH) < 1e-9);
@@ -564,8 +565,10 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
   }
   // The first tick holds the start (a move to where the hand is), then one tick per sample.
   CHECK(k == ticks.size());
-  // Between, the hand is on the chord: within the stated 0.02 mm of a 36 mm reach in 0.4 s.
-  CHECK(chord_m < 2e-5);
+  // Between, the hand is on the chord: within 0.05 mm of the trajectory (the explorer's bound
+  // for its quickest reach; this one's peak acceleration gives about 0.015 mm).
+  CHECK(chord_m < 5e-5);
+  CHECK(chord_m > 1e-6);
 }
 
 TEST_CASE("Perturbed replays of the candidate plans stay inside the explored graph",
@@ -599,7 +602,7 @@ TEST_CASE("Perturbed replays of the candidate plans stay inside the explored gra
   CHECK(double(c.ticks_in_graph) >= 0.95 * double(c.ticks));
 
   // Without a goal there is no plan to replay.
-  CHECK(graph::CandidateReplays(s, graph::ContactGraph{}, o, 1, 0, 4).empty());
+  CHECK(graph::CandidateWaypoints(s, graph::ContactGraph{}, o).empty());
 }
 
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph][explore]") {

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -48,11 +49,12 @@ struct ExploreOptions {
   /// no node and no arc (0: none).
   int closing_motions = 30;
   /// Each closing round also replays this many perturbed copies (0: none) of each candidate
-  /// plan's trajectory as the graph then stands: the `replay_paths` cheapest start -> goal paths
-  /// of the graph pruned with `weights`, the hand aimed at the witnesses' hand poses and at their
-  /// held end's poses (as `plans` makes them), moved as a whole by up to `replay_offset_m`, with
-  /// 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a
-  /// plan meets is then in the graph. None run before the goal is reached.
+  /// plan's trajectory, of the graph as the round starts and of the graph before the first round
+  /// (the one `plans` explores): the `replay_paths` cheapest start -> goal paths of the graph
+  /// pruned with `weights`, the hand aimed at the witnesses' hand poses and at their held end's
+  /// poses (CandidateWaypoints), moved as a whole by up to `replay_offset_m`, with 0.1 mm tremor
+  /// and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a plan meets is
+  /// then in the graph. None run before the goal is reached.
   int replay_copies = 4;
   int replay_paths = 3;
   double replay_offset_m = 0.004;
@@ -111,10 +113,19 @@ double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& option
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& options,
                      const std::function<void(const SaturationPoint&)>& progress = {});
 
-/// The perturbed replays of a closing round (ExploreOptions::replay_copies), of kind "replay":
-/// copies of the candidate trajectories of `graph` with Perturb's replicates `first_replicate`
-/// on, from `seed`. Empty when the graph has no goal or no path to it.
-std::vector<Motion> CandidateReplays(const scene::Scene& scene, const ContactGraph& graph,
+/// The hand's waypoints of the candidate plans of `graph` as `plans` makes them: for each of the
+/// `options.replay_paths` cheapest start -> goal paths of the graph pruned with
+/// `options.weights`, aimed at the witnesses' hand poses, then at their held end's poses. Empty
+/// when the graph has no goal or no path to it.
+std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
+                                                               const ContactGraph& graph,
+                                                               const ExploreOptions& options);
+
+/// Perturbed replays (ExploreOptions::replay_copies), motions of kind "replay": `copies` of a
+/// trajectory through each of `waypoints` at the explorer's speed, Perturb's replicates
+/// `first_replicate` on, from `seed`.
+std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
+                                     std::span<const std::vector<Eigen::Isometry3d>> waypoints,
                                      const ExploreOptions& options, std::uint64_t seed,
                                      int first_replicate, int copies);
 
