@@ -1,4 +1,5 @@
 #include <cmath>
+#include <vector>
 
 #include <tubeplan/report/graph_json.hpp>
 
@@ -90,16 +91,33 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
     curve.push_back({p.motions, p.nodes, p.arcs});
   j["saturation"] = curve;
   j["elements"] = {{"reached", g.reached_elements}, {"unreached", g.unreached_elements}};
+  // The moves of the motions a witness lies in, so that it can be replayed; of the others, the
+  // kind (most closing rounds' motions found nothing new and would double the file).
+  // (A state or transition seen only in an evaluate report's replays has no witness motion.)
+  std::vector<bool> witnessed(g.motions.size(), false);
+  const auto witness = [&](bool from_replay, const graph::TickRef& r) {
+    if (!from_replay && r.motion >= 0 && std::size_t(r.motion) < witnessed.size())
+      witnessed[std::size_t(r.motion)] = true;
+  };
+  for (const graph::Node& n : g.nodes) witness(n.from_replay, n.witness);
+  for (const graph::Arc& a : g.arcs) witness(a.from_replay, a.witness);
   nlohmann::json motions = nlohmann::json::array();
-  for (const graph::Motion& m : g.motions) {
+  for (std::size_t i = 0; i < g.motions.size(); ++i) {
+    const graph::Motion& m = g.motions[i];
+    if (!witnessed[i]) {
+      motions.push_back({{"kind", m.kind}});
+      continue;
+    }
     nlohmann::json moves = nlohmann::json::array();
     for (const graph::Move& mv : m.moves) {
       moves.push_back({{"p", {mv.p_W_m.x(), mv.p_W_m.y(), mv.p_W_m.z()}},
                        {"q", {mv.q_W.w(), mv.q_W.x(), mv.q_W.y(), mv.q_W.z()}},
                        {"speed_m_per_s", mv.speed_m_per_s},
-                       {"turn_rad_per_s", mv.turn_rad_per_s},
-                       {"guard_dir", {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()}},
-                       {"guard_N", mv.guard_N}});
+                       {"turn_rad_per_s", mv.turn_rad_per_s}});
+      if (mv.guard_N > 0.0) {
+        moves.back()["guard_dir"] = {mv.guard_dir_W.x(), mv.guard_dir_W.y(), mv.guard_dir_W.z()};
+        moves.back()["guard_N"] = mv.guard_N;
+      }
       if (mv.relative) moves.back()["relative"] = true;
       if (mv.force_limit_N > 0.0) moves.back()["force_limit_N"] = mv.force_limit_N;
       if (mv.min_ticks > 0) moves.back()["min_ticks"] = mv.min_ticks;

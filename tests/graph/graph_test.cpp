@@ -19,6 +19,7 @@
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
+#include <tubeplan/report/graph_json.hpp>
 #include <tubeplan/trajectories/synthesize.hpp>
 
 namespace {
@@ -603,6 +604,34 @@ TEST_CASE("Perturbed replays of the candidate plans stay inside the explored gra
 
   // Without a goal there is no plan to replay.
   CHECK(graph::CandidateWaypoints(s, graph::ContactGraph{}, o).empty());
+}
+
+TEST_CASE("The graph's JSON keeps the moves of the motions its witnesses lie in",
+          "[graph][explore]") {
+  const scene::Scene s = ExploredScene();
+  const ContactGraph& g = DefaultGraph(1);
+  const nlohmann::json j =
+      report::GraphToJson(g, s, "floor.yaml", graph::ExploreOptions{}, graph::PruneWeights{});
+  CHECK(j["tubeplan_graph"] == report::kGraphJsonVersion);
+  std::set<int> witnessed;
+  for (const Node& n : g.nodes) witnessed.insert(n.witness.motion);
+  for (const graph::Arc& a : g.arcs) witnessed.insert(a.witness.motion);
+  REQUIRE(j["motions"].size() == g.motions.size());
+  std::size_t bare = 0;
+  for (std::size_t i = 0; i < g.motions.size(); ++i) {
+    const nlohmann::json& m = j["motions"][i];
+    CHECK(m["kind"] == g.motions[i].kind);
+    if (witnessed.contains(static_cast<int>(i))) {
+      REQUIRE(m.contains("moves"));
+      CHECK(m["moves"].size() == g.motions[i].moves.size());
+    } else {
+      CHECK(!m.contains("moves"));
+      ++bare;
+    }
+  }
+  // A motion holds a witness only where it had a state's or a transition's longest stay: most
+  // of the closing rounds' motions, which found nothing new, hold none.
+  CHECK(bare >= std::size_t(graph::ExploreOptions{}.closing_motions));
 }
 
 TEST_CASE("Independent random motions stay inside the explored graph", "[graph][explore]") {
