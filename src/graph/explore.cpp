@@ -642,7 +642,11 @@ class Merger {
       const int i = NodeOf(s.cf);
       Node& n = graph_.nodes[std::size_t(i)];
       if (!s.refined) n.ticks += s.length;
-      n.min_force_N = std::min(n.min_force_N, s.sample.force_N);
+      if (s.sample.force_N < n.min_force_N) {
+        n.min_force_N = s.sample.force_N;
+        n.X_W_hand_least = s.sample.X_W_hand;
+        n.X_WH_least = s.sample.X_WH;
+      }
       // The witness: a stay within the force limit before any beyond it, then a settled stay
       // before a refined one, then the longest.
       Best& best = best_[std::size_t(i)];
@@ -757,14 +761,6 @@ class Merger {
   std::vector<Best> best_;
   std::vector<Entry> entry_;
 };
-
-// Whether two lists of poses are the same, bit for bit.
-bool SamePoses(const std::vector<Eigen::Isometry3d>& a, const std::vector<Eigen::Isometry3d>& b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                    [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
-                      return x.matrix() == y.matrix();
-                    });
-}
 
 std::set<std::string> ReachedElements(const ContactGraph& graph) {
   std::set<std::string> reached;
@@ -921,7 +917,11 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   Prune(marked, weights);
   std::vector<std::vector<Eigen::Isometry3d>> aims;
   for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
-    for (const bool held : {false, true}) aims.push_back(PathWaypoints(scene, marked, path, held));
+    for (const Aim aim : {Aim::kHand, Aim::kHeld, Aim::kLeastForce}) {
+      std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, marked, path, aim);
+      if (std::none_of(aims.begin(), aims.end(), [&](const auto& a) { return SamePoses(a, w); }))
+        aims.push_back(std::move(w));
+    }
   return aims;
 }
 

@@ -127,13 +127,30 @@ std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<do
 }
 
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
-                                             const Path& path, bool held) {
+                                             const Path& path, Aim aim) {
   std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
   for (std::size_t j = 1; j < path.nodes.size(); ++j) {
     const Node& node = graph.nodes[std::size_t(path.nodes[j])];
-    waypoints.push_back(held ? node.X_WH : node.X_W_hand);
+    switch (aim) {
+      case Aim::kHand:
+        waypoints.push_back(node.X_W_hand);
+        break;
+      case Aim::kHeld:
+        waypoints.push_back(node.X_WH);
+        break;
+      case Aim::kLeastForce:
+        waypoints.push_back(std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH);
+        break;
+    }
   }
   return waypoints;
+}
+
+bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                    [](const Eigen::Isometry3d& x, const Eigen::Isometry3d& y) {
+                      return x.matrix() == y.matrix();
+                    });
 }
 
 }  // namespace tubeplan::graph

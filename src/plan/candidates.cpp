@@ -1,7 +1,7 @@
 #include <algorithm>
-#include <array>
 #include <iomanip>
 #include <sstream>
+#include <utility>
 
 #include <tubeplan/plan/candidates.hpp>
 
@@ -20,23 +20,28 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     c.plan.limits.max_force_N = scene.device.max_force_N;
     c.plan.limits.dwell_s = options.dwell_s;
     // At the asked speed, then each slower one until a replay is feasible: the hand aimed at
-    // the witnesses' hand poses and at their held end's poses, the feasible one of least peak
-    // force kept (else the last tried).
+    // the witnesses' hand poses, at their held end's poses and at the held end's poses of the
+    // stays of least force (each aim once: those that coincide with an earlier one are left
+    // out), the feasible one of least peak force kept (else the last tried).
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    const std::array<std::vector<Eigen::Isometry3d>, 2> aims = {
-        graph::PathWaypoints(scene, graph, *c.path, false),
-        graph::PathWaypoints(scene, graph, *c.path, true)};
+    std::vector<std::pair<graph::Aim, std::vector<Eigen::Isometry3d>>> aims;
+    for (const graph::Aim aim : {graph::Aim::kHand, graph::Aim::kHeld, graph::Aim::kLeastForce}) {
+      std::vector<Eigen::Isometry3d> w = graph::PathWaypoints(scene, graph, *c.path, aim);
+      if (std::none_of(aims.begin(), aims.end(),
+                       [&](const auto& a) { return graph::SamePoses(a.second, w); }))
+        aims.emplace_back(aim, std::move(w));
+    }
     int tried = 0;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =
           options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
-      for (std::size_t a = 0; a < aims.size(); ++a) {
+      for (const auto& [aim, waypoints] : aims) {
         Candidate t = c;
-        t.trajectory = trajectories::SynthesizeTrajectory(aims[a], synthesis);
+        t.trajectory = trajectories::SynthesizeTrajectory(waypoints, synthesis);
         t.duration_s = t.trajectory.samples.back().t_s;
         t.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
-        t.held = a == 1;
+        t.aim = aim;
         t.tries = ++tried;
         const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
         t.judgement = read ? Judge(scene, *read, t.plan.states, t.plan.limits) : Judgement{};
@@ -67,7 +72,10 @@ std::string VerdictText(const Candidate& c) {
   text << std::setprecision(3)
        << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
   if (c.tries > 1)
-    text << " (try " << c.tries << ": " << (c.held ? "the held end's poses" : "the hand's")
+    text << " (try " << c.tries << ": "
+         << (c.aim == graph::Aim::kHand   ? "the hand's"
+             : c.aim == graph::Aim::kHeld ? "the held end's poses"
+                                          : "the held end's poses of least force")
          << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";
   text << "; peak operator force " << c.judgement.peak_force_N << " N";
   return text.str();

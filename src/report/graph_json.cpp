@@ -55,6 +55,10 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
     nlohmann::json w = Ref(n.witness, T);
     w["hand"] = Pose(n.X_W_hand);
     w["held"] = Pose(n.X_WH);
+    const nlohmann::json least =
+        std::isfinite(n.min_force_N)
+            ? nlohmann::json{{"hand", Pose(n.X_W_hand_least)}, {"held", Pose(n.X_WH_least)}}
+            : nlohmann::json(nullptr);
     nodes.push_back({{"cf", n.cf},
                      {"pcs", n.pcs},
                      {"start", n.start},
@@ -65,6 +69,7 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
                      {"force_N", n.force_N},
                      {"min_force_N", std::isfinite(n.min_force_N) ? nlohmann::json(n.min_force_N)
                                                                   : nlohmann::json(nullptr)},
+                     {"least_force", least},
                      {"distance_m", n.distance_m >= 0.0 ? nlohmann::json(n.distance_m) : nullptr},
                      {"ticks", n.ticks},
                      {"from_replay", n.from_replay},

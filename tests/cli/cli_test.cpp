@@ -304,8 +304,9 @@ TEST_CASE("plans: the tilted groove's two-PC goal gives verified plans on a smal
   for (std::size_t at = r.out.find("groove-tilted-candidate-"); at != std::string::npos;
        at = r.out.find("groove-tilted-candidate-", at + 1)) {
     const std::string said = r.out.substr(at, r.out.find('\n', at) - at);
-    CHECK(said.find("-> {Fs n floor.top, Fs n left.inner}; feasible; peak operator force ") !=
-          std::string::npos);
+    // Feasible, perhaps on a later try (which the line names), with its peak force.
+    CHECK(said.find("-> {Fs n floor.top, Fs n left.inner}; feasible") != std::string::npos);
+    CHECK(said.find("; peak operator force ") != std::string::npos);
     CHECK(std::stod(said.substr(said.rfind("force ") + 6)) < 8.5);
     ++written;
   }

@@ -34,7 +34,7 @@ graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m, dou
 
 }  // namespace
 
-TEST_CASE("Candidates: both aims at each speed, slower until feasible, least force; feasible first",
+TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
           "[plan]") {
   const io::SceneLoadResult loaded =
       io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
@@ -64,23 +64,24 @@ TEST_CASE("Candidates: both aims at each speed, slower until feasible, least for
   CHECK(c[0].path == &paths[1]);
   CHECK(c[0].judgement.feasible);
   CHECK(c[0].tries == 2);
-  CHECK(c[0].held);
+  CHECK(c[0].aim == graph::Aim::kHeld);
   CHECK(c[0].peak_speed_m_per_s == 0.08);
   CHECK(c[0].judgement.peak_force_N < 1.0);
-  // The reachable witness replays feasible at once, both ways alike (its hand and held end are
-  // at one pose): the first is kept.
+  // The reachable witness replays feasible at once: its hand and held end are at one pose, so
+  // the held aim coincides with the hand's and is not tried again.
   CHECK(c[1].path == &paths[2]);
   CHECK(c[1].judgement.feasible);
   CHECK(c[1].tries == 1);
-  CHECK_FALSE(c[1].held);
+  CHECK(c[1].aim == graph::Aim::kHand);
   CHECK(c[1].judgement.peak_force_N < scene.device.max_force_N);
   CHECK(c[1].plan.states == std::vector<std::string>{"{}", "{Fs - floor.top}"});
-  // The witness whose tube was pushed through the floor too stays infeasible after all six
-  // tries, at the device's limit, with the slowest try's longer trajectory.
+  // The witness whose tube was pushed through the floor too (hand and held end at one pose,
+  // one aim) stays infeasible after all three speeds, at the device's limit, with the slowest
+  // try's longer trajectory.
   CHECK(c[2].path == &paths[0]);
   CHECK_FALSE(c[2].judgement.feasible);
-  CHECK(c[2].tries == 6);
-  CHECK(c[2].held);
+  CHECK(c[2].tries == 3);
+  CHECK(c[2].aim == graph::Aim::kHand);
   CHECK(c[2].peak_speed_m_per_s == Approx(0.02));
   CHECK(c[2].duration_s > 2.0 * c[1].duration_s);
   CHECK(c[2].judgement.peak_force_N == Approx(scene.device.max_force_N));
@@ -88,7 +89,7 @@ TEST_CASE("Candidates: both aims at each speed, slower until feasible, least for
   // the goal's lying-flat state).
   const std::string failure = plan::FirstFailure(c[2].judgement);
   CHECK(failure.find("after the goal") != std::string::npos);
-  CHECK(replays == 2 + 2 + 6);
+  CHECK(replays == 2 + 1 + 3);
 }
 
 TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept", "[plan]") {
@@ -119,7 +120,44 @@ TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept
   REQUIRE(p[0].tries == 1);
   REQUIRE(p[0].peak_speed_m_per_s == 0.08);
   CHECK(c[0].judgement.feasible);
-  CHECK(c[0].held);
+  CHECK(c[0].aim == graph::Aim::kHeld);
   CHECK(c[0].tries == 2);
   CHECK(c[0].judgement.peak_force_N < p[0].judgement.peak_force_N - 0.5);
+}
+
+TEST_CASE("Candidates: a state's stay of least force is aimed at as another witness", "[plan]") {
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  // The goal's witness with the hand and the held end 40 mm down, through the floor to the
+  // device's limit; its stay of least force at the lay-flat pose (8.16 mm over the floor).
+  const double z = 0.00816, deep = z - 0.040;
+  graph::ContactGraph g = LayFlatGraph(scene, deep, deep);
+  const graph::ContactGraph flat = LayFlatGraph(scene, z, z);
+  g.nodes[1].min_force_N = 0.1;
+  g.nodes[1].X_W_hand_least = flat.nodes[1].X_W_hand;
+  g.nodes[1].X_WH_least = flat.nodes[1].X_WH;
+  const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
+  plan::CandidateOptions options;
+  options.synthesis.peak_speed_m_per_s = 0.08;
+  options.dwell_s = 0.02;
+  options.scene_ref = "groove.yaml";
+  int replays = 0;
+  const std::vector<plan::Candidate> c =
+      plan::MakeCandidates(scene, g, paths, options, [&](const trajectories::Trajectory& t) {
+        ++replays;
+        return std::optional<trajectories::Trajectory>(t);
+      });
+  REQUIRE(c.size() == 1);
+  // The hand's and the held end's poses coincide (one try); the stay of least force is the
+  // second, and replays feasible at the asked speed, well within the device.
+  CHECK(replays == 2);
+  CHECK(c[0].judgement.feasible);
+  CHECK(c[0].aim == graph::Aim::kLeastForce);
+  CHECK(c[0].tries == 2);
+  CHECK(c[0].peak_speed_m_per_s == 0.08);
+  CHECK(c[0].judgement.peak_force_N < 1.0);
+  CHECK(plan::VerdictText(c[0]).find("(try 2: the held end's poses of least force at 80 mm/s)") !=
+        std::string::npos);
 }

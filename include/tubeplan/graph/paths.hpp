@@ -4,6 +4,7 @@
 // above the cheapest kept arc's, so every transition costs at least one (shorter plans first)
 // and the heuristics order plans of the same length.
 
+#include <span>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -26,10 +27,20 @@ std::vector<double> ArcCosts(const ContactGraph& graph, const PruneWeights& weig
 std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<double>& arc_cost,
                                  int k);
 
-/// The hand's poses along a path: the scene's start, then the hand at each later state's
-/// witness, or with `held` the held end's pose there (the hand no longer pulling the coupling
-/// out). A candidate plan's trajectory goes through them.
+/// Where a candidate plan aims the hand at each state of its path.
+enum class Aim : unsigned char {
+  kHand,        ///< the hand's pose at the state's witness
+  kHeld,        ///< the held end's pose there (the hand no longer pulling the coupling out)
+  kLeastForce,  ///< the held end's pose at the state's stay of least operator force
+};
+
+/// The hand's poses along a path: the scene's start, then one pose per later state as `aim`
+/// says (kLeastForce falls back to kHeld for a state with no measured stay). A candidate plan's
+/// trajectory goes through them.
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
-                                             const Path& path, bool held);
+                                             const Path& path, Aim aim);
+
+/// Whether two lists of poses are the same, bit for bit (two aims that coincide).
+bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b);
 
 }  // namespace tubeplan::graph

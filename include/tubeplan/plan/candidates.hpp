@@ -1,8 +1,9 @@
 #pragma once
 // Candidate plans from paths through the contact-state graph: the hand moves by minimum jerk
 // through the witnesses of each path's states, and every candidate is replayed through the same
-// judge as `evaluate`, aimed at the witnesses' hand poses and at their held end's poses, slower
-// while neither is feasible; the feasible try of least force is kept (docs/graph.md, "Plans").
+// judge as `evaluate`, aimed at the witnesses' hand poses, at their held end's poses and at the
+// held end's poses of the stays of least force, slower while none is feasible; the feasible try
+// of least force is kept (docs/graph.md, "Plans").
 
 #include <functional>
 #include <optional>
@@ -27,9 +28,11 @@ struct CandidateOptions {
   std::string scene_ref;  ///< the scene as the plan files name it
   /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
   /// less): the first tries are at the asked speed. At each speed the hand is aimed at the
-  /// witnesses' hand poses and at their held end's poses (Node::X_WH): a witness the explorer
-  /// reached while the tube held back from the hand (the coupling stretched, the tube pushed
-  /// hard, or still moving) is then approached without the push that carried the tube on.
+  /// witnesses' hand poses, at their held end's poses (Node::X_WH) and at the held end's poses
+  /// of each state's stay of least force (Node::X_WH_least, another witness of the same state):
+  /// a witness the explorer reached while the tube held back from the hand (the coupling
+  /// stretched, the tube pushed hard, or still moving) is then approached without the push that
+  /// carried the tube on.
   std::vector<double> slower = {2.0, 4.0};
 };
 
@@ -38,9 +41,9 @@ struct Candidate {
   Plan plan;  ///< name, trajectory and comment left to the writer
   trajectories::Trajectory trajectory;
   double duration_s = 0.0;
-  double peak_speed_m_per_s = 0.0;  ///< of the try kept
-  bool held = false;                ///< the try kept aims at the held end's poses
-  int tries = 0;                    ///< which try was kept, in the order tried (from 1)
+  double peak_speed_m_per_s = 0.0;     ///< of the try kept
+  graph::Aim aim = graph::Aim::kHand;  ///< where the try kept aims the hand
+  int tries = 0;                       ///< which try was kept, in the order tried (from 1)
   Judgement judgement;
 };
 
@@ -49,9 +52,9 @@ struct Candidate {
 using AsWritten =
     std::function<std::optional<trajectories::Trajectory>(const trajectories::Trajectory&)>;
 
-/// One candidate for each path (in order): of the two tries at the fastest speed where one
-/// replays feasible, the feasible one of least peak operator force, or else the last try; the
-/// feasible come first, each kind in the paths' order.
+/// One candidate for each path (in order): of the tries (one per distinct aim) at the fastest
+/// speed where one replays feasible, the feasible one of least peak operator force, or else the
+/// last try; the feasible come first, each kind in the paths' order.
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options, const AsWritten& as_written);
