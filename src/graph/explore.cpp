@@ -33,7 +33,7 @@ constexpr int kMaxTicksPerMotion = 30000;
 constexpr double kProbeSpeed_m_per_s = 0.15;
 constexpr double kProbeTurn_rad_per_s = 2.0;
 // A replayed trajectory moves the hand along chords of this many ticks (20 ms: within 0.05 mm of
-// the quickest minimum-jerk reach at 80 mm/s, sped up 1.25 times).
+// the quickest minimum-jerk reach at 80 mm/s sped up 1.25 times, and about 0.03 mm of its tremor).
 constexpr int kReplayTicksPerMove = 20;
 // A motion's run keeps a checkpoint every this many ticks (a core snapshot is ~70 kB, copied in
 // about the time of a tick or two): a refinement or a probe starts from the one before its tick
@@ -483,10 +483,10 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
     t -= t.dot(n_W) * n_W;
     if (t.norm() < 1e-6) t = n_W.cross(f.lateral);
     t.normalize();
-    struct Aim {
+    struct Approach {
       Eigen::Vector3d axis, hand, push, slide;
     };
-    std::vector<Aim> tip_aims, side_aims;
+    std::vector<Approach> tip_aims, side_aims;
     for (double phi_deg : {30.0, 60.0, 80.0}) {  // the tip, its axis leaning off the normal
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
       const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
@@ -496,8 +496,8 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
       const Eigen::Vector3d mid = c_W + (gap + r) * n_W;
       side_aims.push_back({a, mid - 0.5 * l * a, -n_W, a});
     }
-    for (const std::vector<Aim>* aims : {&tip_aims, &side_aims}) {
-      for (const Aim& aim : *aims) {
+    for (const std::vector<Approach>* aims : {&tip_aims, &side_aims}) {
+      for (const Approach& aim : *aims) {
         const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, aim.axis);
         Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
         X.linear() = q.toRotationMatrix();
@@ -642,8 +642,11 @@ class Merger {
       const int i = NodeOf(s.cf);
       Node& n = graph_.nodes[std::size_t(i)];
       if (!s.refined) n.ticks += s.length;
-      if (s.sample.force_N < n.min_force_N) {
-        n.min_force_N = s.sample.force_N;
+      n.min_force_N = std::min(n.min_force_N, s.sample.force_N);
+      // The settled stay of least force (a refined stay is a brief bridge, sampled at a tick the
+      // state did not last from), with its poses: another witness to aim at.
+      if (!s.refined && s.sample.force_N < n.least_force_N) {
+        n.least_force_N = s.sample.force_N;
         n.X_W_hand_least = s.sample.X_W_hand;
         n.X_WH_least = s.sample.X_WH;
       }
@@ -904,25 +907,37 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
 std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
                                                                const ContactGraph& graph,
                                                                const ExploreOptions& options) {
-  // The candidate paths of the graph as it stands, pruned as `plans` prunes it.
+  // The candidate paths of the graph as it stands, pruned as `plans` prunes it; of the explored
+  // graph only (a state seen only in an evaluate report has no witness to aim at).
   ContactGraph marked;
-  marked.nodes = graph.nodes;
-  marked.arcs = graph.arcs;
-  marked.start = graph.start;
+  std::vector<int> index(graph.nodes.size(), -1);
+  for (std::size_t i = 0; i < graph.nodes.size(); ++i) {
+    if (graph.nodes[i].from_replay) continue;
+    index[i] = static_cast<int>(marked.nodes.size());
+    marked.nodes.push_back(graph.nodes[i]);
+  }
+  for (const Arc& a : graph.arcs) {
+    if (a.from_replay || index[std::size_t(a.from)] < 0 || index[std::size_t(a.to)] < 0) continue;
+    marked.arcs.push_back(a);
+    marked.arcs.back().from = index[std::size_t(a.from)];
+    marked.arcs.back().to = index[std::size_t(a.to)];
+  }
+  marked.start = graph.start >= 0 ? index[std::size_t(graph.start)] : -1;
   MarkStartAndGoal(scene, marked);
   if (marked.start < 0 || marked.goal < 0 || marked.goal == marked.start) return {};
   const PruneWeights weights =
       options.weights.value_or(PruneWeights{scene.heuristics.friction, scene.heuristics.energy,
                                             scene.heuristics.distance, scene.heuristics.tolerance});
   Prune(marked, weights);
-  std::vector<std::vector<Eigen::Isometry3d>> aims;
+  std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
   for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
     for (const Aim aim : {Aim::kHand, Aim::kHeld, Aim::kLeastForce}) {
       std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, marked, path, aim);
-      if (std::none_of(aims.begin(), aims.end(), [&](const auto& a) { return SamePoses(a, w); }))
-        aims.push_back(std::move(w));
+      if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
+                       [&](const auto& a) { return SamePoses(a, w); }))
+        waypoint_lists.push_back(std::move(w));
     }
-  return aims;
+  return waypoint_lists;
 }
 
 std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
@@ -944,6 +959,34 @@ std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
   }
   return motions;
 }
+
+namespace {
+
+// A closing round's motions: `closing_motions` random motions of the seed from `next_random`, then
+// `replay_copies` perturbed replays from `next_replicate` of each candidate plan of the graph as
+// it stands and of `planned`, each distinct list of poses once. Advances both counters.
+std::vector<Motion> ClosingRound(const scene::Scene& scene, const Box& box,
+                                 const ContactGraph& graph,
+                                 std::span<const std::vector<Eigen::Isometry3d>> planned,
+                                 const ExploreOptions& o, int& next_random, int& next_replicate) {
+  std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
+  if (o.replay_copies > 0) waypoint_lists = CandidateWaypoints(scene, graph, o);
+  for (const std::vector<Eigen::Isometry3d>& p : planned)
+    if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
+                     [&](const auto& w) { return SamePoses(w, p); }))
+      waypoint_lists.push_back(p);
+  std::vector<Motion> round =
+      RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o);
+  next_random += o.closing_motions;
+  std::vector<Motion> replays =
+      PerturbedReplays(scene, waypoint_lists, o, o.seed, next_replicate, o.replay_copies);
+  next_replicate += static_cast<int>(replays.size());
+  round.insert(round.end(), std::make_move_iterator(replays.begin()),
+               std::make_move_iterator(replays.end()));
+  return round;
+}
+
+}  // namespace
 
 double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& options) {
   return options.witness_force_N > 0.0 ? options.witness_force_N : 0.5 * scene.device.max_force_N;
@@ -1075,19 +1118,10 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();
     phase = "closing rounds";
-    std::vector<std::vector<Eigen::Isometry3d>> aims;
-    if (o.replay_copies > 0) aims = CandidateWaypoints(scene, graph, o);
-    for (const std::vector<Eigen::Isometry3d>& p : planned)
-      if (std::none_of(aims.begin(), aims.end(), [&](const auto& a) { return SamePoses(a, p); }))
-        aims.push_back(p);
     std::vector<Motion> round =
-        RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o);
-    next_random += o.closing_motions;
-    std::vector<Motion> replays =
-        PerturbedReplays(scene, aims, o, o.seed, next_replicate, o.replay_copies);
-    next_replicate += static_cast<int>(replays.size());
-    round.insert(round.end(), std::make_move_iterator(replays.begin()),
-                 std::make_move_iterator(replays.end()));
+        ClosingRound(scene, box, graph, planned, o, next_random, next_replicate);
+    // Nothing to run (no random motions, and no plan before the goal is reached): no round.
+    if (round.empty()) break;
     run(std::move(round), {});
     ++graph.closing_rounds;
     probe_new_nodes();

@@ -495,6 +495,9 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
     CHECK(one.nodes[i].ticks == two.nodes[i].ticks);
     CHECK(one.nodes[i].witness.tick == two.nodes[i].witness.tick);
     CHECK(one.nodes[i].energy_J == two.nodes[i].energy_J);
+    // The stays of least force choose what the closing rounds replay.
+    CHECK(one.nodes[i].least_force_N == two.nodes[i].least_force_N);
+    CHECK(one.nodes[i].X_WH_least.matrix() == two.nodes[i].X_WH_least.matrix());
   }
   for (std::size_t i = 0; i < one.arcs.size(); ++i) {
     CHECK(one.arcs[i].from == two.arcs[i].from);
@@ -503,6 +506,8 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
     CHECK(one.arcs[i].simultaneous == two.arcs[i].simultaneous);
   }
   CHECK(one.ticks == two.ticks);
+  for (std::size_t i = 0; i < one.motions.size() && i < two.motions.size(); ++i)
+    CHECK(one.motions[i].kind == two.motions[i].kind);
 }
 
 TEST_CASE("Closing rounds go on until one adds no state and no transition", "[graph][explore]") {
@@ -612,7 +617,8 @@ TEST_CASE("The graph's JSON keeps the moves of the motions its witnesses lie in"
   const ContactGraph& g = DefaultGraph(1);
   const nlohmann::json j =
       report::GraphToJson(g, s, "floor.yaml", graph::ExploreOptions{}, graph::PruneWeights{});
-  CHECK(j["tubeplan_graph"] == report::kGraphJsonVersion);
+  // The layout docs/graph.md describes.
+  CHECK(j["tubeplan_graph"] == 2);
   std::set<int> witnessed;
   for (const Node& n : g.nodes) witnessed.insert(n.witness.motion);
   for (const graph::Arc& a : g.arcs) witnessed.insert(a.witness.motion);

@@ -29,8 +29,10 @@ struct Node {
   double force_N = 0.0;           ///< operator force at the witness
   /// The least operator force of all its stays (each stay's middle tick): what reaching it takes.
   double min_force_N = std::numeric_limits<double>::infinity();
-  /// The hand and the held end at that stay's middle tick (meaningful once min_force_N is finite):
-  /// another witness of the same state, the one reached with the least push.
+  /// The least operator force of its settled stays (not the brief bridges of a refined change),
+  /// and the hand and the held end at that stay's middle tick: another witness of the same
+  /// state, the one reached with the least push (infinite, the poses unset: none).
+  double least_force_N = std::numeric_limits<double>::infinity();
   Eigen::Isometry3d X_W_hand_least = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d X_WH_least = Eigen::Isometry3d::Identity();
   /// Motion of the held end still needed to reach the goal: |p_H - p_H,goal| + (l/2) angle
