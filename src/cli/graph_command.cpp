@@ -1,5 +1,6 @@
 // `tubeplan graph SCENE [--dot FILE] [--json FILE] [--unpruned] [--seed N] [--random N]
-// [--closing N] [--jobs N] [--weights friction=1,energy=1,distance=1] [--tolerance T]`: explores
+// [--closing N] [--replays N] [--check N] [--jobs N] [--weights friction=1,energy=1,distance=1]
+// [--tolerance T]`: explores
 // the scene with the core, prunes the contact-state graph with the paper's heuristics and writes it
 // as DOT and JSON (schema in docs/graph.md). stdout: what was found, the saturation curve, the time
 // taken (report::PrintGraph).

@@ -68,9 +68,9 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--closing", o.closing,
-                  "once every state is probed, rounds of this many more random motions, each "
-                  "followed by probing what it found, until a round adds no state and no "
-                  "transition (0: none; docs/graph.md)")
+                  "once every state is probed, rounds of this many more random motions (and "
+                  "--replays), each followed by probing what it found, until a round adds no "
+                  "state and no transition (0: no random motions in them; docs/graph.md)")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
   sub->add_option("--replays", o.replays,

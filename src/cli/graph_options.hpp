@@ -33,7 +33,7 @@ struct GraphOptions {
   std::string weights;
   std::optional<double> tolerance;
   std::string verdicts_path;  // graph only: an evaluate report
-  int check = 0;              // graph only: independent random motions measuring completeness
+  int check = 0;  // graph only: independent random motions and replays measuring completeness
 };
 
 /// batch::BuildGraph with these options, progress shown on a terminal; on bad input the exit

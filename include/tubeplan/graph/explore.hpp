@@ -50,19 +50,20 @@ struct ExploreOptions {
   int closing_motions = 30;
   /// Each closing round also replays this many perturbed copies (0: none) of each candidate
   /// plan's trajectory, of the graph as the round starts and of the graph before the first round
-  /// (the one `plans` explores): the `replay_paths` cheapest start -> goal paths of the graph
-  /// pruned with `weights`, the hand aimed at the witnesses' hand poses and at their held end's
-  /// poses (CandidateWaypoints), moved as a whole by up to `replay_offset_m`, with 0.1 mm tremor
-  /// and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a plan meets is
-  /// then in the graph. None run before the goal is reached.
+  /// (the one `plans` explores with the same options): the `replay_paths` cheapest start -> goal
+  /// paths of the graph pruned with `weights`, the hand aimed at each distinct aim of
+  /// graph::Aim (CandidateWaypoints) at `speed_m_per_s`, moved as a whole by up to
+  /// `replay_offset_m`, with 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What
+  /// an operator following a plan meets is then in the graph. None run before the goal is
+  /// reached.
   int replay_copies = 4;
   int replay_paths = 3;
   double replay_offset_m = 0.004;
   /// The heuristics' weights of the candidate paths (nothing: the scene's).
   std::optional<PruneWeights> weights;
-  /// At most this many motions run, whatever happens (sweeps, aims, random and probe motions
-  /// together, in that order: a group is cut where the budget ends). A motion is one entry of
-  /// ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
+  /// At most this many motions run, whatever happens (sweeps, aims, random, replay and probe
+  /// motions together, in that order: a group is cut where the budget ends). A motion is one entry
+  /// of ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
   /// node's ten probes after its prefix). The graph says whether it saturated within it.
   int max_motions = 3000;
   /// Wall time bound [s] (0: none). Once passed, no motion starts and those under way stop
@@ -79,8 +80,9 @@ struct ExploreOptions {
   /// maximum force, 4.25 N for the PHANToM Premium), so every witness is a state an operator
   /// reaches well within the device (ExploreForceLimit).
   double witness_force_N = 0.0;
-  double speed_m_per_s = 0.08;  ///< hand speed of sweeps and aims (a calm human motion)
-  int substeps = 16;            ///< sub-ticks per tick when refining a multi-PC change
+  /// Hand speed of sweeps, aims and replays (a calm human motion; `plans`'s default).
+  double speed_m_per_s = 0.08;
+  int substeps = 16;  ///< sub-ticks per tick when refining a multi-PC change
   /// A CF counts once the core has kept it this long (the plan judge's dwell); briefer states
   /// are flicker, not nodes, unless they bridge a two-PC change.
   double dwell_s = 0.020;
@@ -115,7 +117,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& options,
 
 /// The hand's waypoints of the candidate plans of `graph` as `plans` makes them: for each of the
 /// `options.replay_paths` cheapest start -> goal paths of the graph pruned with
-/// `options.weights`, aimed at the witnesses' hand poses, then at their held end's poses. Empty
+/// `options.weights` (its explored states only), one list per distinct aim of graph::Aim. Empty
 /// when the graph has no goal or no path to it.
 std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
                                                                const ContactGraph& graph,
