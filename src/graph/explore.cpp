@@ -642,11 +642,10 @@ class Merger {
       const int i = NodeOf(s.cf);
       Node& n = graph_.nodes[std::size_t(i)];
       if (!s.refined) n.ticks += s.length;
-      n.min_force_N = std::min(n.min_force_N, s.sample.force_N);
-      // The settled stay of least force (a refined stay is a brief bridge, sampled at a tick the
-      // state did not last from), with its poses: another witness to aim at.
-      if (!s.refined && s.sample.force_N < n.least_force_N) {
-        n.least_force_N = s.sample.force_N;
+      // The stay of least force, with its poses: another witness to aim at (a brief bridge's
+      // too: every aim is replayed and judged, and one that does not hold the state is not kept).
+      if (s.sample.force_N < n.min_force_N) {
+        n.min_force_N = s.sample.force_N;
         n.X_W_hand_least = s.sample.X_W_hand;
         n.X_WH_least = s.sample.X_WH;
       }

@@ -139,7 +139,7 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
         waypoints.push_back(node.X_WH);
         break;
       case Aim::kLeastForce:
-        waypoints.push_back(std::isfinite(node.least_force_N) ? node.X_WH_least : node.X_WH);
+        waypoints.push_back(std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH);
         break;
     }
   }

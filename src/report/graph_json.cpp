@@ -55,11 +55,10 @@ nlohmann::json GraphToJson(const graph::ContactGraph& g, const scene::Scene& s,
     nlohmann::json w = Ref(n.witness, T);
     w["hand"] = Pose(n.X_W_hand);
     w["held"] = Pose(n.X_WH);
-    const nlohmann::json least = std::isfinite(n.least_force_N)
-                                     ? nlohmann::json{{"force_N", n.least_force_N},
-                                                      {"hand", Pose(n.X_W_hand_least)},
-                                                      {"held", Pose(n.X_WH_least)}}
-                                     : nlohmann::json(nullptr);
+    const nlohmann::json least =
+        std::isfinite(n.min_force_N)
+            ? nlohmann::json{{"hand", Pose(n.X_W_hand_least)}, {"held", Pose(n.X_WH_least)}}
+            : nlohmann::json(nullptr);
     nodes.push_back({{"cf", n.cf},
                      {"pcs", n.pcs},
                      {"start", n.start},

@@ -496,7 +496,7 @@ TEST_CASE("The default exploration saturates, the same from one thread and from 
     CHECK(one.nodes[i].witness.tick == two.nodes[i].witness.tick);
     CHECK(one.nodes[i].energy_J == two.nodes[i].energy_J);
     // The stays of least force choose what the closing rounds replay.
-    CHECK(one.nodes[i].least_force_N == two.nodes[i].least_force_N);
+    CHECK(one.nodes[i].min_force_N == two.nodes[i].min_force_N);
     CHECK(one.nodes[i].X_WH_least.matrix() == two.nodes[i].X_WH_least.matrix());
   }
   for (std::size_t i = 0; i < one.arcs.size(); ++i) {

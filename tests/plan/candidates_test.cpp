@@ -135,7 +135,7 @@ TEST_CASE("Candidates: a state's stay of least force is aimed at as another witn
   const double z = 0.00816, deep = z - 0.040;
   graph::ContactGraph g = LayFlatGraph(scene, deep, deep);
   const graph::ContactGraph flat = LayFlatGraph(scene, z, z);
-  g.nodes[1].least_force_N = 0.1;
+  g.nodes[1].min_force_N = 0.1;
   g.nodes[1].X_W_hand_least = flat.nodes[1].X_W_hand;
   g.nodes[1].X_WH_least = flat.nodes[1].X_WH;
   const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};

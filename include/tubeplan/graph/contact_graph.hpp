@@ -27,12 +27,11 @@ struct Node {
   double friction_N = 0.0;        ///< sum of |friction force| over the PCs at the witness
   double friction_limit_N = 0.0;  ///< sum of f_max over the PCs: the friction they can resist with
   double force_N = 0.0;           ///< operator force at the witness
-  /// The least operator force of all its stays (each stay's middle tick): what reaching it takes.
+  /// The least operator force of all its stays (each stay's middle tick, or a brief bridge's
+  /// sampled tick): what reaching it takes.
   double min_force_N = std::numeric_limits<double>::infinity();
-  /// The least operator force of its settled stays (not the brief bridges of a refined change),
-  /// and the hand and the held end at that stay's middle tick: another witness of the same
-  /// state, the one reached with the least push (infinite, the poses unset: none).
-  double least_force_N = std::numeric_limits<double>::infinity();
+  /// The hand and the held end at that stay: another witness of the same state, the one reached
+  /// with the least push (unset while min_force_N is infinite).
   Eigen::Isometry3d X_W_hand_least = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d X_WH_least = Eigen::Isometry3d::Identity();
   /// Motion of the held end still needed to reach the goal: |p_H - p_H,goal| + (l/2) angle

@@ -31,12 +31,12 @@ std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<do
 enum class Aim : unsigned char {
   kHand,        ///< the hand's pose at the state's witness
   kHeld,        ///< the held end's pose there (the hand no longer pulling the coupling out)
-  kLeastForce,  ///< the held end's pose at the state's settled stay of least operator force
+  kLeastForce,  ///< the held end's pose at the state's stay of least operator force
 };
 
 /// The hand's poses along a path: the scene's start, then one pose per later state as `aim`
-/// says (kLeastForce falls back to kHeld for a state with no settled stay). A candidate plan's
-/// trajectory goes through them.
+/// says (kLeastForce falls back to kHeld for a state with no stay of measured force). A candidate
+/// plan's trajectory goes through them.
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim);
 
