@@ -32,6 +32,22 @@ graph::ContactGraph LayFlatGraph(const scene::Scene& scene, double hand_z_m, dou
   return g;
 }
 
+// The candidates of `paths` at 80 mm/s with the judge's 20 ms dwell, each try replayed as it is
+// (counted in `replays`).
+std::vector<plan::Candidate> CountedCandidates(const scene::Scene& scene,
+                                               const graph::ContactGraph& g,
+                                               const std::vector<graph::Path>& paths,
+                                               int& replays) {
+  plan::CandidateOptions options;
+  options.synthesis.peak_speed_m_per_s = 0.08;
+  options.dwell_s = 0.02;
+  options.scene_ref = "groove.yaml";
+  return plan::MakeCandidates(scene, g, paths, options, [&](const trajectories::Trajectory& t) {
+    ++replays;
+    return std::optional<trajectories::Trajectory>(t);
+  });
+}
+
 }  // namespace
 
 TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
@@ -48,16 +64,8 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   g.nodes.push_back(LayFlatGraph(scene, deep, z).nodes[1]);
   g.nodes.push_back(LayFlatGraph(scene, deep, deep).nodes[1]);
   const std::vector<graph::Path> paths = {{{0, 3}, 1.0}, {{0, 2}, 1.5}, {{0, 1}, 2.0}};
-  plan::CandidateOptions options;
-  options.synthesis.peak_speed_m_per_s = 0.08;
-  options.dwell_s = 0.02;
-  options.scene_ref = "groove.yaml";
   int replays = 0;
-  const std::vector<plan::Candidate> c =
-      plan::MakeCandidates(scene, g, paths, options, [&](const trajectories::Trajectory& t) {
-        ++replays;
-        return std::optional<trajectories::Trajectory>(t);
-      });
+  const std::vector<plan::Candidate> c = CountedCandidates(scene, g, paths, replays);
   REQUIRE(c.size() == 3);
   // The stretched witness fails aimed at the hand's pose and replays feasible aimed at the held
   // end's, at the asked speed; the feasible come first in the paths' order.
@@ -139,16 +147,8 @@ TEST_CASE("Candidates: a state's stay of least force is aimed at as another witn
   g.nodes[1].X_W_hand_least = flat.nodes[1].X_W_hand;
   g.nodes[1].X_WH_least = flat.nodes[1].X_WH;
   const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
-  plan::CandidateOptions options;
-  options.synthesis.peak_speed_m_per_s = 0.08;
-  options.dwell_s = 0.02;
-  options.scene_ref = "groove.yaml";
   int replays = 0;
-  const std::vector<plan::Candidate> c =
-      plan::MakeCandidates(scene, g, paths, options, [&](const trajectories::Trajectory& t) {
-        ++replays;
-        return std::optional<trajectories::Trajectory>(t);
-      });
+  const std::vector<plan::Candidate> c = CountedCandidates(scene, g, paths, replays);
   REQUIRE(c.size() == 1);
   // The hand's and the held end's poses coincide (one try); the stay of least force is the
   // second, and replays feasible at the asked speed, well within the device.
