@@ -930,12 +930,10 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   Prune(marked, weights);
   std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
   for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
-    for (const Aim aim : {Aim::kHand, Aim::kHeld, Aim::kLeastForce}) {
-      std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, marked, path, aim);
+    for (auto& [aim, w] : DistinctAims(scene, marked, path))
       if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
                        [&](const auto& a) { return SamePoses(a, w); }))
         waypoint_lists.push_back(std::move(w));
-    }
   return waypoint_lists;
 }
 

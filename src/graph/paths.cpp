@@ -3,6 +3,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <utility>
 
 #include <boost/graph/adjacency_list.hpp>
 #include <boost/graph/dijkstra_shortest_paths.hpp>
@@ -144,6 +145,19 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
     }
   }
   return waypoints;
+}
+
+std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(const scene::Scene& scene,
+                                                                         const ContactGraph& graph,
+                                                                         const Path& path) {
+  std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> aims;
+  for (const Aim aim : {Aim::kHand, Aim::kHeld, Aim::kLeastForce}) {
+    std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, graph, path, aim);
+    if (std::none_of(aims.begin(), aims.end(),
+                     [&](const auto& a) { return SamePoses(a.second, w); }))
+      aims.emplace_back(aim, std::move(w));
+  }
+  return aims;
 }
 
 bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b) {

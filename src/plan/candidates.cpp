@@ -25,13 +25,7 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     // out), the feasible one of least peak force kept (else the last tried).
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    std::vector<std::pair<graph::Aim, std::vector<Eigen::Isometry3d>>> aims;
-    for (const graph::Aim aim : {graph::Aim::kHand, graph::Aim::kHeld, graph::Aim::kLeastForce}) {
-      std::vector<Eigen::Isometry3d> w = graph::PathWaypoints(scene, graph, *c.path, aim);
-      if (std::none_of(aims.begin(), aims.end(),
-                       [&](const auto& a) { return graph::SamePoses(a.second, w); }))
-        aims.emplace_back(aim, std::move(w));
-    }
+    const auto aims = graph::DistinctAims(scene, graph, *c.path);
     int tried = 0;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =

@@ -5,6 +5,7 @@
 // and the heuristics order plans of the same length.
 
 #include <span>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -39,6 +40,12 @@ enum class Aim : unsigned char {
 /// plan's trajectory goes through them.
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim);
+
+/// The path's waypoints for each aim, in the order of Aim, each distinct list once (an aim whose
+/// poses equal an earlier one's is left out): what a candidate plan tries.
+std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(const scene::Scene& scene,
+                                                                         const ContactGraph& graph,
+                                                                         const Path& path);
 
 /// Whether two lists of poses are the same, bit for bit (two aims that coincide).
 bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b);
