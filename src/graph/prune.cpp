@@ -31,13 +31,15 @@ Scales ScalesOf(const ContactGraph& graph) {
   return s;
 }
 
-// Transitions from each node to the goal in the unpruned graph (breadth-first search from the
-// goal over reversed arcs); -1 where there is no path.
-std::vector<int> HopsToGoal(const ContactGraph& graph) {
+// Transitions from each node to the goal (breadth-first search from the goal over reversed
+// arcs), along every arc or along the kept ones only; -1 where there is no path.
+enum class Along { kEveryArc, kKeptArcs };
+std::vector<int> HopsToGoal(const ContactGraph& graph, Along along) {
   using G = boost::adjacency_list<boost::vecS, boost::vecS, boost::bidirectionalS>;
   G g(graph.nodes.size());
   for (const Arc& a : graph.arcs)
-    if (a.from != a.to) boost::add_edge(std::size_t(a.from), std::size_t(a.to), g);
+    if (a.from != a.to && (along == Along::kEveryArc || a.kept))
+      boost::add_edge(std::size_t(a.from), std::size_t(a.to), g);
   std::vector<int> hops(graph.nodes.size(), -1);
   if (graph.goal < 0) return hops;
   hops[std::size_t(graph.goal)] = 0;
@@ -53,6 +55,22 @@ std::vector<int> HopsToGoal(const ContactGraph& graph) {
   recorder.hops = &hops;
   boost::breadth_first_search(reversed, std::size_t(graph.goal), boost::visitor(recorder));
   return hops;
+}
+
+// Each heuristic decides at one node, and together they can cut every way to the goal (arcs
+// nearer by distance lead into a part of the graph whose kept arcs lead back). A node with a way
+// to the goal but none along the kept arcs keeps back its arcs one transition nearer the goal
+// (none back into the start): by induction on the transitions left, the start then reaches the
+// goal along kept arcs whenever it does at all.
+void KeepAWayToTheGoal(ContactGraph& graph, const std::vector<int>& hops) {
+  const std::vector<int> kept_hops = HopsToGoal(graph, Along::kKeptArcs);
+  for (Arc& a : graph.arcs) {
+    const int hu = hops[std::size_t(a.from)], hv = hops[std::size_t(a.to)];
+    if (a.kept || a.from == graph.goal || a.to == graph.start) continue;
+    if (hu < 0 || kept_hops[std::size_t(a.from)] >= 0 || hv != hu - 1) continue;
+    a.kept = true;
+    a.reason.clear();
+  }
 }
 
 // "a <= b unit", three significant digits.
@@ -80,7 +98,7 @@ double ArcScore(const ContactGraph& graph, const Arc& arc, const PruneWeights& w
 }
 
 void Prune(ContactGraph& graph, const PruneWeights& weights) {
-  const std::vector<int> hops = HopsToGoal(graph);
+  const std::vector<int> hops = HopsToGoal(graph, Along::kEveryArc);
   auto distance = [&](int node) { return graph.nodes[std::size_t(node)].distance_m; };
   // Towards the goal: nearer to it by distance (the paper's distance heuristic). A node none of
   // whose arcs gets nearer keeps those that are one transition nearer, so it is no dead end.
@@ -165,6 +183,7 @@ void Prune(ContactGraph& graph, const PruneWeights& weights) {
       a.reason = reasons[i] + buffer + graph.nodes[std::size_t(graph.arcs[best_arc].to)].cf + ")";
     }
   }
+  if (graph.goal >= 0) KeepAWayToTheGoal(graph, hops);
 }
 
 }  // namespace tubeplan::graph

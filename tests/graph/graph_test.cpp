@@ -141,6 +141,56 @@ TEST_CASE("Pruning a hand-made graph keeps the undominated arcs towards the goal
         std::string::npos);
 }
 
+TEST_CASE("Pruning keeps a way from the start to the goal where the heuristics cut them all",
+          "[graph]") {
+  // A's one arc nearer by distance leads to B, whose one way on is C, whose arc nearer by
+  // distance leads back to B: each heuristic, at its node, cuts the ways on (A -> X and
+  // C -> D, further by distance), and the kept arcs would circle between B and C.
+  ContactGraph g;
+  auto node = [&](const char* cf, double distance) {
+    Node n;
+    n.cf = cf;
+    n.distance_m = distance;
+    g.nodes.push_back(n);
+    return static_cast<int>(g.nodes.size()) - 1;
+  };
+  const int a = node("{}", 0.10), b = node("{Ee - floor.top}", 0.05);
+  const int c = node("{Ee ~ floor.top}", 0.30), d = node("{Fe - floor.top}", 0.40);
+  const int x = node("{Fs - left.inner}", 0.15), goal = node("{Fs - floor.top}", 0.0);
+  g.start = a, g.goal = goal;
+  for (auto [from, to] : std::array<std::pair<int, int>, 7>{
+           {{a, b}, {a, x}, {x, goal}, {b, c}, {c, b}, {c, d}, {d, goal}}}) {
+    Arc arc;
+    arc.from = from, arc.to = to, arc.count = 1;
+    g.arcs.push_back(arc);
+  }
+  graph::Prune(g, graph::PruneWeights{});
+  auto kept = [&](int from, int to) {
+    for (const Arc& arc : g.arcs)
+      if (arc.from == from && arc.to == to) return arc.kept;
+    FAIL("no such arc");
+    return false;
+  };
+  // What each heuristic keeps stays kept.
+  CHECK(kept(a, b));
+  CHECK(kept(b, c));
+  CHECK(kept(c, b));
+  // A and C had a way to the goal but none along the kept arcs: their arcs one transition nearer
+  // the goal are kept back.
+  CHECK(kept(a, x));
+  CHECK(kept(c, d));
+  // The goal is reached from the start along kept arcs.
+  std::vector<bool> reached(g.nodes.size(), false);
+  reached[std::size_t(a)] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (const Arc& arc : g.arcs)
+      if (arc.kept && reached[std::size_t(arc.from)] && !reached[std::size_t(arc.to)])
+        reached[std::size_t(arc.to)] = grew = true;
+  }
+  CHECK(reached[std::size_t(goal)]);
+}
+
 // Runs a command, returns its exit status and its standard error.
 int Run(const std::string& command, std::string& err) {
   const std::string err_file = "graph_test_stderr.txt";

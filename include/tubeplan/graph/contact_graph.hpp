@@ -116,7 +116,10 @@ struct PruneWeights {
 ///     change, distance of w to the goal), lower being better on each, or its weighted score
 ///     w_f f/f* + w_e dE/E* + w_d d/d*  is within `tolerance` of the best such arc's.
 /// Arcs out of the goal ("leaves the goal") and back into the start ("returns to the start") are
-/// dropped. Without a goal every arc is dropped.
+/// dropped. Then a node with a way to the goal in the unpruned graph but none along the kept arcs
+/// (1 and 2 decide at each node alone, and together can leave the kept arcs circling) keeps back
+/// its arcs one transition nearer the goal: the start reaches the goal along kept arcs whenever
+/// it does at all. Without a goal every arc is dropped.
 void Prune(ContactGraph& graph, const PruneWeights& weights);
 
 /// The weighted score of an arc (criterion 3 above) under `weights`.
