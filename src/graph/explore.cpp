@@ -930,10 +930,10 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   Prune(marked, weights);
   std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
   for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
-    for (auto& [aim, w] : DistinctAims(scene, marked, path))
+    for (auto& aimed : DistinctAims(scene, marked, path))
       if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
-                       [&](const auto& a) { return SamePoses(a, w); }))
-        waypoint_lists.push_back(std::move(w));
+                       [&](const auto& a) { return SamePoses(a, aimed.second); }))
+        waypoint_lists.push_back(std::move(aimed.second));
   return waypoint_lists;
 }
 
