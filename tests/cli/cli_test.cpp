@@ -549,7 +549,7 @@ TEST_CASE("check: a broken scene is exit code 2 with file:line:col diagnostics",
   CHECK(doc["files"][0]["diagnostics"].size() == static_cast<std::size_t>(count));
 }
 
-TEST_CASE("bench prints one finite figure set per scenario", "[cli][bench]") {
+TEST_CASE("bench prints one finite figure set per scenario", "[cli][bench-report]") {
   // Only the shape of the report is tested: speed is measured by running `tubeplan bench`,
   // never asserted in a test.
   const Outcome r =
