@@ -60,8 +60,9 @@ std::vector<int> HopsToGoal(const ContactGraph& graph, Along along) {
 // Each heuristic decides at one node, and together they can cut every way to the goal (arcs
 // nearer by distance lead into a part of the graph whose kept arcs lead back). A node with a way
 // to the goal but none along the kept arcs keeps back its arcs one transition nearer the goal
-// (none back into the start): by induction on the transitions left, the start then reaches the
-// goal along kept arcs whenever it does at all.
+// (none back into the start, which no shortest way from the start needs: its nodes are all
+// nearer than the start): by induction on the transitions left, the start then reaches the goal
+// along kept arcs whenever it does at all.
 void KeepAWayToTheGoal(ContactGraph& graph, const std::vector<int>& hops) {
   const std::vector<int> kept_hops = HopsToGoal(graph, Along::kKeptArcs);
   for (Arc& a : graph.arcs) {

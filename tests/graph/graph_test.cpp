@@ -157,9 +157,11 @@ TEST_CASE("Pruning keeps a way from the start to the goal where the heuristics c
   const int a = node("{}", 0.10), b = node("{Ee - floor.top}", 0.05);
   const int c = node("{Ee ~ floor.top}", 0.30), d = node("{Fe - floor.top}", 0.40);
   const int x = node("{Fs - left.inner}", 0.15), goal = node("{Fs - floor.top}", 0.0);
+  // Z's one way to the goal is back through the start.
+  const int z = node("{Fs - right.inner}", 0.50);
   g.start = a, g.goal = goal;
-  for (auto [from, to] : std::array<std::pair<int, int>, 7>{
-           {{a, b}, {a, x}, {x, goal}, {b, c}, {c, b}, {c, d}, {d, goal}}}) {
+  for (auto [from, to] : std::array<std::pair<int, int>, 8>{
+           {{a, b}, {a, x}, {x, goal}, {b, c}, {c, b}, {c, d}, {d, goal}, {z, a}}}) {
     Arc arc;
     arc.from = from, arc.to = to, arc.count = 1;
     g.arcs.push_back(arc);
@@ -179,6 +181,8 @@ TEST_CASE("Pruning keeps a way from the start to the goal where the heuristics c
   // the goal are kept back.
   CHECK(kept(a, x));
   CHECK(kept(c, d));
+  // None back into the start.
+  CHECK_FALSE(kept(z, a));
   // The goal is reached from the start along kept arcs.
   std::vector<bool> reached(g.nodes.size(), false);
   reached[std::size_t(a)] = true;
@@ -565,8 +569,8 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
 
 TEST_CASE("The floor's default exploration: saturated and closed alike on one thread or two",
           "[graph][explore]") {
-  // One exploration per thread count, shared by the sections (a process each would explore
-  // it again: about a minute each).
+  // One exploration per thread count, shared by the sections (as test cases of their own, each
+  // in its own process, they explored it six times).
   SECTION("The default exploration saturates, the same from one thread and from two") {
     const ContactGraph& one = DefaultGraph(1);
     const ContactGraph& two = DefaultGraph(2);
