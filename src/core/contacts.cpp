@@ -48,6 +48,18 @@ double SmoothStep(double a) {
   return a * a * (3.0 - 2.0 * a);
 }
 
+// A lower bound on the distance from segment [p0, p1] to the edge: the edge lies in its faces'
+// planes, so no point is nearer the edge than it is to either plane, and a segment wholly on one
+// side of a plane is no nearer than its nearer end. 0 for a round side's axis (it has no faces).
+double FacePlaneBound(const PartEdge& edge, const Vec3& p0, const Vec3& p1) {
+  double bound = 0.0;
+  for (const Vec3& n : edge.face_normals_W) {
+    const double d0 = (p0 - edge.a_W).dot(n), d1 = (p1 - edge.a_W).dot(n);
+    if (d0 * d1 > 0.0) bound = std::max(bound, std::min(std::abs(d0), std::abs(d1)));
+  }
+  return bound;
+}
+
 // How far point c lies in front of both the edge's face planes (where the edge is the part's
 // nearest feature): 1 there, fading to 0 over ramp_m behind either plane; and its gradient.
 double InFrontOfFaces(const PartEdge& edge, const Vec3& c, double ramp_m, Vec3& gradient) {
@@ -425,7 +437,7 @@ class Finder {
     FindNearestRidges(part, a + theta_lo * v, a + theta_hi * v);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if (!Bears(edge, e)) continue;
+      if (!Bears(edge, e) || FacePlaneBound(edge, a, b) - r1 - edge.radius_m >= eps) continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(a, b, edge.a_W, edge.b_W, theta, u);
       if ((u == 0.0 && !edge.a_bears) || (u == 1.0 && !edge.b_bears)) continue;
@@ -514,7 +526,10 @@ class Finder {
     FindNearestRidges(part, m0, m1);
     for (const int e : EdgesNear()) {
       const PartEdge& edge = edges[std::size_t(e)];
-      if (!Bears(edge, e)) continue;
+      // Most edges whose boxes meet the piece's lie beyond reach: the face planes' bound leaves
+      // them out before the segments' closest points are sought.
+      if (!Bears(edge, e) || FacePlaneBound(edge, m0, m1) - bulge >= r1 + edge.radius_m + eps)
+        continue;
       double theta = 0.0, u = 0.0;
       ClosestSegmentPoints(m0, m1, edge.a_W, edge.b_W, theta, u);
       const Vec3 ab = edge.b_W - edge.a_W;
