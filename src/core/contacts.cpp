@@ -158,11 +158,16 @@ class Finder {
 
  private:
   // The part's edges whose boxes meet the box lo..hi of a piece of the tube, in order: the only
-  // ones Side and Curve can find near it.
+  // ones Side and Curve can find near it. (The tree's leaves hold several edges: each edge's own
+  // box is tested too.)
   void FindEdgesNear(const PartModel& part, const Vec3& lo, const Vec3& hi) {
     edge_count_ = 0;
-    part.geometry.EdgesOverlapping(
-        lo, hi, [&](int e) { d_.scratch.edges_near[std::size_t(edge_count_++)] = e; });
+    const auto& edges = part.geometry.edges();
+    part.geometry.EdgesOverlapping(lo, hi, [&](int e) {
+      const PartEdge& edge = edges[std::size_t(e)];
+      if ((edge.min_W.array() <= hi.array()).all() && (edge.max_W.array() >= lo.array()).all())
+        d_.scratch.edges_near[std::size_t(edge_count_++)] = e;
+    });
     std::sort(d_.scratch.edges_near.begin(), d_.scratch.edges_near.begin() + edge_count_);
   }
 
