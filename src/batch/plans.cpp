@@ -3,6 +3,7 @@
 
 #include <tubeplan/batch/plans.hpp>
 #include <tubeplan/graph/motion.hpp>
+#include <tubeplan/graph/summary.hpp>
 #include <tubeplan/io/plan_file.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/states/contact_formation.hpp>
@@ -86,9 +87,11 @@ PlansEnd MakePlans(const PlansRequest& request, const scene::Scene& scene,
     return PlansEnd::kNothingToPlan;
   }
   if (graph.goal < 0) {
+    const std::string near = graph::NearGoalText(graph, scene.goal, 4);
     err << request.scene_path << ": error: exploration never reached the goal "
         << states::ToString(scene.goal) << ", so there is no plan to extract; expected a "
-        << "goal the tube can reach (try a larger --budget)\n";
+        << "goal the tube can reach (try a larger --budget"
+        << (near.empty() ? "" : ", or one of the nearest states reached: " + near) << ")\n";
     return PlansEnd::kGoalNotReached;
   }
   plans.paths = graph::KShortestPaths(graph, graph::ArcCosts(graph, weights), request.k);

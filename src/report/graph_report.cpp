@@ -69,6 +69,8 @@ void PrintReach(std::ostream& t, const graph::ContactGraph& g, const scene::Scen
     << (g.start >= 0 ? g.nodes[std::size_t(g.start)].cf : "not reached (no motion ended)")
     << "; goal " << states::ToString(scene.goal)
     << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
+  const std::string near = g.goal < 0 ? graph::NearGoalText(g, scene.goal, 4) : "";
+  if (!near.empty()) t << "  nearest states reached (least operator force): " << near << "\n";
   t << "part elements touched: " << g.reached_elements.size()
     << "; never touched: " << g.unreached_elements.size();
   for (std::size_t i = 0; i < g.unreached_elements.size() && i < 8; ++i)

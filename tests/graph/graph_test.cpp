@@ -17,6 +17,7 @@
 #include <tubeplan/graph/completeness.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/summary.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/report/graph_json.hpp>
@@ -139,6 +140,30 @@ TEST_CASE("Pruning a hand-made graph keeps the undominated arcs towards the goal
   CHECK(arc(0, 3).kept);
   CHECK(arc(0, 2).reason.find("score 4.300 > best 1.250 + tolerance (-> {Fe - floor.top})") !=
         std::string::npos);
+}
+
+TEST_CASE("An unreached goal's nearest states: its contacts under other markers first", "[graph]") {
+  ContactGraph g;
+  auto node = [&](const char* cf, double least_force) {
+    Node n;
+    n.cf = cf;
+    n.min_force_N = least_force;
+    g.nodes.push_back(n);
+  };
+  node("{}", 0.0);
+  node("{Fs n post.side, Fs ~ table.top}", 0.5);
+  node("{Fs ~ table.top}", 0.1);
+  node("{Ee ~ table.top, Fs n post.side}", 0.2);  // the table under the rim, not the side
+  node("{Fs u post.side, Fs n table.top}", 0.3);
+  // The same elements under other markers, by least force; the rim's state is not among them.
+  const std::vector<int> near = graph::NearGoal(g, Cf("{Fs - post.side, Fs - table.top}"), 4);
+  CHECK(near == std::vector<int>{4, 1});
+  CHECK(graph::NearGoal(g, Cf("{Fs - post.side, Fs - table.top}"), 1) == std::vector<int>{4});
+  // No state with the goal's contacts: those touching all its part elements.
+  CHECK(graph::NearGoal(g, Cf("{Fe - table.top, Fs - post.side}"), 4) == std::vector<int>{3, 4, 1});
+  CHECK(graph::NearGoal(g, Cf("{Fs - shelf.top}"), 4).empty());
+  CHECK(graph::NearGoalText(g, Cf("{Fs - post.side, Fs - table.top}"), 4) ==
+        "{Fs u post.side, Fs n table.top} (0.3 N), {Fs n post.side, Fs ~ table.top} (0.5 N)");
 }
 
 TEST_CASE("Pruning keeps a way from the start to the goal where the heuristics cut them all",
