@@ -485,12 +485,20 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
     t.normalize();
     struct Approach {
       Eigen::Vector3d axis, hand, push, slide;
+      bool along_axis = false;  // the last stretch of the approach along the tube's axis
     };
     std::vector<Approach> tip_aims, side_aims;
-    for (double phi_deg : {30.0, 60.0, 80.0}) {  // the tip, its axis leaning off the normal
+    // The tip, its axis leaning off the normal; where no leaning pose is free on an element of
+    // the goal (the floor of a hole to insert into), straight along the normal, end first,
+    // coming in along its axis.
+    const bool in_goal = std::any_of(
+        scene.goal.contacts.begin(), scene.goal.contacts.end(),
+        [&](const states::PrincipalContact& pc) { return pc.part_element == element.name; });
+    for (double phi_deg : {30.0, 60.0, 80.0, 0.0}) {
+      if (phi_deg == 0.0 && !in_goal) continue;
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
       const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
-      tip_aims.push_back({a, tip - l * a, a, t});
+      tip_aims.push_back({a, tip - l * a, a, t, phi_deg == 0.0});
     }
     for (const Eigen::Vector3d& a : {t, n_W.cross(t).normalized()}) {  // the side, along it
       const Eigen::Vector3d mid = c_W + (gap + r) * n_W;
@@ -505,14 +513,24 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         if (!InWorkspace(scene, aim.hand) || !FreePose(probe, X)) continue;
         Motion m;
         m.kind = "aim " + element.name;
-        // Over the target at a safe height, down onto it, press, slide, back off.
-        Eigen::Vector3d above = aim.hand;
-        above.z() = std::max(f.p0.z(), aim.hand.z());
+        // Over the target at a safe height, down onto it (straight in: down to half a tube
+        // length back along the axis, then along it), press, slide, back off.
+        Eigen::Vector3d entry = aim.hand;
+        if (aim.along_axis) {
+          Eigen::Isometry3d X_entry = X;
+          X_entry.translation() = aim.hand - 0.5 * l * aim.axis;
+          if (InWorkspace(scene, X_entry.translation()) && FreePose(probe, X_entry))
+            entry = X_entry.translation();
+        }
+        Eigen::Vector3d above = entry;
+        above.z() = std::max(f.p0.z(), entry.z());
         Eigen::Vector3d lift = f.p0;
         lift.z() = above.z();
         m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
         m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
-        m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+        if (entry != aim.hand)
+          m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+        m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, entry));
         // Onto the surface, stopped by the first light push (the element touched, the tube not
         // yet bent by it) and held where it stopped, then pressed, slid and backed off, each
         // from where the last move stopped.
