@@ -171,7 +171,8 @@ void BuildModel(const scene::Scene& scene, Model& m, std::vector<scene::PartElem
   // A tick's Newton iterations at most, over its friction passes: a snap through spreads over
   // ticks (each moving every point at most this many step caps) instead of stalling one.
   m.solver.max_iterations = 24;
-  m.solver.tolerance_N = 1e-5;
+  // A tenth of what a haptic device resolves (docs/core.md, "Convergence").
+  m.solver.tolerance_N = 1e-4;
 }
 
 Core::Core(const scene::Scene& scene) : scene_(scene), model_(std::make_unique<Model>()) {
