@@ -135,11 +135,33 @@ double BendingEnergyOf(const Model& model, const Data& data, std::span<const Vec
 
 namespace {
 
+// How many softness widths a point takes to join a smooth minimum (AddRim, AddSideGroup).
+constexpr double kEaseInWidths = 10.0;
+
+// A point joins its contact's smooth minimum gradually: its weight there is eased in from 0 where
+// it is first recorded (distance epsilon) to 1 at kEaseInWidths softness widths inside, so that
+// the contact's distance does not jump when a point joins it. The factor s, and the slope of the
+// distance it adds, -tau log s, per metre of the point's distance.
+struct EaseIn {
+  double factor = 1.0;
+  double slope = 0.0;
+};
+
+EaseIn EaseInOf(double distance_m, double eps, double tau) {
+  const double band = kEaseInWidths * tau;
+  const double x = (eps - distance_m) / band;
+  if (x >= 1.0) return {};
+  if (!(x > 0.0)) return {0.0, 0.0};
+  const double factor = x * x * (3.0 - 2.0 * x);
+  return {factor, tau * 6.0 * x * (1.0 - x) / (factor * band)};
+}
+
 // The rim's points on one part, samples [first, end): one contact whose distance is the smooth
-// minimum d = -tau log sum exp(-d_j / tau) of theirs, with the paper's K (eps - d)+ shared by
-// the softmin's weights. Tilted, the nearest point takes it all (a point contact, K); flat, the
-// points share it evenly (the whole end face, K), and the end resists tilting as a rigid flat
-// end does, up to the moment that puts the whole force on its rim (docs/core.md).
+// minimum d = -tau log sum exp(-d_j / tau) of theirs (each eased in as it joins: EaseInOf), with
+// the paper's K (eps - d)+ shared by the softmin's weights. Tilted, the nearest point takes it all
+// (a point contact, K); flat, the points share it evenly (the whole end face, K), and the end
+// resists tilting as a rigid flat end does, up to the moment that puts the whole force on its rim
+// (docs/core.md).
 double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int first, int end,
               Assembler& a) {
   const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
@@ -150,16 +172,21 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   for (int j = 1; j < count; ++j) d_min = std::min(d_min, s[j].distance_m);
   double sum = 0.0;
   std::array<double, kRimSamples> w{};
-  for (int j = 0; j < count; ++j)
-    sum += (w[std::size_t(j)] = std::exp(-(s[j].distance_m - d_min) / tau));
-  for (int j = 0; j < count; ++j) w[std::size_t(j)] /= sum;
-  const double d = d_min - tau * std::log(sum);
+  std::array<EaseIn, kRimSamples> ease{};
+  for (int j = 0; j < count; ++j) {
+    ease[std::size_t(j)] = EaseInOf(s[j].distance_m, eps, tau);
+    sum += (w[std::size_t(j)] =
+                ease[std::size_t(j)].factor * std::exp(-(s[j].distance_m - d_min) / tau));
+  }
+  // Every point just joining: no contact yet.
+  const double d = sum > 0.0 ? d_min - tau * std::log(sum) : eps;
   for (int j = 0; j < count; ++j) s[j].contact_distance_m = d;
   const double depth = eps - d;
   if (!(depth > 0.0)) {
     for (int j = 0; j < count; ++j) s[j].normal_force_N = 0.0;
     return 0.0;
   }
+  for (int j = 0; j < count; ++j) w[std::size_t(j)] /= sum;
   const double force = K * depth;
   for (int j = 0; j < count; ++j) s[j].normal_force_N = force * w[std::size_t(j)];
   if (a.gradient()) {
@@ -168,9 +195,11 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
     Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
     Eigen::Matrix<double, 6, 6> spread = Eigen::Matrix<double, 6, 6>::Zero();
     for (int j = 0; j < count; ++j) {
+      if (!(w[std::size_t(j)] > 0.0)) continue;
       const MaterialPoint mp =
           Material(Carrier::kEndNode, x_W, s[j].node, 0.0, s[j].moving_offset_W);
-      const Eigen::Matrix<double, 6, 1> g = mp.jacobian.leftCols<6>().transpose() * s[j].normal_W;
+      const Eigen::Matrix<double, 6, 1> g = (1.0 + ease[std::size_t(j)].slope) *
+                                            (mp.jacobian.leftCols<6>().transpose() * s[j].normal_W);
       mean += w[std::size_t(j)] * g;
       spread += w[std::size_t(j)] * g * g.transpose();
     }
@@ -195,7 +224,8 @@ struct SectionStencil {
   Eigen::Matrix<double, 9, 9> curvature = Eigen::Matrix<double, 9, 9>::Zero();
 };
 
-SectionStencil StencilOf(const Sample& smp, std::span<const Vec3> x_W, double eps, bool curvature) {
+SectionStencil StencilOf(const Sample& smp, std::span<const Vec3> x_W, double eps, bool curvature,
+                         double ease_slope) {
   const MaterialPoint mp =
       Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
   SectionStencil st;
@@ -205,7 +235,8 @@ SectionStencil StencilOf(const Sample& smp, std::span<const Vec3> x_W, double ep
                     : mp.first + mp.nodes) -
              st.first;
   const int d0 = 3 * (mp.first - st.first);
-  st.gradient.segment(d0, 9 - d0) = (mp.jacobian.transpose() * smp.normal_W).head(9 - d0);
+  st.gradient.segment(d0, 9 - d0) =
+      (1.0 + ease_slope) * (mp.jacobian.transpose() * smp.normal_W).head(9 - d0);
   if (fades) {
     const int w0 = 3 * (smp.weight_first - st.first);
     st.gradient.segment(w0, 9 - w0) -= eps * smp.weight_gradient.head(9 - w0);
@@ -214,7 +245,8 @@ SectionStencil StencilOf(const Sample& smp, std::span<const Vec3> x_W, double ep
   if (!curvature || smp.curvature_per_m.isZero(0.0)) return st;
   const Eigen::Matrix<double, 3, 9> CJ = smp.curvature_per_m * mp.jacobian;
   const Eigen::Matrix<double, 9, 9> JCJ = mp.jacobian.transpose().lazyProduct(CJ);
-  st.curvature.block(d0, d0, 9 - d0, 9 - d0) = JCJ.topLeftCorner(9 - d0, 9 - d0);
+  st.curvature.block(d0, d0, 9 - d0, 9 - d0) =
+      (1.0 + ease_slope) * JCJ.topLeftCorner(9 - d0, 9 - d0);
   return st;
 }
 
@@ -256,9 +288,10 @@ void GroupSideSections(Scratch& s) {
 
 // The side's sections on one part element press as one contact, as the rim's points do: its
 // distance is the smooth minimum d = -tau log sum exp(-d_j / tau) of theirs, where a section
-// whose share w_j fades is taken (1 - w_j) epsilon farther off, and the paper's K (eps - d)+ is
-// shared by the softmin's weights. A side lying along a face is then one contact of stiffness K
-// however many sections bear on it, and a curved side presses with its nearest section.
+// whose share w_j fades is taken (1 - w_j) epsilon farther off and one joining is eased in
+// (EaseInOf), and the paper's K (eps - d)+ is shared by the softmin's weights. A side lying along
+// a face is then one contact of stiffness K however many sections bear on it, and a curved side
+// presses with its nearest section.
 // Its Hessian K m m^T + (F / tau) (sum s_j g_j g_j^T - m m^T) - F sum s_j C_j (m the weighted
 // mean of the distances' gradients g_j, C_j their curvatures) goes into the band where m fits
 // in it, and as a band part and a rank-one term c m m^T otherwise (SolveEquilibrium).
@@ -275,15 +308,19 @@ double AddSideGroup(const Model& model, Data& data, std::span<const Vec3> x_W, c
   };
   double d_min = distance(member(0));
   for (int j = 1; j < g.count; ++j) d_min = std::min(d_min, distance(member(j)));
+  const auto share = [&](const Sample& smp) {
+    return EaseInOf(smp.distance_m, eps, tau).factor * std::exp(-(distance(smp) - d_min) / tau);
+  };
   double sum = 0.0;
-  for (int j = 0; j < g.count; ++j) sum += std::exp(-(distance(member(j)) - d_min) / tau);
-  const double d = d_min - tau * std::log(sum);
+  for (int j = 0; j < g.count; ++j) sum += share(member(j));
+  // Every section just joining: no contact yet.
+  const double d = sum > 0.0 ? d_min - tau * std::log(sum) : eps;
   const double depth = eps - d;
   const double force = depth > 0.0 ? K * depth : 0.0;
   for (int j = 0; j < g.count; ++j) {
     Sample& smp = member(j);
     smp.contact_distance_m = d;
-    smp.normal_force_N = force * std::exp(-(distance(smp) - d_min) / tau) / sum;
+    smp.normal_force_N = force > 0.0 ? force * share(smp) / sum : 0.0;
   }
   if (!(depth > 0.0)) return 0.0;
   if (!a.gradient()) return 0.5 * K * depth * depth;
@@ -306,7 +343,9 @@ double AddSideGroup(const Model& model, Data& data, std::span<const Vec3> x_W, c
   for (int j = 0; j < g.count; ++j) {
     const Sample& smp = member(j);
     const double weight = smp.normal_force_N / force;
-    const SectionStencil st = StencilOf(smp, x_W, eps, a.hessian());
+    if (!(weight > 0.0)) continue;
+    const SectionStencil st =
+        StencilOf(smp, x_W, eps, a.hessian(), EaseInOf(smp.distance_m, eps, tau).slope);
     StencilTerm t;
     t.first = st.first;
     t.nodes = st.nodes;
