@@ -276,9 +276,7 @@ void GroupSideSections(Scratch& s) {
     g.first = members;
     for (int j = k; j < s.sample_count; ++j) {
       const Sample& smp = s.samples[std::size_t(j)];
-      if (grouped[std::size_t(j)] || !IsSideSection(smp) || smp.part != first.part ||
-          smp.element != first.element)
-        continue;
+      if (grouped[std::size_t(j)] || !IsSideSection(smp) || smp.part != first.part) continue;
       grouped[std::size_t(j)] = true;
       s.side_members[std::size_t(members++)] = j;
     }
@@ -286,12 +284,13 @@ void GroupSideSections(Scratch& s) {
   }
 }
 
-// The side's sections on one part element press as one contact, as the rim's points do: its
+// The side's sections on one part press as one contact, as the rim's points do: its
 // distance is the smooth minimum d = -tau log sum exp(-d_j / tau) of theirs, where a section
 // whose share w_j fades is taken (1 - w_j) epsilon farther off and one joining is eased in
 // (EaseInOf), and the paper's K (eps - d)+ is shared by the softmin's weights. A side lying along
 // a face is then one contact of stiffness K however many sections bear on it, and a curved side
-// presses with its nearest section.
+// presses with its nearest section. The part, not its element: a section that moves from a face
+// onto its edge stays in the contact (its distance to the part is continuous there).
 // Its Hessian K m m^T + (F / tau) (sum s_j g_j g_j^T - m m^T) - F sum s_j C_j (m the weighted
 // mean of the distances' gradients g_j, C_j their curvatures) goes into the band where m fits
 // in it, and as a band part and a rank-one term c m m^T otherwise (SolveEquilibrium).

@@ -101,17 +101,17 @@ struct FrictionPoint {
 inline constexpr int kMaxSamples = 512;
 /// The feature of the held end's section's contact point (a kSide at node 0).
 inline constexpr int kHeldFeature = -1;
-/// Part elements the side can press on at once as one contact each (SideGroup); the side's
-/// sections on any more press each on their own.
+/// Parts the side can press on at once as one contact each (SideGroup); the side's sections
+/// on any more press each on their own.
 inline constexpr int kMaxSideGroups = 16;
 
-/// Whether a contact point is one of the side's sections that press on a part element together
-/// as one contact: the spheres at the inner nodes and the held end's section.
+/// Whether a contact point is one of the side's sections that press on a part together as one
+/// contact: the spheres at the inner nodes and the held end's section.
 inline bool IsSideSection(const Sample& s) {
   return s.kind == SampleKind::kNode || (s.kind == SampleKind::kSide && s.feature == kHeldFeature);
 }
 
-/// The side's sections on one part element: samples side_members[first, first + count).
+/// The side's sections on one part: samples side_members[first, first + count).
 struct SideGroup {
   int first = 0;
   int count = 0;
@@ -185,9 +185,11 @@ struct Scratch {
   struct ElementLoad {
     int part = 0;
     ElementIndex element = kNoElement;
-    double group_N = 0.0;                    ///< the normal force of its points within epsilon
-    double side_N = 0.0;                     ///< of the side's sections among them (IsSideSection)
-    double side_depth_m = 0.0;               ///< the side's sections' depths eps - d, summed
+    double group_N = 0.0;  ///< the normal force of its points within epsilon
+    /// Of the side's sections on its part (IsSideSection), which press as one contact: their
+    /// normal force and their depths eps - d, summed.
+    double side_N = 0.0;
+    double side_depth_m = 0.0;
     double static_N = 0.0, kinetic_N = 0.0;  ///< FrictionLimit at group_N
   };
   std::array<ElementLoad, kMaxSamples> element_loads{};

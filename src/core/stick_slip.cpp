@@ -88,9 +88,18 @@ void SumElementLoads(const Model& model, Data& data) {
     }
     s.element_of[std::size_t(k)] = e;
     if (smp.distance_m < eps) load.group_N += smp.normal_force_N;
+  }
+  // The side's sections on one part press as one contact (Assemble): their loads are summed
+  // over the part, whichever of its elements each lies on.
+  for (int k = 0; k < s.sample_count; ++k) {
+    const Sample& smp = s.samples[std::size_t(k)];
     if (!IsSideSection(smp)) continue;
-    load.side_N += smp.normal_force_N;
-    load.side_depth_m += std::max(0.0, eps - smp.distance_m);
+    for (int e = 0; e < count; ++e) {
+      Scratch::ElementLoad& load = s.element_loads[std::size_t(e)];
+      if (load.part != smp.part) continue;
+      load.side_N += smp.normal_force_N;
+      load.side_depth_m += std::max(0.0, eps - smp.distance_m);
+    }
   }
   for (int e = 0; e < count; ++e) {
     Scratch::ElementLoad& load = s.element_loads[std::size_t(e)];
@@ -103,10 +112,10 @@ void SumElementLoads(const Model& model, Data& data) {
 
 // Contact point k's friction limits: its share of its part element's limit (its PC's share rule,
 // friction.hpp) in proportion to its load, with the element's loads of SumElementLoads. Its load
-// is its own normal force, or for one of the side's sections that press as one contact
-// (Assemble) the contact's force shared by their depths eps - d: the smooth minimum puts the
-// force on the deepest section, which changes with every small tilt of a side lying flat; shared
-// by depth, the friction limits do not jump.
+// is its own normal force, or for one of the side's sections, which press on a part as one
+// contact (Assemble), the contact's force shared by their depths eps - d: the smooth minimum puts
+// the force on the deepest section, which changes with every small tilt of a side lying flat;
+// shared by depth, the friction limits do not jump.
 Limits LimitsOf(const Model& model, const Data& data, int k) {
   const Sample& of = data.scratch.samples[std::size_t(k)];
   const Scratch::ElementLoad& load =

@@ -528,6 +528,49 @@ TEST_CASE("A side lying along a floor slides along it at the kinetic ratio", "[c
   CHECK(std::abs(out.force_W_N.x()) / std::abs(out.force_W_N.z()) == Approx(0.3).epsilon(0.02));
 }
 
+TEST_CASE("A side lying along a face slides over its edge, smoothly and converging", "[core]") {
+  // The short steel rod pressed about 1 N flat on a frictionless floor, 3 degrees off the floor's
+  // end edge (well below the 20 degrees from which a smooth side bears an edge it crosses), then
+  // moved square to that edge at 10 mm/s until it has slid off: its sections pass from the top
+  // face onto the edge one by one. Their distance to the floor is continuous there, so the
+  // force must be: the hand moves 10 um a tick against a chain of about 400 N/m, 4 mN a tick,
+  // and the rim leaving the face halves the contact's stiffness over a few ticks (about 5 mN a
+  // tick). A section that pressed alone on the edge once it crossed (its full K (eps - d) at
+  // once, where the face's deeper sections had shadowed it) gave 21 mN, and 206 of the 1000
+  // ticks stopped at the iteration cap.
+  scene::Scene s = SteelScene();
+  s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
+  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  const double K = s.contact.stiffness_N_per_m, skew = 3.0 * kPi / 180.0;
+  const double edge_x = 0.03;
+  s.X_WH_start = Held({edge_x - 6e-3, -0.025, r1 + 0.5e-3},
+                      Eigen::Vector3d(std::sin(skew), std::cos(skew), 0.0));
+  s.parts.push_back(Box("floor", {0.1, 0.1, 0.02}, {edge_x - 0.05, 0.0, -0.01}));
+  core::Core c(s);
+  double t = 0.0;
+  // About 1 N across: the side's contact and the rim's, 2K, in series with the coupling.
+  Eigen::Isometry3d X = s.X_WH_start;
+  X.translation().z() -= (0.5e-3 - eps) + 1.0 * (1.0 / 400.0 + 1.0 / (2.0 * K));
+  MoveTo(c, X, 500, 200, t);
+  REQUIRE(c.last().contact_count == 1);
+  CHECK(c.last().force_W_N.z() == Approx(1.0).epsilon(0.02));
+  Tally tally;
+  double worst_N = 0.0, last_N = c.last().force_W_N.z();
+  for (int k = 1; k <= 1000; ++k) {
+    Eigen::Isometry3d Y = X;
+    Y.translation().x() += 10e-3 * k * 1e-3;
+    const core::StepOutput& out = c.Step(t += 1e-3, Y);
+    ++tally.ticks;
+    if (out.flags & core::kNotConverged) ++tally.unconverged;
+    worst_N = std::max(worst_N, std::abs(out.force_W_N.z() - last_N));
+    last_N = out.force_W_N.z();
+  }
+  // Slid off the floor's end: nothing left to touch.
+  CHECK(c.last().contact_count == 0);
+  CHECK(tally.unconverged == 0);
+  CHECK(worst_N < 0.01);
+}
+
 TEST_CASE("A stiff tube jammed over a part's end at the device's force converges", "[core]") {
   // The steel tube tipped 15 deg down, its hand driven so low that its end passes a floor's end
   // and dips below the floor's top, the coupling at the device's force. The last element's side
