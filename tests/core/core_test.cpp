@@ -533,11 +533,11 @@ TEST_CASE("A side lying along a face slides over its edge, smoothly and convergi
   // end edge (well below the 20 degrees from which a smooth side bears an edge it crosses), then
   // moved square to that edge at 10 mm/s until it has slid off: its sections pass from the top
   // face onto the edge one by one. Their distance to the floor is continuous there, so the
-  // force must be: the hand moves 10 um a tick against a chain of about 400 N/m, 4 mN a tick,
-  // and the rim leaving the face halves the contact's stiffness over a few ticks (about 5 mN a
-  // tick). A section that pressed alone on the edge once it crossed (its full K (eps - d) at
-  // once, where the face's deeper sections had shadowed it) gave 21 mN, and 206 of the 1000
-  // ticks stopped at the iteration cap.
+  // force must be: the largest change between ticks is the rim leaving the face, which takes its
+  // spring K away (2K to K in series with the coupling, 2 % of the force) over a few ticks,
+  // about 5 mN a tick. A section that pressed alone on the edge once it crossed (its full
+  // K (eps - d) at once, where the face's deeper sections had shadowed it) gave 21 mN, and 206
+  // of the 1000 ticks stopped at the iteration cap.
   scene::Scene s = SteelScene();
   s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
   const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
