@@ -79,17 +79,21 @@ double InFrontOfFaces(const PartEdge& edge, const Vec3& c, double ramp_m, Vec3& 
   return front;
 }
 
-// How square the tube's direction v (any length) crosses the edge's unit direction: s(sin^2 phi /
-// sin^2 20 deg), 1 from 20 degrees on; and its gradient in v. Below, the node spheres bear the
-// edge as a line along the tube.
+// How square the tube's direction v (any length) crosses the edge's unit direction: 0 up to 5
+// degrees, s((sin^2 phi - sin^2 5 deg) / (sin^2 20 deg - sin^2 5 deg)) between, 1 from 20
+// degrees on; and its gradient in v. Below 20 degrees, the node spheres bear the edge as a line
+// along the tube. Below 5 the share is none: there the point of the side nearest the edge runs
+// along the tube faster than the nodes move, and its share's curvature, left out of the
+// Hessian, stalled Newton (docs/core.md, "Contact points").
 double Across(const Vec3& v, const Vec3& unit, Vec3& gradient) {
-  constexpr double kSin2Fade = 0.116977778440511;  // sin^2 20 deg
+  constexpr double kSin2Fade = 0.116977778440511;    // sin^2 20 deg
+  constexpr double kSin2None = 0.00759612349389597;  // sin^2 5 deg
   const Vec3 cross = v.cross(unit);
   const double v2 = v.squaredNorm();
   const double sin2 = cross.squaredNorm() / v2;
-  const double x = std::clamp(sin2 / kSin2Fade, 0.0, 1.0);
+  const double x = std::clamp((sin2 - kSin2None) / (kSin2Fade - kSin2None), 0.0, 1.0);
   const Vec3 d_sin2_dv = 2.0 * unit.cross(cross) / v2 - 2.0 * cross.squaredNorm() * v / (v2 * v2);
-  gradient = 6.0 * x * (1.0 - x) / kSin2Fade * d_sin2_dv;
+  gradient = 6.0 * x * (1.0 - x) / (kSin2Fade - kSin2None) * d_sin2_dv;
   return SmoothStep(x);
 }
 
