@@ -65,6 +65,17 @@ const core::StepOutput& MoveTo(core::Core& c, const Eigen::Isometry3d& X, int ti
   return *out;
 }
 
+// The hand's pose that presses the held rod, level 0.5 mm above a floor (its side in the
+// contact band), about 1 N onto it: the side's contact and the rim's, 2K, in series with the
+// coupling. Moves there in 500 ticks and holds 200.
+Eigen::Isometry3d PressFlat(core::Core& c, const scene::Scene& s, double& t) {
+  Eigen::Isometry3d X = s.X_WH_start;
+  X.translation().z() -= (0.5e-3 - s.contact.threshold_m) +
+                         1.0 * (1.0 / 400.0 + 1.0 / (2.0 * s.contact.stiffness_N_per_m));
+  MoveTo(c, X, 500, 200, t);
+  return X;
+}
+
 }  // namespace
 
 TEST_CASE("Free motion: the held end follows the hand and nothing is felt", "[core]") {
@@ -504,16 +515,12 @@ TEST_CASE("A side lying along a floor slides along it at the kinetic ratio", "[c
   scene::Scene s = SteelScene();
   s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
   s.friction = scene::Friction{0.3, 0.3, 1.0, 1.0};
-  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
-  const double K = s.contact.stiffness_N_per_m;
+  const double r1 = s.tube.outer_radius_m;
   s.X_WH_start = Held({0.0, 0.0, r1 + 0.5e-3}, Eigen::Vector3d::UnitX());
   s.parts.push_back(Box("floor", {0.3, 0.1, 0.02}, {0.05, 0.0, -0.01}));
   core::Core c(s);
   double t = 0.0;
-  // About 1 N across: the side's contact and the rim's, 2K, in series with the coupling.
-  Eigen::Isometry3d X = s.X_WH_start;
-  X.translation().z() -= (0.5e-3 - eps) + 1.0 * (1.0 / 400.0 + 1.0 / (2.0 * K));
-  MoveTo(c, X, 500, 200, t);
+  const Eigen::Isometry3d X = PressFlat(c, s, t);
   REQUIRE(c.last().contact_count == 1);
   CHECK(c.last().force_W_N.z() == Approx(1.0).epsilon(0.02));
   Eigen::Isometry3d along = X;
@@ -540,18 +547,14 @@ TEST_CASE("A side lying along a face slides over its edge, smoothly and convergi
   // of the 1000 ticks stopped at the iteration cap.
   scene::Scene s = SteelScene();
   s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
-  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
-  const double K = s.contact.stiffness_N_per_m, skew = 3.0 * kPi / 180.0;
+  const double r1 = s.tube.outer_radius_m, skew = 3.0 * kPi / 180.0;
   const double edge_x = 0.03;
   s.X_WH_start = Held({edge_x - 6e-3, -0.025, r1 + 0.5e-3},
                       Eigen::Vector3d(std::sin(skew), std::cos(skew), 0.0));
   s.parts.push_back(Box("floor", {0.1, 0.1, 0.02}, {edge_x - 0.05, 0.0, -0.01}));
   core::Core c(s);
   double t = 0.0;
-  // About 1 N across: the side's contact and the rim's, 2K, in series with the coupling.
-  Eigen::Isometry3d X = s.X_WH_start;
-  X.translation().z() -= (0.5e-3 - eps) + 1.0 * (1.0 / 400.0 + 1.0 / (2.0 * K));
-  MoveTo(c, X, 500, 200, t);
+  const Eigen::Isometry3d X = PressFlat(c, s, t);
   REQUIRE(c.last().contact_count == 1);
   CHECK(c.last().force_W_N.z() == Approx(1.0).epsilon(0.02));
   Tally tally;
