@@ -22,6 +22,7 @@ struct Gathered {
   int merged_into = -1;
   ContactState pc;
   double s_far_m = 0.0;  ///< arc position of its point farthest from the held end
+  double sliding_N = 0.0;  ///< the normal force of its points that slide
 };
 
 // The tube's element of a contact point: the rim's points are the end face when the face's
@@ -130,7 +131,7 @@ void Classify(const Model& model, Data& data) {
     pc.moment_W_Nm += (smp.point_W - p_H).cross(f);
     pc.friction_ratio = std::max(pc.friction_ratio, smp.friction_ratio);
     pc.friction_work_J += smp.friction_work_J;
-    pc.sliding = pc.sliding || smp.sliding;
+    if (smp.sliding) g[std::size_t(at)].sliding_N += smp.normal_force_N;
     g[std::size_t(at)].s_far_m = std::max(g[std::size_t(at)].s_far_m, ArcOf(model, smp));
     if (smp.contact_distance_m < pc.distance_m) {
       pc.distance_m = smp.contact_distance_m;
@@ -166,7 +167,7 @@ void Classify(const Model& model, Data& data) {
     b.moment_W_Nm += a.pc.moment_W_Nm;
     b.friction_ratio = std::max(b.friction_ratio, a.pc.friction_ratio);
     b.friction_work_J += a.pc.friction_work_J;
-    b.sliding = b.sliding || a.pc.sliding;
+    g[std::size_t(into)].sliding_N += a.sliding_N;
     g[std::size_t(into)].s_far_m = std::max(g[std::size_t(into)].s_far_m, a.s_far_m);
     if (a.pc.distance_m < b.distance_m) {
       b.distance_m = a.pc.distance_m;
@@ -193,6 +194,9 @@ void Classify(const Model& model, Data& data) {
     ContactState& pc = a.pc;
     const scene::Friction& fr = model.parts[std::size_t(a.part)].friction;
     pc.friction_limit_N = FrictionLimit(fr, fr.static_coefficient, pc.normal_force_N);
+    // A PC slides when the points that bear most of its load do: a point at the band's edge,
+    // bearing nothing, slides at any stretch, and does not move the contact.
+    pc.sliding = a.sliding_N > 0.5 * pc.normal_force_N;
     if (!bends) {
       pc.marker = Marker::kNone;
       continue;

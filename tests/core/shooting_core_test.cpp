@@ -79,6 +79,7 @@ sh::Rod ReferenceRod(const scene::Scene& s) {
 struct CoreHold {
   Vector2d force_N = Vector2d::Zero();  ///< on the hand
   bool touching = false;
+  bool sliding = false;  ///< at the last tick of the ramp
   double energy_J = 0.0, work_J = 0.0;
 };
 struct CoreRun {
@@ -94,6 +95,7 @@ CoreRun RunCore(const scene::Scene& s, const std::vector<sh::Hold>& holds, int r
   CoreRun run;
   for (const sh::Hold& h : holds) {
     const Eigen::Isometry3d to = HandPose(h);
+    CoreHold r;
     for (int i = 1; i <= ramp + settle; ++i) {
       Eigen::Isometry3d X = to;
       const double u = std::min(1.0, double(i) / ramp);
@@ -105,9 +107,11 @@ CoreRun RunCore(const scene::Scene& s, const std::vector<sh::Hold>& holds, int r
       work_J += 0.5 * (f_on_tube - o.force_W_N).dot(o.X_WH.translation() - p_held);
       f_on_tube = -o.force_W_N;
       p_held = o.X_WH.translation();
+      // Sliding into the hold: at the last tick the hand moves (held still, a contact sticks).
+      if (i == ramp)
+        for (const core::ContactState& pc : o.Contacts()) r.sliding = r.sliding || pc.sliding;
     }
     from = to;
-    CoreHold r;
     r.force_N = {c.last().force_W_N.x(), c.last().force_W_N.z()};
     r.energy_J = c.last().energy_J;
     r.work_J = work_J;
@@ -151,7 +155,8 @@ double ComparePath(const scene::Scene& tube, const scene::Friction& friction,
     // The reference gives the force on the tube, the core the force on the hand.
     const Vector2d f_ref = h.solution.operator_force_N;
     INFO("hold " << k << ": reference " << f_ref.transpose() << " N (" << PhaseName(h.phase[0])
-                 << "), core " << (-c.force_N).transpose() << " N");
+                 << "), core " << (-c.force_N).transpose() << " N ("
+                 << (c.sliding ? "sliding" : "stuck") << ")");
     // Touching where the reference touches, but for a contact at the band's edge (below 1 mN,
     // 0.1 um inside it), where the two solvers' roundings decide.
     if (h.phase[0] == sh::ContactPhase::kOpen || h.solution.contacts[0].normal_N > 1e-3)
@@ -160,6 +165,8 @@ double ComparePath(const scene::Scene& tube, const scene::Friction& friction,
     // engages between two ticks).
     CHECK(c.energy_J <= 1.01 * c.work_J + 1e-12);
     if (f_ref.norm() < 0.1) continue;
+    // Stuck or sliding as the reference is (a frictionless contact has no friction state).
+    if (!friction.IsFrictionless()) CHECK(c.sliding == (h.phase[0] == sh::ContactPhase::kSliding));
     ++compared;
     stuck += h.phase[0] == sh::ContactPhase::kStuck;
     sliding += h.phase[0] == sh::ContactPhase::kSliding;

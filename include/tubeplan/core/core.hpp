@@ -80,7 +80,7 @@ struct ContactState {
   /// Work its friction dissipated this tick [J], >= 0: the kinetic force times the slip of its
   /// sliding points' anchors over the part (a stuck point's spring stores, it does not dissipate).
   double friction_work_J = 0.0;
-  bool sliding = false;  ///< any of its points slides
+  bool sliding = false;  ///< its points bearing more than half its normal force slide
 };
 
 /// What one tick returns. Plain data; valid until the next Step.
