@@ -689,9 +689,9 @@ TEST_CASE(
   CHECK(straight_N >= 0.85 * clamped_clamped_N);
   CHECK(straight_N <= clamped_clamped_N);
   CHECK(snapped);
-  // The snap is reported (its ticks flagged unconverged: near the bifurcation the energy is
-  // nearly quartic along the buckling mode, and Newton's method creeps, about 2.5 s of ticks
-  // here), and is over well before the end.
+  // The snap is reported (its ticks flagged unconverged: Newton's steps along the buckling mode
+  // zigzag against the stiff axial springs, about 2.5 s of ticks here; docs/accuracy.md), and is
+  // over well before the end.
   CHECK(snap_ticks > 0);
   CHECK(branch_holds >= 70);
 }

@@ -250,9 +250,9 @@ TEST_CASE(
     "The rubber tube's side pressed onto an edge with friction, stuck: within 5 % of the "
     "shooting reference's at a contact band of 0.1 mm",
     "[core][shooting]") {
-  // As the frictionless edge above, pressed 20 mm, the side stuck throughout. The two hold a
-  // stuck side at different points inside the band (docs/accuracy.md): 20 % apart along the
-  // tube's axis at the shipped eps = 1 mm, 7.3 % at 0.3 mm; at 0.1 mm, measured 2.6 %.
+  // As the frictionless edge above, pressed 20 mm, the side stuck throughout. The two differ
+  // inside the contact band (docs/accuracy.md): 20 % apart along the tube's axis at the shipped
+  // eps = 1 mm, 7.3 % at 0.3 mm; at 0.1 mm, measured 2.6 %.
   scene::Scene tube = testing::RubberScene();
   tube.contact.threshold_m = 1e-4;
   const double l = tube.tube.length_m, r1 = tube.tube.outer_radius_m;
