@@ -6,6 +6,7 @@
 #include <tubeplan/core/friction.hpp>
 
 #include "core/rod.hpp"
+#include "core/stick_slip.hpp"
 
 namespace tubeplan::core {
 namespace {
@@ -21,7 +22,7 @@ struct Gathered {
   ElementIndex element = kNoElement;
   int merged_into = -1;
   ContactState pc;
-  double s_far_m = 0.0;  ///< arc position of its point farthest from the held end
+  double s_far_m = 0.0;    ///< arc position of its point farthest from the held end
   double sliding_N = 0.0;  ///< the normal force of its points that slide
 };
 
@@ -128,7 +129,7 @@ void Classify(const Model& model, Data& data) {
     pc.normal_force_N += smp.normal_force_N;
     pc.friction_W_N += smp.friction_W_N;
     pc.force_W_N += f;
-    pc.moment_W_Nm += (smp.point_W - p_H).cross(f);
+    pc.moment_W_Nm += ContactMoment(model, smp, p_H);
     pc.friction_ratio = std::max(pc.friction_ratio, smp.friction_ratio);
     pc.friction_work_J += smp.friction_work_J;
     if (smp.sliding) g[std::size_t(at)].sliding_N += smp.normal_force_N;

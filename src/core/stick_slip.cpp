@@ -8,6 +8,20 @@
 #include "core/assemble.hpp"
 
 namespace tubeplan::core {
+
+Eigen::Vector3d FrictionOffset(const Model& model, const Sample& smp) {
+  if (smp.kind == SampleKind::kRim || smp.kind == SampleKind::kEndFace) return smp.offset_W;
+  // Past half the radius inside a part, no farther in.
+  const double gap_m = std::max(smp.distance_m, -0.5 * model.rod.outer_radius_m);
+  return smp.offset_W - gap_m * smp.normal_W;
+}
+
+Eigen::Vector3d ContactMoment(const Model& model, const Sample& smp, const Eigen::Vector3d& p_W) {
+  const Eigen::Vector3d friction_at_W = smp.point_W - smp.offset_W + FrictionOffset(model, smp);
+  return (smp.point_W - p_W).cross(smp.normal_force_N * smp.normal_W) +
+         (friction_at_W - p_W).cross(smp.friction_W_N);
+}
+
 namespace {
 
 using Vec3 = Eigen::Vector3d;
@@ -51,8 +65,8 @@ void Match(const Model& model, Data& data) {
     for (int f = 0; f < st.friction_count; ++f) {
       const FrictionPoint& fp = st.friction[std::size_t(f)];
       if (fp.sample >= 0 || fp.part != smp.part) continue;
-      const double d_m =
-          (FrictionMaterial(model, fp, st.x_W, s.tangents).point_W - smp.point_W).norm();
+      const Vec3 held_W = smp.point_W - smp.offset_W + FrictionOffset(model, smp);
+      const double d_m = (FrictionMaterial(model, fp, st.x_W, s.tangents).point_W - held_W).norm();
       if (d_m < best_m) {
         best_m = d_m;
         best = f;
@@ -229,7 +243,7 @@ void CarryFriction(const Model& model, Data& data) {
     nf.node = smp.node;
     nf.feature = smp.feature;
     nf.theta = smp.theta;
-    nf.offset_W = smp.offset_W;
+    nf.offset_W = FrictionOffset(model, smp);
     nf.anchor_W = FrictionMaterial(model, nf, data.state.x_W, s.tangents).point_W - stretch;
     nf.normal_W = smp.normal_W;
     nf.sliding = sliding;

@@ -6,6 +6,7 @@
 #include "core/assemble.hpp"
 #include "core/classify.hpp"
 #include "core/contacts.hpp"
+#include "core/stick_slip.hpp"
 
 namespace tubeplan::core {
 namespace {
@@ -96,8 +97,7 @@ void WriteOutput(const Model& model, Data& data) {
   for (int k = 0; k < data.scratch.sample_count; ++k) {
     const Sample& smp = data.scratch.samples[std::size_t(k)];
     if (!(smp.distance_m < eps)) continue;
-    const Vec3 f = smp.normal_force_N * smp.normal_W + smp.friction_W_N;
-    torque += (smp.point_W - st.x_W[0]).cross(f);
+    torque += ContactMoment(model, smp, st.x_W[0]);
     penetration = penetration || smp.distance_m < 0.0;
   }
   if (c.saturated) out.flags |= kProxySeparated;

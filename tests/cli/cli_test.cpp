@@ -714,9 +714,11 @@ TEST_CASE("simulate --out: every row has the header's columns; a PC's friction w
       const std::string p = "pc" + std::to_string(k);
       const double work = std::stod(f[column.at(p + "_work")]);
       INFO("t " << f[0] << " " << p << " " << f[column.at(p)] << ": " << work << " J");
-      // Dissipated, never returned; nothing while stuck (the stuck spring holds it).
+      // Dissipated, never returned. A PC reads stuck while the points bearing most of its load
+      // stick; a light point at the band's edge may slip meanwhile (measured up to 6e-10 J a
+      // tick, against 3e-5 J over the run).
       CHECK(work >= 0.0);
-      if (f[column.at(p + "_state")] == "stuck") CHECK(work == 0.0);
+      if (f[column.at(p + "_state")] == "stuck") CHECK(work <= 1e-8);
       sliding += f[column.at(p + "_state")] == "sliding";
       total_J += work;
       // The same number in both formats (CSV prints 17 significant digits: the same double).

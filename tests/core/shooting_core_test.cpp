@@ -176,7 +176,7 @@ double ComparePath(const scene::Scene& tube, const scene::Friction& friction,
     // 5 %: the margin a verdict near a force limit can carry (docs/accuracy.md).
     CHECK(error <= 0.05);
   }
-  CHECK(compared >= int(holds.size()) / 2);
+  CHECK(compared >= 30);
   CHECK(stuck >= min_stuck);
   CHECK(sliding >= min_sliding);
   return largest_error;
@@ -246,23 +246,35 @@ TEST_CASE(
   INFO("largest relative error " << error);
 }
 
-TEST_CASE(
-    "The rubber tube's side pressed onto an edge with friction, stuck: within 5 % of the "
-    "shooting reference's at a contact band of 0.1 mm",
-    "[core][shooting]") {
-  // As the frictionless edge above, pressed 20 mm, the side stuck throughout. The two differ
-  // inside the contact band (docs/accuracy.md): 20 % apart along the tube's axis at the shipped
-  // eps = 1 mm, 7.3 % at 0.3 mm; at 0.1 mm, measured 2.6 %.
+namespace {
+
+// The rubber tube's side pressed 20 mm onto an edge with friction (as the frictionless edge
+// above), stuck throughout, at contact band eps. In fine holds up to 2.5 mm: the reference places
+// its first anchor by interpolating between holds, which at holds of 0.5 mm puts up to 0.012 N
+// more along the tube into its spring (10 % of the first compared hold's force at eps = 0.3 mm).
+double StuckOnEdge(double eps_m) {
   scene::Scene tube = testing::RubberScene();
-  tube.contact.threshold_m = 1e-4;
+  tube.contact.threshold_m = eps_m;
   const double l = tube.tube.length_m, r1 = tube.tube.outer_radius_m;
   const Vector2d edge(r1 + 2e-3, 2.0 * l / 3.0);
   std::vector<sh::Hold> holds;
-  for (int k = 0; k <= 40; ++k) holds.push_back({Vector2d(0.5e-3 * k, 0.0), 0.0});
+  for (int k = 0; k <= 80; ++k) holds.push_back({Vector2d(0.5e-3 / 16.0 * k, 0.0), 0.0});
+  for (int k = 6; k <= 40; ++k) holds.push_back({Vector2d(0.5e-3 * k, 0.0), 0.0});
   sh::Obstacle ob;
   ob.kind = sh::ObstacleKind::kEdge;
   ob.point_m = edge;
-  const double error =
-      ComparePath(tube, {0.7, 0.08, 2.0 / 3.0, 1.0}, EdgeBlock(edge), ob, holds, 20, 0);
-  INFO("largest relative error " << error);
+  return ComparePath(tube, {0.7, 0.08, 2.0 / 3.0, 1.0}, EdgeBlock(edge), ob, holds, 30, 0);
+}
+
+}  // namespace
+
+TEST_CASE(
+    "The rubber tube's side pressed onto an edge with friction, stuck: within 5 % of the "
+    "shooting reference's at the shipped contact band and at a tenth of it",
+    "[core][shooting]") {
+  // A stuck point is held where it touches the edge, across the band's gap: the tube turning
+  // about the edge stretches no spring (measured 1.0 % at eps = 1 mm, 0.37 % at 0.1 mm; 20 %
+  // at 1 mm when the point was held on the tube's surface).
+  SECTION("eps = 1 mm") { INFO("largest relative error " << StuckOnEdge(1e-3)); }
+  SECTION("eps = 0.1 mm") { INFO("largest relative error " << StuckOnEdge(1e-4)); }
 }
