@@ -274,7 +274,7 @@ TEST_CASE(
     "[core][shooting]") {
   // A stuck point is held where it touches the edge, across the band's gap: the tube turning
   // about the edge stretches no spring (measured 1.0 % at eps = 1 mm, 0.37 % at 0.1 mm; 20 %
-  // at 1 mm when the point was held on the tube's surface).
+  // at 1 mm with the point held on the tube's surface).
   SECTION("eps = 1 mm") { INFO("largest relative error " << StuckOnEdge(1e-3)); }
   SECTION("eps = 0.1 mm") { INFO("largest relative error " << StuckOnEdge(1e-4)); }
 }
