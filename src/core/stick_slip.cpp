@@ -16,10 +16,18 @@ Eigen::Vector3d FrictionOffset(const Model& model, const Sample& smp) {
   return smp.offset_W - gap_m * smp.normal_W;
 }
 
+namespace {
+
+// Where a contact point's friction holds the tube (FrictionOffset), in the world.
+Eigen::Vector3d HeldPoint(const Model& model, const Sample& smp) {
+  return smp.point_W - smp.offset_W + FrictionOffset(model, smp);
+}
+
+}  // namespace
+
 Eigen::Vector3d ContactMoment(const Model& model, const Sample& smp, const Eigen::Vector3d& p_W) {
-  const Eigen::Vector3d friction_at_W = smp.point_W - smp.offset_W + FrictionOffset(model, smp);
   return (smp.point_W - p_W).cross(smp.normal_force_N * smp.normal_W) +
-         (friction_at_W - p_W).cross(smp.friction_W_N);
+         (HeldPoint(model, smp) - p_W).cross(smp.friction_W_N);
 }
 
 namespace {
@@ -62,10 +70,10 @@ void Match(const Model& model, Data& data) {
     if (!Active(model, smp) || smp.friction_point >= 0) continue;
     int best = -1;
     double best_m = reach_m;
+    const Vec3 held_W = HeldPoint(model, smp);
     for (int f = 0; f < st.friction_count; ++f) {
       const FrictionPoint& fp = st.friction[std::size_t(f)];
       if (fp.sample >= 0 || fp.part != smp.part) continue;
-      const Vec3 held_W = smp.point_W - smp.offset_W + FrictionOffset(model, smp);
       const double d_m = (FrictionMaterial(model, fp, st.x_W, s.tangents).point_W - held_W).norm();
       if (d_m < best_m) {
         best_m = d_m;
