@@ -335,9 +335,10 @@ double AddSideGroup(const Model& model, Data& data, std::span<const Vec3> x_W, c
   // m in the band (three nodes at most), else as a rank-one term of its own while there is room
   // for one (beyond, its term is left out of the Hessian: the gradient stays exact).
   const bool banded = hi - lo <= 2;
-  const bool low_rank = a.hessian() && !banded && sc.low_rank_count < kMaxSideGroups;
+  const bool low_rank = a.hessian() && !banded && sc.factors.low_rank_count < kMaxSideGroups;
   Eigen::Matrix<double, 9, 1> band_mean = Eigen::Matrix<double, 9, 1>::Zero();
-  Eigen::VectorXd* mean = low_rank ? &sc.low_rank_u[std::size_t(sc.low_rank_count)] : nullptr;
+  Eigen::VectorXd* mean =
+      low_rank ? &sc.factors.low_rank_u[std::size_t(sc.factors.low_rank_count)] : nullptr;
   if (mean != nullptr) mean->setZero();
   for (int j = 0; j < g.count; ++j) {
     const Sample& smp = member(j);
@@ -369,7 +370,7 @@ double AddSideGroup(const Model& model, Data& data, std::span<const Vec3> x_W, c
     t.hessian = c * band_mean * band_mean.transpose();
     a.AddStencil(t);
   } else if (low_rank && std::abs(c) > 1e-12 * K) {
-    sc.low_rank_c[std::size_t(sc.low_rank_count++)] = c;
+    sc.factors.low_rank_c[std::size_t(sc.factors.low_rank_count++)] = c;
   }
   return 0.5 * K * depth * depth;
 }
@@ -432,7 +433,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
   // part press as one contact.
   const double K = model.contact.stiffness_N_per_m, eps = model.contact.threshold_m;
   Scratch& sc = data.scratch;
-  if (a.hessian()) sc.low_rank_count = 0;
+  if (a.hessian()) sc.factors.low_rank_count = 0;
   GroupSideSections(sc);
   std::array<bool, kMaxSamples> in_group{};
   for (int g = 0; g < sc.side_group_count; ++g) {

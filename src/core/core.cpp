@@ -68,13 +68,17 @@ void InitData(const Model& model, const Eigen::Isometry3d& X_WH, Data& d) {
   for (Eigen::VectorXd* v : {&d.scratch.unknowns, &d.scratch.unknowns_trial, &d.scratch.gradient,
                              &d.scratch.step, &d.scratch.direction, &d.scratch.work})
     v->setZero(unknowns);
-  for (int k = 0; k < kMaxSideGroups; ++k) {
-    d.scratch.low_rank_u[std::size_t(k)].setZero(unknowns);
-    d.scratch.low_rank_z[std::size_t(k)].setZero(unknowns);
+  for (HessianFactors* f : {&d.scratch.factors, &d.state.kept.factors}) {
+    for (int k = 0; k < kMaxSideGroups; ++k) {
+      f->low_rank_u[std::size_t(k)].setZero(unknowns);
+      f->low_rank_z[std::size_t(k)].setZero(unknowns);
+    }
+    f->low_rank_count = 0;
+    f->band = BandLdlt(unknowns);
   }
-  d.scratch.low_rank_count = 0;
+  d.scratch.factors_current = false;
+  d.state.kept.valid = false;
   d.scratch.hessian = BandMatrix(unknowns);
-  d.scratch.factor = BandLdlt(unknowns);
   d.scratch.parts_near.assign(parts, 0);
   d.scratch.clearance_m.assign(nodes, 0.0);
   d.scratch.entry_seen.assign(parts * nodes, 0);

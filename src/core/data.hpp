@@ -118,7 +118,29 @@ struct SideGroup {
 };
 inline constexpr int kMaxFrictionPoints = 256;
 
-/// What a tick carries to the next: the rod, the held end, the hand, friction.
+/// The Hessian is the band B plus sum_k c_k u_k u_k^T over the side groups whose sections span
+/// more than the band (one term each). Its factors: B's LDL^T, B^-1 u_k, and the factors of the
+/// capacitance C^-1 + U^T B^-1 U (Woodbury's identity).
+struct HessianFactors {
+  BandLdlt band;
+  std::array<Eigen::VectorXd, kMaxSideGroups> low_rank_u, low_rank_z;
+  std::array<double, kMaxSideGroups> low_rank_c{};
+  int low_rank_count = 0;
+  using Capacitance =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSideGroups, kMaxSideGroups>;
+  Eigen::LDLT<Capacitance> capacitance;
+};
+
+/// The factors of the last Hessian a converged, stable solve factored, kept for the solves after
+/// it: one that starts with the same contacts takes its first step with them (SolveEquilibrium).
+struct KeptFactors {
+  HessianFactors factors;
+  std::uint64_t contacts = 0;  ///< the contact set they were factored with (ContactSetKey)
+  int solves = 0;              ///< the solves that have stepped with them since
+  bool valid = false;
+};
+
+/// What a tick carries to the next: the rod, the held end, the hand, friction, kept factors.
 struct CarriedState {
   std::vector<Eigen::Vector3d> x_W;                    ///< nodes 0..N [m]
   std::vector<Eigen::Vector3d> x_prev_W;               ///< the nodes a tick before [m]
@@ -134,6 +156,7 @@ struct CarriedState {
   /// Per contact point of the last tick: the element it was pressed on, per (node, part), so
   /// that a point pushed inside a part keeps being pushed back out the way it came in.
   std::vector<ElementIndex> entry_element;
+  KeptFactors kept;
 };
 
 /// The tick's working memory.
@@ -146,7 +169,9 @@ struct Scratch {
   Eigen::VectorXd unknowns, unknowns_trial;
   Eigen::VectorXd gradient, step, direction, work;
   BandMatrix hessian;
-  BandLdlt factor;
+  HessianFactors factors;
+  /// `factors` are of the Hessian last assembled, unshifted (it was positive definite).
+  bool factors_current = false;
   std::vector<std::uint8_t> parts_near;  ///< per part: within reach this iteration
   /// Per node: the distance from its section's surface to the nearest part (a lower bound) [m],
   /// and that bound for the parts not near.
@@ -169,15 +194,6 @@ struct Scratch {
   std::array<int, kMaxSamples> side_members{};
   std::array<SideGroup, kMaxSideGroups> side_groups{};
   int side_group_count = 0;
-  /// The Hessian is the band `hessian` plus sum_k c_k u_k u_k^T over the side groups whose
-  /// sections span more than the band (one term each), and the solve's B^-1 u_k.
-  std::array<Eigen::VectorXd, kMaxSideGroups> low_rank_u, low_rank_z;
-  std::array<double, kMaxSideGroups> low_rank_c{};
-  int low_rank_count = 0;
-  /// The factors of the capacitance C^-1 + U^T B^-1 U of those terms (Woodbury's identity).
-  using Capacitance =
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxSideGroups, kMaxSideGroups>;
-  Eigen::LDLT<Capacitance> capacitance;
   /// The inner nodes' tangents, kept while their nodes stay the same (Material).
   NodeTangents tangents;
   /// The loads of the part elements the contact points press on, and their friction limits,

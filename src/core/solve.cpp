@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "core/assemble.hpp"
 #include "core/contacts.hpp"
@@ -13,6 +14,10 @@ using Vec3 = Eigen::Vector3d;
 
 // Below this Newton decrement (the energy a full step would release) a tick has converged.
 constexpr double kDecrementFloor_J = 1e-14;
+
+// Solves that step with one set of kept factors at most before the Hessian is factored again
+// (StepWithKeptFactors).
+constexpr int kKeptSolves = 16;
 
 // Largest displacement of a node (or of the held end) in a step of the unknowns.
 double LargestMove(const Eigen::VectorXd& step) {
@@ -37,25 +42,25 @@ double StepFraction(const Model& model, const Scratch& s, const Eigen::VectorXd&
 // Factors the Hessian: its band B, then the capacitance S = C^-1 + U^T B^-1 U of its rank-one
 // terms U C U^T (Woodbury). False where B + U C U^T is not positive definite: B is not, or S has
 // not as many negative eigenvalues as C (Haynsworth's inertia additivity).
-bool FactorHessian(Scratch& s, double min_pivot) {
-  if (!s.factor.Factor(s.hessian, min_pivot)) return false;
-  const int k = s.low_rank_count;
+bool FactorHessian(const BandMatrix& hessian, HessianFactors& f, double min_pivot) {
+  if (!f.band.Factor(hessian, min_pivot)) return false;
+  const int k = f.low_rank_count;
   if (k == 0) return true;
-  Scratch::Capacitance S(k, k);
+  HessianFactors::Capacitance S(k, k);
   int negative = 0;
   for (int i = 0; i < k; ++i) {
-    s.low_rank_z[std::size_t(i)] = s.low_rank_u[std::size_t(i)];
-    s.factor.Solve(s.low_rank_z[std::size_t(i)]);
-    negative += s.low_rank_c[std::size_t(i)] < 0.0;
+    f.low_rank_z[std::size_t(i)] = f.low_rank_u[std::size_t(i)];
+    f.band.Solve(f.low_rank_z[std::size_t(i)]);
+    negative += f.low_rank_c[std::size_t(i)] < 0.0;
   }
   for (int i = 0; i < k; ++i)
     for (int j = 0; j < k; ++j)
-      S(i, j) = s.low_rank_u[std::size_t(i)].dot(s.low_rank_z[std::size_t(j)]) +
-                (i == j ? 1.0 / s.low_rank_c[std::size_t(i)] : 0.0);
-  s.capacitance.compute(S);
+      S(i, j) = f.low_rank_u[std::size_t(i)].dot(f.low_rank_z[std::size_t(j)]) +
+                (i == j ? 1.0 / f.low_rank_c[std::size_t(i)] : 0.0);
+  f.capacitance.compute(S);
   int found = 0;
   for (int i = 0; i < k; ++i) {
-    const double d = s.capacitance.vectorD()[i];
+    const double d = f.capacitance.vectorD()[i];
     if (!(std::abs(d) > 1e-13 * std::abs(S(i, i)))) return false;
     found += d < 0.0;
   }
@@ -63,22 +68,23 @@ bool FactorHessian(Scratch& s, double min_pivot) {
 }
 
 // x = H^-1 x, in place, with the factors of FactorHessian.
-void SolveHessian(Scratch& s, Eigen::VectorXd& x) {
-  s.factor.Solve(x);
-  const int k = s.low_rank_count;
+void SolveHessian(const HessianFactors& f, Eigen::VectorXd& x) {
+  f.band.Solve(x);
+  const int k = f.low_rank_count;
   if (k == 0) return;
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxSideGroups, 1> b(k), w(k);
-  for (int i = 0; i < k; ++i) b[i] = s.low_rank_u[std::size_t(i)].dot(x);
-  w = s.capacitance.solve(b);
-  for (int i = 0; i < k; ++i) x -= w[i] * s.low_rank_z[std::size_t(i)];
+  for (int i = 0; i < k; ++i) b[i] = f.low_rank_u[std::size_t(i)].dot(x);
+  w = f.capacitance.solve(b);
+  for (int i = 0; i < k; ++i) x -= w[i] * f.low_rank_z[std::size_t(i)];
 }
 
 // y = H x: the band and the rank-one terms.
 void MultiplyHessian(const Scratch& s, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const HessianFactors& f = s.factors;
   s.hessian.Multiply(x, y);
-  for (int i = 0; i < s.low_rank_count; ++i)
-    y += (s.low_rank_c[std::size_t(i)] * s.low_rank_u[std::size_t(i)].dot(x)) *
-         s.low_rank_u[std::size_t(i)];
+  for (int i = 0; i < f.low_rank_count; ++i)
+    y += (f.low_rank_c[std::size_t(i)] * f.low_rank_u[std::size_t(i)].dot(x)) *
+         f.low_rank_u[std::size_t(i)];
 }
 
 // Factors H + (shift + lambda) I with the smallest lambda >= 0 (0, then growing from a small
@@ -89,13 +95,14 @@ double FactorShifted(Scratch& s, double shift) {
   const double min_pivot = 1e-13 * diag;
   s.hessian.AddDiagonal(shift);
   double lambda = 0.0;
-  bool ok = FactorHessian(s, min_pivot);
+  bool ok = FactorHessian(s.hessian, s.factors, min_pivot);
   for (double add = 1e-7 * diag; !ok && add < 1e3 * diag; add *= 4.0) {
     s.hessian.AddDiagonal(add - lambda);
     lambda = add;
-    ok = FactorHessian(s, min_pivot);
+    ok = FactorHessian(s.hessian, s.factors, min_pivot);
   }
   s.hessian.AddDiagonal(-shift - lambda);
+  s.factors_current = ok && shift == 0.0 && lambda == 0.0;
   return ok ? lambda : -1.0;
 }
 
@@ -108,7 +115,7 @@ double NegativeCurvature(Scratch& s, Eigen::VectorXd& v) {
   for (int i = 0; i < v.size(); ++i) v[i] = 1.0 + 0.5 * std::sin(1.7 * i + 0.3);
   v.normalize();
   for (int k = 0; k < 8; ++k) {
-    SolveHessian(s, v);
+    SolveHessian(s.factors, v);
     v.normalize();
   }
   MultiplyHessian(s, v, s.work);
@@ -127,7 +134,7 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
   const bool balanced = data.solve.residual_N <= model.solver.tolerance_N;
   if (balanced && lambda == 0.0) return Outcome::kConverged;
   s.step = -s.gradient;
-  SolveHessian(s, s.step);
+  SolveHessian(s.factors, s.step);
   if (lambda > 0.0) {
     const double curvature = NegativeCurvature(s, s.direction);
     if (curvature < 0.0) {
@@ -144,27 +151,50 @@ Outcome NewtonStep(const Model& model, Data& data, double damping) {
   return damping == 0.0 ? Outcome::kDefiniteStep : Outcome::kStep;
 }
 
+// The energy, gradient and Hessian at x_W: the factors are then no longer the Hessian's.
+double AssembleHessian(const Model& model, Data& data, std::span<const Vec3> x_W) {
+  data.scratch.factors_current = false;
+  return Assemble(model, data, x_W, Derivatives::kHessian);
+}
+
+// The energy at alpha along the step (its gradient too where asked), with the contacts there;
+// their choices are pending until TakeTrial.
+double TrialEnergy(const Model& model, Data& data, double alpha, Derivatives derivatives) {
+  Scratch& s = data.scratch;
+  s.unknowns_trial = s.unknowns + alpha * s.step;
+  NodesOf(model, s.unknowns_trial, s.x_trial_W);
+  FindContacts(model, s.x_trial_W, data, Choices::kPending);
+  return Assemble(model, data, s.x_trial_W, derivatives);
+}
+
+// Moves the unknowns to the trial point.
+void TakeTrial(Data& data) {
+  Scratch& s = data.scratch;
+  CommitContactChoices(data);
+  s.unknowns = s.unknowns_trial;
+  std::copy(s.x_trial_W.begin(), s.x_trial_W.end(), data.state.x_W.begin());
+}
+
+// Whether energy e at alpha along a step of the given slope falls enough from `energy` (Armijo),
+// with room for the rounding of a sum of terms near equilibrium.
+bool FallsEnough(double e, double energy, double alpha, double slope) {
+  return e <= energy + 1e-4 * alpha * std::min(slope, 0.0) + 1e-13 * std::abs(energy);
+}
+
 // Moves the unknowns along the step, capped so that no point moves farther than the step cap
 // (contacts are found again before a part could be crossed), halving it while the energy does
 // not fall enough (Armijo). Returns the fraction of the step taken (0 for none), with the nodes,
 // contacts, energy and derivatives of the new point.
 double LineSearch(const Model& model, Data& data, double& energy) {
   Scratch& s = data.scratch;
-  std::span<Vec3> trial(s.x_trial_W);
   double alpha = StepFraction(model, s, s.step);
   const double slope = s.gradient.dot(s.step);
   for (int halving = 0; halving < 8; ++halving, alpha *= 0.5) {
-    s.unknowns_trial = s.unknowns + alpha * s.step;
-    NodesOf(model, s.unknowns_trial, trial);
-    FindContacts(model, trial, data, Choices::kPending);
     // The first trial is taken most often: its gradient is assembled with its energy.
     const double e =
-        Assemble(model, data, trial, halving == 0 ? Derivatives::kGradient : Derivatives::kNone);
-    // With room for the rounding of a sum of terms near equilibrium.
-    if (e <= energy + 1e-4 * alpha * std::min(slope, 0.0) + 1e-13 * std::abs(energy)) {
-      CommitContactChoices(data);
-      s.unknowns = s.unknowns_trial;
-      std::copy(trial.begin(), trial.end(), data.state.x_W.begin());
+        TrialEnergy(model, data, alpha, halving == 0 ? Derivatives::kGradient : Derivatives::kNone);
+    if (FallsEnough(e, energy, alpha, slope)) {
+      TakeTrial(data);
       if (halving > 0) Assemble(model, data, data.state.x_W, Derivatives::kGradient);
       energy = e;
       return alpha;
@@ -172,8 +202,85 @@ double LineSearch(const Model& model, Data& data, double& energy) {
   }
   // None taken: the contacts and derivatives of where the search started.
   FindContacts(model, data.state.x_W, data);
-  energy = Assemble(model, data, data.state.x_W, Derivatives::kHessian);
+  energy = AssembleHessian(model, data, data.state.x_W);
   return 0.0;
+}
+
+// Which points of the tube press on which part elements, and which friction points slide: two
+// states with the same key have Hessians of the same terms.
+std::uint64_t ContactSetKey(const Data& data) {
+  std::uint64_t key = 14695981039346656037ull;  // FNV-1a
+  const auto mix = [&key](std::int64_t v) { key = (key ^ std::uint64_t(v)) * 1099511628211ull; };
+  const Scratch& s = data.scratch;
+  for (int k = 0; k < s.sample_count; ++k) {
+    const Sample& smp = s.samples[std::size_t(k)];
+    for (const std::int64_t v :
+         {std::int64_t(smp.kind), std::int64_t(smp.part), std::int64_t(smp.node),
+          std::int64_t(smp.feature), std::int64_t(smp.element)})
+      mix(v);
+  }
+  mix(data.state.friction_count);
+  for (int k = 0; k < data.state.friction_count; ++k)
+    mix(data.state.friction[std::size_t(k)].sliding);
+  return key;
+}
+
+// The factors' own data, and only the rank-one terms in use.
+void CopyFactors(const HessianFactors& from, HessianFactors& to) {
+  to.band = from.band;
+  for (std::size_t i = 0; i < std::size_t(from.low_rank_count); ++i) {
+    to.low_rank_u[i] = from.low_rank_u[i];
+    to.low_rank_z[i] = from.low_rank_z[i];
+  }
+  to.low_rank_c = from.low_rank_c;
+  to.low_rank_count = from.low_rank_count;
+  to.capacitance = from.capacitance;
+}
+
+// A solve that starts with the contacts of the last factored Hessian first tries its factors (a
+// chord step): where the hand moved little since, it is balanced there, or one full step with
+// them lands within the tolerance, and no Hessian is assembled or factored. Otherwise nothing
+// is kept of the try, and the solve goes on from where it started. The factors were positive
+// definite; a straight column past its buckling load (a saddle whose gradient stays zero) is
+// found by the factorisation after kKeptSolves solves. True when converged.
+bool StepWithKeptFactors(const Model& model, Data& data) {
+  KeptFactors& kept = data.state.kept;
+  Scratch& s = data.scratch;
+  SolveReport& report = data.solve;
+  if (!kept.valid || kept.solves >= kKeptSolves || kept.contacts != ContactSetKey(data))
+    return false;
+  ++kept.solves;
+  const double energy = Assemble(model, data, data.state.x_W, Derivatives::kGradient);
+  report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
+  if (report.residual_N <= model.solver.tolerance_N) return true;
+  if (report.iterations >= model.solver.max_iterations) return false;
+  s.step = -s.gradient;
+  SolveHessian(kept.factors, s.step);
+  const double slope = s.gradient.dot(s.step);
+  if (StepFraction(model, s, s.step) == 1.0) {
+    const double e = TrialEnergy(model, data, 1.0, Derivatives::kGradient);
+    const double residual_N = s.gradient.lpNorm<Eigen::Infinity>();
+    if (FallsEnough(e, energy, 1.0, slope) && residual_N <= model.solver.tolerance_N) {
+      TakeTrial(data);
+      ++report.iterations;
+      report.residual_N = residual_N;
+      return true;
+    }
+    FindContacts(model, data.state.x_W, data);
+  }
+  return false;
+}
+
+// A converged, stable solve whose factors are of its last Hessian keeps them for the solves after
+// it; any other solve that did not converge with the kept ones drops them.
+void KeepFactors(Data& data) {
+  KeptFactors& kept = data.state.kept;
+  const Scratch& s = data.scratch;
+  kept.valid = data.solve.converged && !data.solve.indefinite && s.factors_current;
+  if (!kept.valid) return;
+  CopyFactors(s.factors, kept.factors);
+  kept.contacts = ContactSetKey(data);
+  kept.solves = 0;
 }
 
 }  // namespace
@@ -184,8 +291,12 @@ void SolveEquilibrium(const Model& model, Data& data) {
   std::span<Vec3> x(data.state.x_W);
   UnknownsOf(model, x, s.unknowns);
   FindContacts(model, x, data);
-  double energy = Assemble(model, data, x, Derivatives::kHessian);
   report.converged = false;
+  if (StepWithKeptFactors(model, data)) {
+    report.converged = true;
+    return;
+  }
+  double energy = AssembleHessian(model, data, x);
   // The iterations left of the tick's budget, which its friction passes share.
   while (report.iterations < model.solver.max_iterations) {
     report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
@@ -215,7 +326,7 @@ void SolveEquilibrium(const Model& model, Data& data) {
       break;
     }
     // The next iteration needs the Hessian where the search ended.
-    if (taken > 0.0) Assemble(model, data, x, Derivatives::kHessian);
+    if (taken > 0.0) AssembleHessian(model, data, x);
     bool moved = taken > 0.0;
     for (double damping = model.contact.stiffness_N_per_m;
          !moved && damping < 1e5 * model.contact.stiffness_N_per_m; damping *= 10.0) {
@@ -226,6 +337,7 @@ void SolveEquilibrium(const Model& model, Data& data) {
     if (!moved) break;
   }
   report.residual_N = s.gradient.lpNorm<Eigen::Infinity>();
+  KeepFactors(data);
 }
 
 }  // namespace tubeplan::core

@@ -212,14 +212,14 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
     core::FindContacts(model, x, data, core::Choices::kKeep);
     core::Assemble(model, data, x, core::Derivatives::kHessian);
     const core::Scratch& sc = data.scratch;
-    INFO("rise " << rise_m << " m: " << sc.low_rank_count << " rank-one terms");
-    CHECK(sc.low_rank_count == (rise_m == 0.0 ? 1 : 0));
+    INFO("rise " << rise_m << " m: " << sc.factors.low_rank_count << " rank-one terms");
+    CHECK(sc.factors.low_rank_count == (rise_m == 0.0 ? 1 : 0));
     const core::BandMatrix band = sc.hessian;
     std::vector<Eigen::VectorXd> u;
     std::vector<double> c;
-    for (int i = 0; i < sc.low_rank_count; ++i) {
-      u.push_back(sc.low_rank_u[std::size_t(i)]);
-      c.push_back(sc.low_rank_c[std::size_t(i)]);
+    for (int i = 0; i < sc.factors.low_rank_count; ++i) {
+      u.push_back(sc.factors.low_rank_u[std::size_t(i)]);
+      c.push_back(sc.factors.low_rank_c[std::size_t(i)]);
     }
     const auto gradient_at = [&](const Eigen::VectorXd& step) {
       std::vector<Eigen::Vector3d> y = x;
