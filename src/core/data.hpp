@@ -135,7 +135,7 @@ struct HessianFactors {
 /// it: one that starts with the same contacts takes its first step with them (SolveEquilibrium).
 struct KeptFactors {
   HessianFactors factors;
-  std::uint64_t contacts = 0;  ///< the contact set they were factored with (ContactSetKey)
+  std::uint64_t contacts = 0;  ///< the contact set where the solve that kept them ended
   int solves = 0;              ///< the solves that have stepped with them since
   bool valid = false;
 };
@@ -170,7 +170,8 @@ struct Scratch {
   Eigen::VectorXd gradient, step, direction, work;
   BandMatrix hessian;
   HessianFactors factors;
-  /// `factors` are of the Hessian last assembled, unshifted (it was positive definite).
+  /// `factors` are an unshifted factorisation of the Hessian at this or the last iterate (it
+  /// was positive definite), with its rank-one terms.
   bool factors_current = false;
   std::vector<std::uint8_t> parts_near;  ///< per part: within reach this iteration
   /// Per node: the distance from its section's surface to the nearest part (a lower bound) [m],

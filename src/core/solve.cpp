@@ -206,8 +206,9 @@ double LineSearch(const Model& model, Data& data, double& energy) {
   return 0.0;
 }
 
-// Which points of the tube press on which part elements, and which friction points slide: two
-// states with the same key have Hessians of the same terms.
+// Which points of the tube press on which part elements, and which friction points slide: a
+// solve whose key is the kept one's starts where those factors still fit, most likely (a change
+// the key misses costs the checked step, not accuracy).
 std::uint64_t ContactSetKey(const Data& data) {
   std::uint64_t key = 14695981039346656037ull;  // FNV-1a
   const auto mix = [&key](std::int64_t v) { key = (key ^ std::uint64_t(v)) * 1099511628211ull; };

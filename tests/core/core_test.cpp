@@ -700,8 +700,8 @@ TEST_CASE("A straight column pushed exactly along its axis buckles at its Euler 
   // The slender tube of the column test above, held exactly plumb over a frictionless floor and
   // lowered at 5 mm/s. Nothing breaks the symmetry: past its load the straight column stays
   // balanced (a saddle), and only the Hessian's negative curvature shows it is unstable. A solve
-  // that kept stepping with factors from below the load would carry it straight on (measured:
-  // straight to 1.13 times the load, never buckled).
+  // that stepped with factors from below the load for ever would carry it straight on, to 1.13
+  // times the load in this push.
   scene::Scene s = RubberScene();
   s.tube = {2e-3, 1e-3, 0.15, 9.7e7, 0.5};
   s.model.elements = 48;
