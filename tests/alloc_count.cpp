@@ -1,6 +1,5 @@
 // Every allocation of the test program goes through here and is counted per thread
-// (alloc_count.hpp). Moved out of tests/core/core_invariants_test.cpp so that the core's and the
-// servo's allocation tests share one count.
+// (alloc_count.hpp), one count shared by the core's and the servo's allocation tests.
 #include "alloc_count.hpp"
 
 #include <cstddef>

@@ -409,8 +409,8 @@ void ReadModel(Reader& r, const YAML::Node& node, scene::ModelOptions& m) {
                                                    {"elastica", scene::TubeModel::kRod},
                                                    {"linear", scene::TubeModel::kLinear}}))
       m.tube = *v;
-  // Options of an earlier core, which solved contacts one after another: the rod solves them
-  // together, so they no longer choose anything.
+  // Accepted and ignored with a warning: the rod solves all contacts together, so these choose
+  // nothing.
   for (const char* gone : {"multi_contact", "slip", "capsules"})
     if (const YAML::Node n = r.Get(node, gone, w, false); n.IsDefined())
       r.Warning(n, std::string("model.") + gone +

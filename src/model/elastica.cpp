@@ -164,11 +164,10 @@ double ResidualSlope(const Loading& load, const Trial& trial) {
   // With s0 = 0 the first argument is identically zero and its term vanishes. Otherwise its R_D
   // comes from the other two by Carlson's identity (DLMF 19.21.13; R_D is symmetric in its first
   // two arguments) R_D(y, z, x) + R_D(z, x, y) + R_D(x, y, z) = 3 / sqrt(x y z), which saves
-  // one of the three R_D a slope (~650 instructions a three-PC tick, and a long chain of square
-  // roots). No digits are lost: x <= y <= z (s0 < k as d > 0, and r <= 1), and R_D decreases
-  // fastest in its third argument, so R_D(y, z, x) is the largest of the three, at least a third
-  // of the sum it is taken from. sqrt(x y z) is formed from its factors' roots r s0, r k and k,
-  // so the product cannot underflow before x does.
+  // one of the three R_D a slope (a long chain of square roots). No digits are lost: x <= y <= z
+  // (s0 < k as d > 0, and r <= 1), and R_D decreases fastest in its third argument, so R_D(y, z, x)
+  // is the largest of the three, at least a third of the sum it is taken from. sqrt(x y z) is
+  // formed from its factors' roots r s0, r k and k, so the product cannot underflow before x does.
   if (load.s0 > 0.0) {
     const double rd_x = 3.0 / (r_sq * load.s0 * k_sq) - rd_y - rd_z;
     sum += rd_x * (-load.s0 * load.s0 * kkc / c0_sq);
@@ -375,8 +374,7 @@ struct Jacobi {
 struct LandenChain {
   static constexpr int kMaxLevels = 24;
   // Left uninitialised: MakeLandenChain writes the levels it uses (1 to `levels`) and nothing
-  // reads past them; zeroing the arrays took as many instructions as the descent itself (~270 a
-  // three-PC tick, two chains). Level 0 is k and kc below; of the complements k_n' only their
+  // reads past them. Level 0 is k and kc below; of the complements k_n' only their
   // squares are read (kcs_sq).
   std::array<double, kMaxLevels> ks;
   // Per level, the terms JacobiFunctions forms of the modulus alone: 1 + k_n, k_n^2 and k_n'^2,
@@ -395,11 +393,7 @@ LandenChain MakeLandenChain(double k, double kc) {
   LandenChain chain;
   chain.k = k;
   chain.kc = kc;
-  // A level's terms are formed as soon as its modulus is, in the descent's own loop, which
-  // carries k_n and k_n' in registers: the same operations on the same numbers, and the
-  // descent's product in the same order of levels, as when a second loop over the stored levels
-  // made them (its loop, reloads and the stores of k_n' that nothing read: ~20 instructions a
-  // three-PC tick, two chains).
+  // A level's terms are formed in the descent's own loop, as soon as its modulus is.
   int n = 0;
   double k_n = k, kc_n = kc;
   double descent = 1.0;
@@ -427,7 +421,7 @@ LandenChain MakeLandenChain(double k, double kc) {
 Jacobi JacobiFunctions(double z, const LandenChain& chain) {
   const auto& ks = chain.ks;
   const int n = chain.levels;
-  // One division for the descent and one a level for the ascent (it was one a level and two):
+  // One division for the descent and one a level for the ascent:
   // the divider is the slowest unit here, and a tick with a small-alpha segment evaluates these
   // a dozen times (the tip's quadrature). Each product rounds once more than the quotient it
   // replaces: a few ulp over the levels, as the rest of the chain (elastica_test.cpp).
@@ -486,8 +480,7 @@ void TipDisplacementByQuadrature(const Loading& load, const Trial& trial, double
   // sigma below it, whose functions come from those at sqrt(alpha) and at sigma by the addition
   // theorem (sums of positive terms but sn's difference, over half its larger term as sigma <=
   // 0.43 sqrt(alpha), and a denominator within 4 % of 1 for sqrt(alpha) <= 0.71). Six descents
-  // instead of ten: the quadrature runs in most two-PC ticks (the tip's segment has alpha <=
-  // 0.5), and its Jacobi functions with their sine and cosine were 8 % of such a tick's time.
+  // instead of ten.
   std::array<Jacobi, kGaussPoints> at{};
   const Jacobi end = JacobiFunctions(sqrt_alpha, chain);
   for (int i = 0; i < kGaussPoints / 2; ++i) {
@@ -707,11 +700,7 @@ Eigen::Vector2d Tangent(double sin_tip, double cos_tip, double gap_x, double gap
 
 // The shape figures from sn, cn, dn at w and D(w) = w - E(w) = int_0^w k^2 sn^2 (Jacobi's
 // epsilon function E): every sample of the shape comes through here, however those were found.
-// The modulus k and its complement kc come as values, not in the solution: a caller's loop that
-// stores its samples between two calls would otherwise read them again and form their products
-// k kc, k^2, k'^2 again a sample (a store to a double may be to the solution, for all the
-// compiler knows); as values those are the same numbers, formed once (~130 instructions of a
-// three-PC tick's 17 samples).
+// The modulus k and its complement kc come as values, not in the solution.
 FromTip FromJacobi(double k, double kc, double sqrt_alpha, double s, double sn, double cn,
                    double dn, double big_d) {
   FromTip out;
@@ -836,9 +825,8 @@ struct SampleArcs {
   double span, last_index;
 };
 
-// D(K) = (k^2 / 3) R_D(0, k'^2, 1), formed when a reflection first needs it: an R_D, and the
-// three-PC tick's samples (a whole segment whose root lies within K/2 of its tip) reflect none
-// (~0.12 k instructions).
+// D(K) = (k^2 / 3) R_D(0, k'^2, 1), formed when a reflection first needs it (a whole segment
+// whose root lies within K/2 of its tip reflects none).
 class CompleteDefect {
  public:
   CompleteDefect(double k_sq, double kc) : k_sq_(k_sq), kc_(kc) {}
@@ -873,7 +861,7 @@ Stepped StepFunctions(double delta, double big_k, double k, double kc, const Lan
 // The root's figures from the tip: the first sample's when it is the root (`first_sample`).
 // A root past the first sample is made as the walk would make it: on the root side of K/2 by
 // reflection with the same D(K), whose rounding then cancels between the root and the samples
-// there (ShapeFromTip's direct R_D left it in: 1.1e-12 of l at alpha = 0.002, found in review).
+// there (a direct R_D would leave it in: 1.1e-12 of l at alpha = 0.002).
 FromTip RootFromTip(const ElasticaSolution& solution, const LandenChain& chain, double sqrt_alpha,
                     double tau0, double s_first, const Eigen::Vector2d& first_sample,
                     CompleteDefect& d_complete) {
@@ -913,12 +901,11 @@ void EllipticSamples(const ElasticaSolution& solution, const Loading& load, cons
   const Stepped step = StepFunctions(delta, tau0 + sqrt_alpha, k, kc, chain, d_complete);
   // One step forward from `at`, or afresh at `argument()` (<= K/2) when the walk since the last
   // fresh evaluation has reached the anchor spacing (always, for steps longer than it). The
-  // argument is formed only then (a sample's s with its division, a product and a sum: ~70
-  // instructions a tick, whose 16 steps re-anchor once or never).
+  // argument is formed only then.
   // Also afresh after kAnchorSteps steps: the step's own functions carry a relative error (~5e-14
   // in cn and dn near k = 1) that each step adds again, and a short range of many points (a
   // segment's mesh) walks hundreds of steps within one anchor spacing (2.6e-12 of the tangent
-  // at 64 steps, found in review). 16 steps: a walk over the whole length (n = 17 samples, the
+  // at 64 steps). 16 steps: a walk over the whole length (n = 17 samples, the
   // tick's) never reaches it, so the tick keeps its bits.
   constexpr int kAnchorSteps = 16;
   double walked = 0.0;
@@ -962,7 +949,7 @@ void EllipticSamples(const ElasticaSolution& solution, const Loading& load, cons
   const FromTip root =
       RootFromTip(solution, chain, sqrt_alpha, tau0, s_of.first, xz_out[0], d_complete);
   const FromRoot from_root(solution, load, root.along, root.across);
-  // The tip angle's sine and cosine as the caller kept them (the core's chain), else formed.
+  // The tip angle's sine and cosine as the caller kept them, else formed.
   const ElasticaTip& tip = solution.tip;
   double sin_tip = solution.tip_sin, cos_tip = solution.tip_cos;
   if (!(solution.tip_trig_angle_rad == tip.tip_angle_rad)) {

@@ -728,8 +728,8 @@ TEST_CASE("simulate --out: every row has the header's columns; a PC's friction w
   CHECK(rows == 5501);  // 5.5 s at 1 kHz, and the row at t = 0
   CHECK(sliding > 100);
   // The end face's slide on the floor and the lay-down: a few tens of microjoules (f_k ~ 5 mN
-  // over millimetres), not the 2.86 mJ a jump of the deepest point along the lying side once
-  // counted (docs/evaluate.md).
+  // over millimetres), not the 2.86 mJ that counting a jump of the deepest point along the lying
+  // side would give (docs/evaluate.md).
   CHECK(total_J > 1e-6);
   CHECK(total_J < 2e-4);
   std::filesystem::remove(csv);

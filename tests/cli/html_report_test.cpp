@@ -180,7 +180,7 @@ TEST_CASE("evaluate --html of a long recording: a bounded page", "[cli][html]") 
   CHECK(frames["t_s"].size() <= report::ReplayRecording::kMaxBins + 1);
   CHECK(frames["t_s"].size() > report::ReplayRecording::kMaxBins / 2);
   CHECK(data["plans"][0]["bin_s"] == 0.08);
-  // The page: three.js (0.6 MB), the frames and the plots; 2.4 MB before the bins were bounded.
+  // The page: three.js (0.6 MB), the frames and the plots, the bins bounded.
   CHECK(page.size() < 2'000'000);
   std::filesystem::remove_all(dir);
 }

@@ -138,7 +138,7 @@ TEST_CASE("An element's side on an edge bears continuously across the edge's fac
   // and meets the edge. Its axis point nearest the edge lies on the plane of the wall's end face,
   // in front of or behind it as the tube tilts by a hair; the edge's share must not switch on and
   // off there, or the solve meets a step in its energy that no Newton step can descend (a tube
-  // squeezed between two such walls stalled with 3 N left over).
+  // squeezed between two such walls would stall with 3 N left over).
   scene::Scene s;
   s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
   s.contact = {1e4, 1e-3, 1e-4};

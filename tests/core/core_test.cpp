@@ -542,9 +542,9 @@ TEST_CASE("A side lying along a face slides over its edge, smoothly and convergi
   // face onto the edge one by one. Their distance to the floor is continuous there, so the
   // force must be: the largest change between ticks is the rim leaving the face, which takes its
   // spring K away (2K to K in series with the coupling, 2 % of the force) over a few ticks,
-  // about 5 mN a tick. A section that pressed alone on the edge once it crossed (its full
-  // K (eps - d) at once, where the face's deeper sections had shadowed it) gave 21 mN, and 206
-  // of the 1000 ticks stopped at the iteration cap.
+  // about 5 mN a tick. A section pressing alone on the edge once it crossed (its full
+  // K (eps - d) at once, where the face's deeper sections had shadowed it) would jump by 21 mN,
+  // and stop about a fifth of the 1000 ticks at the iteration cap.
   scene::Scene s = SteelScene();
   s.tube = {3e-3, 0.0, 0.05, 200e9, 0.3};
   const double r1 = s.tube.outer_radius_m, skew = 3.0 * kPi / 180.0;
@@ -579,10 +579,10 @@ TEST_CASE("A soft side slid across a narrow wall's top, 3 degrees off its edges,
   // The rubber tube lying along a wall's top 4 mm wide, 3 degrees off the wall's edges, pressed
   // about 1.3 N with friction (mu 0.3), then moved across the top at 10 mm/s until it has rolled
   // over the edge and off. Near parallel, the side's point nearest an edge runs along the tube
-  // many times faster than the nodes move; where that point's share did not fade out until 0
-  // degrees, its curvature (left out of the Hessian) made Newton overshoot, and 38 of these
-  // 1200 ticks stopped at the iteration cap. A few ticks where the contact set changes may
-  // still take the cap (one does); seven times fewer than that is the bound.
+  // many times faster than the nodes move; a share fading out only at 0 degrees would, through
+  // its curvature (left out of the Hessian), make Newton overshoot and stop 38 of these 1200
+  // ticks at the iteration cap. A few ticks where the contact set changes may still take the cap
+  // (one does); seven times fewer than 38 is the bound.
   scene::Scene s = RubberScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m;
   const double yaw = 3.0 * kPi / 180.0;

@@ -80,7 +80,7 @@ TEST_CASE("A PC's points share its limit: the shares add up to f_max at its norm
 }
 
 TEST_CASE("A tip stuck on a wall: k Delta until f_max, then the kinetic force", "[friction]") {
-  // The issue's analytic case in the friction law's terms: the hand moves sideways by Delta, the
+  // The analytic stuck-tip case in the friction law's terms: the hand moves sideways by Delta, the
   // stuck tip's spring k = 3 E I / l^3 stretches, the trial force is k Delta. Below mu_s N it
   // sticks; above, it slides and carries mu_k N, and it slips until k (Delta - slip) = mu_k N.
   const double k = 7.27;  // N/m: scenes/groove.yaml's tube, 3 E I / l^3

@@ -594,8 +594,7 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
 
 TEST_CASE("The floor's default exploration: saturated and closed alike on one thread or two",
           "[graph][explore]") {
-  // One exploration per thread count, shared by the sections (as test cases of their own, each
-  // in its own process, they explored it six times).
+  // One exploration per thread count, shared by the sections.
   SECTION("The default exploration saturates, the same from one thread and from two") {
     const ContactGraph& one = DefaultGraph(1);
     const ContactGraph& two = DefaultGraph(2);
@@ -803,7 +802,7 @@ TEST_CASE("The budget bounds the motions exactly, the same on any number of thre
 
 TEST_CASE("A tiny tube's exploration ends within its budget", "[graph][explore]") {
   // A 0.1 mm tube, 1 mm long, on the groove: its sweeps alone are 1202 motions (offsets a
-  // radius apart across 60 mm), which a budget of 3 used not to bound.
+  // radius apart across 60 mm), which a budget of 3 must cut to three.
   scene::Scene tiny = Groove();
   tiny.tube.outer_radius_m = 1e-4;
   tiny.tube.inner_radius_m = 5e-5;

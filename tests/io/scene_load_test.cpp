@@ -90,7 +90,7 @@ TEST_CASE("The minimal scene of these tests is valid", "[scene]") {
   CHECK(loaded.scene->friction.exponent == 1.0);
 }
 
-TEST_CASE("A model option that no longer chooses anything warns and loads", "[scene]") {
+TEST_CASE("A model option that chooses nothing warns and loads", "[scene]") {
   const auto loaded = LoadSceneText(kMinimal + "model: {capsules: 16, elements: 24}\n", "t.yaml");
   REQUIRE(loaded.scene);
   CHECK(loaded.diagnostics.FormatAll() ==

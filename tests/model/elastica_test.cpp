@@ -301,7 +301,7 @@ TEST_CASE("Elastica centreline ends match the tip figures", "[elastica]") {
       ElasticaCentreline(solution, s, xz, theta);
       CHECK(xz[0].norm() == 0.0);
       CHECK(theta[0] == 0.0);
-      // The brief's consistency requirement between the shape and the tip figures.
+      // The shape's end agrees with the tip figures.
       const double scale = std::max(solution.tip.deflection, 1e-300);
       CHECK(std::abs(xz[1].x() - solution.tip.deflection) <= 1e-10 * scale);
       // z = 1 - h itself is stored near 1, so it only carries h to one ulp of 1 (1.1e-16).
@@ -349,7 +349,7 @@ TEST_CASE("Evenly spaced elastica samples agree with the centreline evaluated po
 TEST_CASE("Elastica samples over a part of the length agree with the centreline point by point",
           "[elastica]") {
   // ElasticaSamples over [s_first, s_last]: the walk starts afresh past the root and short of
-  // the tip (a chain segment's points, Core::Centreline). Ranges on the root side of K/2 only,
+  // the tip. Ranges on the root side of K/2 only,
   // the tip side only, across it, a single point twice, and the whole; the same 1e-12 as the
   // whole length's samples (the walk is no longer, so it loses no more).
   const double alphas[] = {1e-6, 2e-3, 2.0, 13.8, 260.0, 1e3, 1e4};
@@ -370,7 +370,7 @@ TEST_CASE("Elastica samples over a part of the length agree with the centreline 
       }
     }
   }
-  // Short ranges of many points, found in review: one anchor spacing holding hundreds of steps
+  // Short ranges of many points: one anchor spacing holding hundreds of steps
   // (alpha = 5000 near k = 1: the tangent drifted 2.6e-12 in 64 steps, 4.1e-11 in 1000), and a
   // root made apart from the walk's D(K) (alpha = 0.002: 1.1e-12 of l).
   struct Short {

@@ -11,8 +11,9 @@
 
 namespace tubeplan::batch {
 
-/// Version 2 added the plan set and the shard a report covers (`plan_set`, `shard`); version 3
-/// has the implicit core's flag times (`fault_s`, `beyond_linear_s`, `unconverged_s`).
+/// Version 3: the plan set and the shard a report covers (`plan_set`, `shard`) and the flag times
+/// (`fault_s`, `beyond_linear_s`, `unconverged_s`); version 1 lacks the first two, version 2 the
+/// flag times.
 inline constexpr int kEvaluateJsonVersion = 3;
 
 /// What a report covers: shard `shard_index` of `shard_count` of one plan set, named by

@@ -47,9 +47,8 @@ struct ElasticaSolution {
   double loading_psi_rad = std::numeric_limits<double>::quiet_NaN();
   double loading_s0 = 0.0, loading_c0 = 0.0, loading_cos_psi = 0.0, loading_sin_psi = 0.0;
   /// std::sin and std::cos of tip.tip_angle_rad, valid while tip_trig_angle_rad equals it (NaN:
-  /// none; SolveElastica leaves them so): a caller that forms them anyway (the core's elastica
-  /// chain, turning the next clamp by the tip angle) keeps them here, and ElasticaSamples takes
-  /// them instead of another sine and cosine.
+  /// none; SolveElastica leaves them so): a caller that forms them anyway keeps them here, and
+  /// ElasticaSamples takes them instead of another sine and cosine.
   double tip_trig_angle_rad = std::numeric_limits<double>::quiet_NaN();
   double tip_sin = 0.0, tip_cos = 1.0;
 };
@@ -82,7 +81,7 @@ void ElasticaCentreline(const ElasticaSolution& solution, std::span<const double
 void ElasticaSamples(const ElasticaSolution& solution, std::span<Eigen::Vector2d> xz_out,
                      std::span<Eigen::Vector2d> tangent_out);
 /// The same over [s_first, s_last] (0 <= s_first <= s_last <= 1): s_j = s_first + (s_last -
-/// s_first) j / (n - 1), the last exactly s_last (a shape's points on one segment of a chain).
+/// s_first) j / (n - 1), the last exactly s_last.
 /// The walk starts afresh at a first sample past the root and a last short of the tip. Throws
 /// std::invalid_argument for a range out of [0, 1] or out of order, as for the sizes.
 void ElasticaSamples(const ElasticaSolution& solution, double s_first, double s_last,

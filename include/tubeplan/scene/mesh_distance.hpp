@@ -5,9 +5,10 @@
 // the box's). Queries walk an AABB tree over the triangles and allocate nothing.
 //
 // Why an own tree and not FCL's BVHModel: on a 10,000-triangle torus, for points within 5 mm of
-// its surface (tests/scene/mesh_distance_test.cpp, "[.bench]"), the median query took 1.6 us
-// here and 9.4 us through fcl::distance with a sphere of radius 0, which also allocates twice a
-// query (the tick allocates nothing). The core makes 10-60 queries a part in a 1 ms tick.
+// its surface (tests/scene/mesh_distance_test.cpp, "[.bench]"), the median query takes 1.6 us
+// and 9.4 us through fcl::distance with a sphere of radius 0, which also allocates twice a query
+// (the tick allocates nothing; docs/meshes.md, "Distance to a mesh"). The core makes 10-60 queries
+// a part in a 1 ms tick.
 
 #include <array>
 #include <cstdint>

@@ -1,7 +1,7 @@
 /* A minimal stand-in for OpenHaptics' HD/hd.h, for a compile check only: it declares just the
  * documented HD API types, constants and calls that src/device/openhaptics.cpp uses, with the
- * signatures of the OpenHaptics 3.4 reference. It is not the SDK (which cannot be installed
- * here) and nothing links against it; the constants' values are placeholders. */
+ * signatures of the OpenHaptics 3.4 reference. It is not the SDK (which Debian does not
+ * package) and nothing links against it; the constants' values are placeholders. */
 #ifndef TUBEPLAN_OPENHAPTICS_CHECK_HD_H
 #define TUBEPLAN_OPENHAPTICS_CHECK_HD_H
 
@@ -59,8 +59,7 @@ void hdEnable(HDenum cap);
 void hdDisable(HDenum cap);
 void hdStartScheduler(void);
 void hdStopScheduler(void);
-void hdScheduleSynchronous(HDSchedulerCallback pCallback, void* pUserData,
-                           HDushort nPriority);
+void hdScheduleSynchronous(HDSchedulerCallback pCallback, void* pUserData, HDushort nPriority);
 void hdBeginFrame(HHD hHD);
 void hdEndFrame(HHD hHD);
 void hdGetDoublev(HDenum pname, HDdouble* params);
