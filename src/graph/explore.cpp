@@ -453,6 +453,20 @@ bool FreePose(core::Core& core, const Eigen::Isometry3d& X) {
   return out.contact_count == 0 && (out.flags & core::kPenetration) == 0;
 }
 
+// A point of element e (an index into the core's elements) and its outward normal; a round
+// element's where it faces the start.
+scene::ElementPoint PointFacingStart(const scene::Scene& scene, const core::Core& probe, int e,
+                                     const Frame& f) {
+  const auto& elements = probe.elements();
+  const std::size_t part_index = elements[std::size_t(e)].part_index;
+  // The element's index within its part: elements come in part order.
+  int first = e;
+  while (first > 0 && elements[std::size_t(first - 1)].part_index == part_index) --first;
+  const scene::Part& part = scene.parts[part_index];
+  return scene::PointOnElement(part, e - first,
+                               f.p0 - part.X_WP * scene::BoundsInPart(part).center());
+}
+
 // The force that ends an aim's approach: a touch that bends a soft tube by less than the
 // scene's bend threshold.
 constexpr double kTouchGuard_N = 0.02;
@@ -465,14 +479,7 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   std::vector<Motion> motions;
   for (int e : elements) {
     const scene::PartElement& element = probe.elements()[std::size_t(e)];
-    const scene::Part& part = scene.parts[element.part_index];
-    // The element's index within its part: elements come in part order.
-    int first = e;
-    while (first > 0 && probe.elements()[std::size_t(first - 1)].part_index == element.part_index)
-      --first;
-    // A round element is aimed at where it faces the start.
-    const scene::ElementPoint at = scene::PointOnElement(
-        part, e - first, f.p0 - part.X_WP * scene::BoundsInPart(part).center());
+    const scene::ElementPoint at = PointFacingStart(scene, probe, e, f);
     const Eigen::Vector3d& c_W = at.p_W;
     const Eigen::Vector3d& n_W = at.n_W;
     // An element whose outside is inside another part (a wall's bottom on the floor) cannot be
@@ -547,6 +554,94 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
     }
   }
   return motions;
+}
+
+// An aim at the goal's contacts together, for a goal of two or more PCs (a tube lying in a
+// corner, or on a floor with its end against a wall): the straight tube posed clear of every
+// goal element by the same gap, its axis along each face its side is to lie on and into the one
+// its end is to meet, brought in along the sum of their inward normals so that it touches them
+// together, held there, then pressed and backed off.
+std::vector<Motion> GoalAims(const scene::Scene& scene, core::Core& probe,
+                             const ExploreOptions& o) {
+  const auto& goal = scene.goal.contacts;
+  if (goal.size() < 2) return {};
+  const Frame f = StartFrame(scene);
+  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
+  struct Target {
+    Eigen::Vector3d c, n;
+    bool side = false;
+  };
+  std::vector<Target> targets;
+  for (const states::PrincipalContact& pc : goal) {
+    const auto& elements = probe.elements();
+    const auto it = std::find_if(elements.begin(), elements.end(),
+                                 [&](const auto& e) { return e.name == pc.part_element; });
+    if (it == elements.end()) return {};
+    const scene::ElementPoint at =
+        PointFacingStart(scene, probe, static_cast<int>(it - elements.begin()), f);
+    targets.push_back({at.p_W, at.n_W, pc.tube == states::TubeElement::kSide});
+  }
+  // The axis: into the first end contact's element, else along the first two sides' faces.
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();
+  for (const Target& t : targets)
+    if (!t.side && a.isZero()) a = -t.n;
+  if (a.isZero()) {
+    for (std::size_t j = 1; j < targets.size() && a.norm() < 1e-3; ++j)
+      a = targets[0].n.cross(targets[j].n);
+    if (a.norm() < 1e-3) a = f.axis;
+    if (a.dot(f.axis) < 0.0) a = -a;
+  }
+  for (const Target& t : targets)
+    if (t.side) a -= a.dot(t.n) * t.n;
+  if (a.norm() < 1e-3) return {};
+  a.normalize();
+  // The free end's centre (below): the side's axis r + gap off its faces, the end face gap off its
+  // own, nearest the first element's point (the tube's middle there when only sides are aimed).
+  const bool sides_only =
+      std::all_of(targets.begin(), targets.end(), [](const Target& t) { return t.side; });
+  const Eigen::Vector3d base = targets[0].c + (sides_only ? 0.5 * l : 0.0) * a;
+  Eigen::MatrixXd N(3, Eigen::Index(targets.size()));
+  for (std::size_t i = 0; i < targets.size(); ++i) N.col(Eigen::Index(i)) = targets[i].n;
+  Eigen::Vector3d push = -N.rowwise().sum();
+  if (push.norm() < 1e-6) return {};
+  push.normalize();
+  const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, a);
+  // Clear of every element by the gap; a narrower one where the wider does not fit (a tube
+  // seated in a groove's corner has 2 mm to spare on the other side).
+  for (const double gap : {scene.contact.threshold_m + 3e-3, scene.contact.threshold_m + 1e-3}) {
+    Eigen::VectorXd rhs(Eigen::Index(targets.size()));
+    // How far along push until the last element is within reach.
+    double travel = 0.0;
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      const Target& t = targets[i];
+      rhs[Eigen::Index(i)] = t.n.dot(t.c - base) + (t.side ? r : 0.0) + gap;
+      const double rate = -push.dot(t.n);
+      if (rate < 0.1) return {};
+      travel = std::max(travel, gap / rate);
+    }
+    const Eigen::Vector3d tip =
+        base + N * (N.transpose() * N).completeOrthogonalDecomposition().solve(rhs);
+    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+    X.linear() = q.toRotationMatrix();
+    X.translation() = tip - l * a;
+    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    Motion m;
+    m.kind = "aim goal";
+    Eigen::Vector3d above = X.translation() - travel * push;
+    above.z() = std::max(f.p0.z(), above.z());
+    Eigen::Vector3d lift = f.p0;
+    lift.z() = above.z();
+    m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
+    m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
+    m.moves.push_back(MoveTo(X.translation(), q, 0.5 * o.speed_m_per_s, o.push_N, above));
+    m.moves.push_back(MoveBy(scene, travel * push, q, 0.1 * o.speed_m_per_s, kTouchGuard_N));
+    m.moves.push_back(MoveBy(scene, Eigen::Vector3d::Zero(), q, o.speed_m_per_s, 0.0));
+    m.moves.back().min_ticks = 100;
+    m.moves.push_back(MoveBy(scene, 3e-3 * push, q, 0.5 * o.speed_m_per_s, o.push_N));
+    m.moves.push_back(MoveBy(scene, -2.5 * r * push, q, o.speed_m_per_s, 0.0));
+    return {m};
+  }
+  return {};
 }
 
 // Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each; motion
@@ -1078,7 +1173,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   run(Sweeps(scene, box, o), {});
   graph.start = graph.nodes.empty() ? -1 : 0;  // the first stay of the first motion: the start
   if (!stopped) {
-    // Aim at the goal's elements first, then at those no PC has touched yet.
+    // Aim at the goal's contacts together first, then at the goal's elements, then at those no PC
+    // has touched yet.
     const std::set<std::string> reached = ReachedElements(graph);
     std::set<std::string> in_goal;
     for (const states::PrincipalContact& pc : scene.goal.contacts) in_goal.insert(pc.part_element);
@@ -1090,7 +1186,9 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
           !in_goal.contains(probe.elements()[e].name))
         unseen.push_back(static_cast<int>(e));
     phase = "aims";
-    run(Aims(scene, probe, unseen, o), {});
+    std::vector<Motion> aims = GoalAims(scene, probe, o);
+    for (Motion& m : Aims(scene, probe, unseen, o)) aims.push_back(std::move(m));
+    run(std::move(aims), {});
   }
   // Random motions from the seed, all merged (they reach pressed, tipped and wedged states the
   // sweeps and aims do not).
