@@ -850,6 +850,9 @@ TEST_CASE("Aims reach goals that sweeps and single elements' aims do not", "[gra
            // The tube lying straight on a table along a wall: aimed at one face, it bends before
            // it meets the other; the aim at the goal's two PCs together lays it in the corner.
            Case{"corner.yaml", 100, "{Fs - table.top, Fs - wall.xneg}"},
+           // The tube lying on a floor, its end face against a step's riser: aimed along the
+           // floor into the riser.
+           Case{"step.yaml", 100, "{Fe - step.yneg, Fs - floor.top}"},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
