@@ -556,89 +556,148 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   return motions;
 }
 
-// An aim at the goal's contacts together, for a goal of two or more PCs (a tube lying in a
-// corner, or on a floor with its end against a wall): the straight tube posed clear of every
-// goal element by the same gap, its axis along each face its side is to lie on and into the one
-// its end is to meet, brought in along the sum of their inward normals so that it touches them
-// together, held there, then pressed and backed off.
-std::vector<Motion> GoalAims(const scene::Scene& scene, core::Core& probe,
-                             const ExploreOptions& o) {
-  const auto& goal = scene.goal.contacts;
-  if (goal.size() < 2) return {};
-  const Frame f = StartFrame(scene);
-  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
+// A goal's PCs as the aim at them together sees them: each element's point and outward normal,
+// whether the tube's side is to lie on it (else its end is to meet it), the tube's axis, and
+// where the tube's free end would be with its middle (sides only) or its end at the first point.
+struct GoalPose {
   struct Target {
     Eigen::Vector3d c, n;
     bool side = false;
   };
   std::vector<Target> targets;
-  for (const states::PrincipalContact& pc : goal) {
+  Eigen::Vector3d axis, base;
+  Eigen::MatrixXd normals;  // 3 x targets
+  Eigen::Quaterniond q;
+
+  // The free end's centre where the side's axis is r + gap off its faces and the end face gap off
+  // its own, nearest `base` (least squares where they cannot all hold: between facing faces).
+  Eigen::Vector3d Tip(double r, double gap) const {
+    Eigen::VectorXd rhs(Eigen::Index(targets.size()));
+    for (std::size_t i = 0; i < targets.size(); ++i)
+      rhs[Eigen::Index(i)] =
+          targets[i].n.dot(targets[i].c - base) + (targets[i].side ? r : 0.0) + gap;
+    return base +
+           normals * (normals.transpose() * normals).completeOrthogonalDecomposition().solve(rhs);
+  }
+};
+
+// The axis: into the first end contact's element, else along the first two sides' faces (the
+// start's axis along facing faces), turned into every side's face. False where there is none.
+bool MakeGoalPose(const scene::Scene& scene, const core::Core& probe, const Frame& f, GoalPose& g) {
+  for (const states::PrincipalContact& pc : scene.goal.contacts) {
     const auto& elements = probe.elements();
     const auto it = std::find_if(elements.begin(), elements.end(),
                                  [&](const auto& e) { return e.name == pc.part_element; });
-    if (it == elements.end()) return {};
+    if (it == elements.end()) return false;
     const scene::ElementPoint at =
         PointFacingStart(scene, probe, static_cast<int>(it - elements.begin()), f);
-    targets.push_back({at.p_W, at.n_W, pc.tube == states::TubeElement::kSide});
+    g.targets.push_back({at.p_W, at.n_W, pc.tube == states::TubeElement::kSide});
   }
-  // The axis: into the first end contact's element, else along the first two sides' faces.
   Eigen::Vector3d a = Eigen::Vector3d::Zero();
-  for (const Target& t : targets)
+  for (const GoalPose::Target& t : g.targets)
     if (!t.side && a.isZero()) a = -t.n;
   if (a.isZero()) {
-    for (std::size_t j = 1; j < targets.size() && a.norm() < 1e-3; ++j)
-      a = targets[0].n.cross(targets[j].n);
+    for (std::size_t j = 1; j < g.targets.size() && a.norm() < 1e-3; ++j)
+      a = g.targets[0].n.cross(g.targets[j].n);
     if (a.norm() < 1e-3) a = f.axis;
     if (a.dot(f.axis) < 0.0) a = -a;
   }
-  for (const Target& t : targets)
+  for (const GoalPose::Target& t : g.targets)
     if (t.side) a -= a.dot(t.n) * t.n;
-  if (a.norm() < 1e-3) return {};
-  a.normalize();
-  // The free end's centre (below): the side's axis r + gap off its faces, the end face gap off its
-  // own, nearest the first element's point (the tube's middle there when only sides are aimed).
+  if (a.norm() < 1e-3) return false;
+  g.axis = a.normalized();
   const bool sides_only =
-      std::all_of(targets.begin(), targets.end(), [](const Target& t) { return t.side; });
-  const Eigen::Vector3d base = targets[0].c + (sides_only ? 0.5 * l : 0.0) * a;
-  Eigen::MatrixXd N(3, Eigen::Index(targets.size()));
-  for (std::size_t i = 0; i < targets.size(); ++i) N.col(Eigen::Index(i)) = targets[i].n;
-  Eigen::Vector3d push = -N.rowwise().sum();
-  if (push.norm() < 1e-6) return {};
-  push.normalize();
-  const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, a);
+      std::all_of(g.targets.begin(), g.targets.end(), [](const auto& t) { return t.side; });
+  g.base = g.targets[0].c + (sides_only ? 0.5 * scene.tube.length_m : 0.0) * g.axis;
+  g.normals.resize(3, Eigen::Index(g.targets.size()));
+  for (std::size_t i = 0; i < g.targets.size(); ++i)
+    g.normals.col(Eigen::Index(i)) = g.targets[i].n;
+  g.q = TurnAxis(f.q0, f.axis, g.axis);
+  return true;
+}
+
+// The hand's pose that puts the straight tube's free end at `tip` along the goal's axis.
+Eigen::Isometry3d HandFor(const scene::Scene& scene, const GoalPose& g,
+                          const Eigen::Vector3d& tip) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = g.q.toRotationMatrix();
+  X.translation() = tip - scene.tube.length_m * g.axis;
+  return X;
+}
+
+// From the start over `entry` at a safe height and down to it.
+void GoOver(const Frame& f, const Eigen::Vector3d& entry, const Eigen::Quaterniond& q,
+            const ExploreOptions& o, Motion& m) {
+  Eigen::Vector3d above = entry;
+  above.z() = std::max(f.p0.z(), entry.z());
+  Eigen::Vector3d lift = f.p0;
+  lift.z() = above.z();
+  m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
+  m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
+  m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+}
+
+// A move that stops at the first light touch, then a hold of 100 ms (so the unbent state counts).
+void TouchAndHold(const scene::Scene& scene, const Eigen::Vector3d& d, const Eigen::Quaterniond& q,
+                  double speed, double guard_N, Motion& m) {
+  m.moves.push_back(MoveBy(scene, d, q, speed, guard_N));
+  m.moves.push_back(MoveBy(scene, Eigen::Vector3d::Zero(), q, speed, 0.0));
+  m.moves.back().min_ticks = 100;
+}
+
+// An aim at the goal's contacts together, for a goal of two or more PCs (a tube lying in a
+// corner, or on a floor with its end against a wall): the straight tube posed clear of every
+// goal element by the same gap, its axis along each face its side is to lie on and into the one
+// its end is to meet, brought in along the sum of their inward normals so that it touches them
+// together, held there, then pressed and backed off. Between facing faces (a slot), or where
+// that pose is not clear, the tube is set down on the lowest-facing goal face short of the
+// others and slid in along its axis.
+std::vector<Motion> GoalAims(const scene::Scene& scene, core::Core& probe,
+                             const ExploreOptions& o) {
+  if (scene.goal.contacts.size() < 2) return {};
+  const Frame f = StartFrame(scene);
+  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
+  const double eps = scene.contact.threshold_m;
+  GoalPose g;
+  if (!MakeGoalPose(scene, probe, f, g)) return {};
+  Motion m;
+  m.kind = "aim goal";
+  Eigen::Vector3d push = -g.normals.rowwise().sum();
   // Clear of every element by the gap; a narrower one where the wider does not fit (a tube
   // seated in a groove's corner has 2 mm to spare on the other side).
-  for (const double gap : {scene.contact.threshold_m + 3e-3, scene.contact.threshold_m + 1e-3}) {
-    Eigen::VectorXd rhs(Eigen::Index(targets.size()));
+  for (const double gap : {eps + 3e-3, eps + 1e-3}) {
+    if (push.norm() < 1e-6) break;
+    push.normalize();
     // How far along push until the last element is within reach.
     double travel = 0.0;
-    for (std::size_t i = 0; i < targets.size(); ++i) {
-      const Target& t = targets[i];
-      rhs[Eigen::Index(i)] = t.n.dot(t.c - base) + (t.side ? r : 0.0) + gap;
-      const double rate = -push.dot(t.n);
-      if (rate < 0.1) return {};
-      travel = std::max(travel, gap / rate);
-    }
-    const Eigen::Vector3d tip =
-        base + N * (N.transpose() * N).completeOrthogonalDecomposition().solve(rhs);
-    Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-    X.linear() = q.toRotationMatrix();
-    X.translation() = tip - l * a;
+    for (const GoalPose::Target& t : g.targets)
+      travel = std::max(travel, gap / std::max(-push.dot(t.n), 0.1));
+    const Eigen::Isometry3d X = HandFor(scene, g, g.Tip(r, gap));
     if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
-    Motion m;
-    m.kind = "aim goal";
-    Eigen::Vector3d above = X.translation() - travel * push;
-    above.z() = std::max(f.p0.z(), above.z());
-    Eigen::Vector3d lift = f.p0;
-    lift.z() = above.z();
-    m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
-    m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
-    m.moves.push_back(MoveTo(X.translation(), q, 0.5 * o.speed_m_per_s, o.push_N, above));
-    m.moves.push_back(MoveBy(scene, travel * push, q, 0.1 * o.speed_m_per_s, kTouchGuard_N));
-    m.moves.push_back(MoveBy(scene, Eigen::Vector3d::Zero(), q, o.speed_m_per_s, 0.0));
-    m.moves.back().min_ticks = 100;
-    m.moves.push_back(MoveBy(scene, 3e-3 * push, q, 0.5 * o.speed_m_per_s, o.push_N));
-    m.moves.push_back(MoveBy(scene, -2.5 * r * push, q, o.speed_m_per_s, 0.0));
+    GoOver(f, X.translation(), g.q, o, m);
+    TouchAndHold(scene, travel * push, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
+    m.moves.push_back(MoveBy(scene, 3e-3 * push, g.q, 0.5 * o.speed_m_per_s, o.push_N));
+    m.moves.push_back(MoveBy(scene, -2.5 * r * push, g.q, o.speed_m_per_s, 0.0));
+    return {m};
+  }
+  // Set down on the goal face that faces up most, drawn back along the axis by half the tube or
+  // all of it, then slid in.
+  const auto lowest =
+      std::max_element(g.targets.begin(), g.targets.end(), [&](const auto& x, const auto& y) {
+        return x.side < y.side || (x.side == y.side && x.n.dot(f.up) < y.n.dot(f.up));
+      });
+  if (!lowest->side) return {};
+  const Eigen::Vector3d& n_up = lowest->n;
+  const double gap = eps + 3e-3;
+  const Eigen::Vector3d tip = g.Tip(r, 0.5 * eps);
+  for (const double back : {0.5 * l, l}) {
+    const Eigen::Isometry3d X = HandFor(scene, g, tip - back * g.axis + gap * n_up);
+    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    GoOver(f, X.translation(), g.q, o, m);
+    TouchAndHold(scene, -gap * n_up, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
+    TouchAndHold(scene, back * g.axis, g.q, 0.25 * o.speed_m_per_s, o.push_N, m);
+    m.moves.push_back(MoveBy(scene, -back * g.axis, g.q, 0.5 * o.speed_m_per_s, 0.0));
+    m.moves.push_back(MoveBy(scene, 2.5 * r * n_up, g.q, o.speed_m_per_s, 0.0));
     return {m};
   }
   return {};

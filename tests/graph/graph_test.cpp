@@ -839,6 +839,7 @@ TEST_CASE("Aims reach goals that sweeps and single elements' aims do not", "[gra
     const char* file;
     int motions;  // the sweeps and aims, and the first probes
     const char* goal;
+    double gentle_N;  // the goal's least operator force at most: set down, not pushed in
   };
   for (const Case& c : {
            // The shipped pocket, parts and start turned 30 deg about world x: the start still
@@ -846,21 +847,24 @@ TEST_CASE("Aims reach goals that sweeps and single elements' aims do not", "[gra
            // off the floor's normal, runs its end into a wall. The aim at the pocket's floor
            // comes in along its normal. (Without it no motion reaches the goal in a default
            // exploration of 3000 motions.)
-           Case{"pocket-turned.yaml", 250, "{Fe - base.top}"},
+           Case{"pocket-turned.yaml", 250, "{Fe - base.top}", 0.1},
            // The tube lying straight on a table along a wall: aimed at one face, it bends before
            // it meets the other; the aim at the goal's two PCs together lays it in the corner.
-           Case{"corner.yaml", 100, "{Fs - table.top, Fs - wall.xneg}"},
+           Case{"corner.yaml", 100, "{Fs - table.top, Fs - wall.xneg}", 0.1},
            // The tube lying on a floor, its end face against a step's riser: aimed along the
            // floor into the riser.
-           Case{"step.yaml", 100, "{Fe - step.yneg, Fs - floor.top}"},
+           Case{"step.yaml", 100, "{Fe - step.yneg, Fs - floor.top}", 0.1},
+           // The tube lying on a floor under a bar, within epsilon of both: set down short of
+           // the bar and slid in along its axis. Within epsilon of both faces the penalty presses
+           // from both sides (measured 0.31 N).
+           Case{"slot.yaml", 100, "{Fs - bar.bottom, Fs - floor.top}", 0.5},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
     REQUIRE(g.goal >= 0);
     const Node& goal = g.nodes[std::size_t(g.goal)];
     CHECK(goal.cf == c.goal);
-    // Reached gently: set down, not pushed in.
-    CHECK(goal.min_force_N < 0.1);
+    CHECK(goal.min_force_N < c.gentle_N);
   }
 }
 
