@@ -557,8 +557,8 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
 }
 
 // A goal's PCs as the aim at them together sees them: each element's point and outward normal,
-// whether the tube's side is to lie on it (else its end is to meet it), the tube's axis, and
-// where the tube's free end would be with its middle (sides only) or its end at the first point.
+// whether the tube's side is to lie on it (else its end is to meet it), the tube's axis and the
+// hand's turn to it, and a point the tube's middle (sides only) or its end is placed nearest.
 struct GoalPose {
   struct Target {
     Eigen::Vector3d c, n;
@@ -581,9 +581,11 @@ struct GoalPose {
   }
 };
 
-// The axis: into the first end contact's element, else along the first two sides' faces (the
-// start's axis along facing faces), turned into every side's face. False where there is none.
+// The goal's targets and the pose's axis: into the first end contact's element, else along the
+// first two sides' faces (the start's axis between facing faces), turned into every side's
+// face; the base point is the targets' mean. False where there is no such axis.
 bool MakeGoalPose(const scene::Scene& scene, const core::Core& probe, const Frame& f, GoalPose& g) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const states::PrincipalContact& pc : scene.goal.contacts) {
     const auto& elements = probe.elements();
     const auto it = std::find_if(elements.begin(), elements.end(),
@@ -592,6 +594,7 @@ bool MakeGoalPose(const scene::Scene& scene, const core::Core& probe, const Fram
     const scene::ElementPoint at =
         PointFacingStart(scene, probe, static_cast<int>(it - elements.begin()), f);
     g.targets.push_back({at.p_W, at.n_W, pc.tube == states::TubeElement::kSide});
+    mean += at.p_W / double(scene.goal.contacts.size());
   }
   Eigen::Vector3d a = Eigen::Vector3d::Zero();
   for (const GoalPose::Target& t : g.targets)
@@ -608,7 +611,7 @@ bool MakeGoalPose(const scene::Scene& scene, const core::Core& probe, const Fram
   g.axis = a.normalized();
   const bool sides_only =
       std::all_of(g.targets.begin(), g.targets.end(), [](const auto& t) { return t.side; });
-  g.base = g.targets[0].c + (sides_only ? 0.5 * scene.tube.length_m : 0.0) * g.axis;
+  g.base = mean + (sides_only ? 0.5 * scene.tube.length_m : 0.0) * g.axis;
   g.normals.resize(3, Eigen::Index(g.targets.size()));
   for (std::size_t i = 0; i < g.targets.size(); ++i)
     g.normals.col(Eigen::Index(i)) = g.targets[i].n;
@@ -625,82 +628,101 @@ Eigen::Isometry3d HandFor(const scene::Scene& scene, const GoalPose& g,
   return X;
 }
 
-// From the start over `entry` at a safe height and down to it.
-void GoOver(const Frame& f, const Eigen::Vector3d& entry, const Eigen::Quaterniond& q,
-            const ExploreOptions& o, Motion& m) {
-  Eigen::Vector3d above = entry;
-  above.z() = std::max(f.p0.z(), entry.z());
+// From the start over `from` at a safe height, and from there to `to`.
+void GoOver(const Frame& f, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+            const Eigen::Quaterniond& q, const ExploreOptions& o, Motion& m) {
+  Eigen::Vector3d above = from;
+  above.z() = std::max(f.p0.z(), from.z());
   Eigen::Vector3d lift = f.p0;
   lift.z() = above.z();
   m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
   m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
-  m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
+  m.moves.push_back(MoveTo(to, q, 0.5 * o.speed_m_per_s, o.push_N, above));
 }
 
-// A move that stops at the first light touch, then a hold of 100 ms (so the unbent state counts).
-void TouchAndHold(const scene::Scene& scene, const Eigen::Vector3d& d, const Eigen::Quaterniond& q,
-                  double speed, double guard_N, Motion& m) {
+// A move by d that stops where the force against it passes guard_N, then a hold of 100 ms (so
+// the state there counts).
+void GuardedMoveAndHold(const scene::Scene& scene, const Eigen::Vector3d& d,
+                        const Eigen::Quaterniond& q, double speed, double guard_N, Motion& m) {
   m.moves.push_back(MoveBy(scene, d, q, speed, guard_N));
   m.moves.push_back(MoveBy(scene, Eigen::Vector3d::Zero(), q, speed, 0.0));
   m.moves.back().min_ticks = 100;
 }
 
-// An aim at the goal's contacts together, for a goal of two or more PCs (a tube lying in a
-// corner, or on a floor with its end against a wall): the straight tube posed clear of every
-// goal element by the same gap, its axis along each face its side is to lie on and into the one
-// its end is to meet, brought in along the sum of their inward normals so that it touches them
-// together, held there, then pressed and backed off. Between facing faces (a slot), or where
-// that pose is not clear, the tube is set down on the lowest-facing goal face short of the
-// others and slid in along its axis.
+// The straight tube clear of every goal element by the same gap, brought in along the sum of
+// their inward normals so that it meets them together (a tube lying in a corner, or on a floor
+// with its end against a wall), held at the first light touch, pressed and backed off. None
+// where that sum does not close on every element (facing faces) or no pose is clear.
+std::optional<Motion> ApproachTogether(const scene::Scene& scene, core::Core& probe, const Frame& f,
+                                       const GoalPose& g, const ExploreOptions& o) {
+  Eigen::Vector3d push = -g.normals.rowwise().sum();
+  if (push.norm() < 1e-6) return std::nullopt;
+  push.normalize();
+  // Each element's distance falls at this rate along push, or the approach cannot meet it.
+  double slowest = 1.0;
+  for (const GoalPose::Target& t : g.targets) slowest = std::min(slowest, -push.dot(t.n));
+  if (slowest < 0.1) return std::nullopt;
+  // A narrower gap where the wider does not fit (a tube seated in a groove's corner has 2 mm to
+  // spare on the other side).
+  for (const double gap : {scene.contact.threshold_m + 3e-3, scene.contact.threshold_m + 1e-3}) {
+    const double travel = gap / slowest;  // until the last element is within reach
+    const Eigen::Isometry3d X = HandFor(scene, g, g.Tip(scene.tube.outer_radius_m, gap));
+    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    Motion m;
+    m.kind = "aim goal";
+    GoOver(f, X.translation() - travel * push, X.translation(), g.q, o, m);
+    GuardedMoveAndHold(scene, travel * push, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
+    m.moves.push_back(MoveBy(scene, 3e-3 * push, g.q, 0.5 * o.speed_m_per_s, o.push_N));
+    m.moves.push_back(
+        MoveBy(scene, -2.5 * scene.tube.outer_radius_m * push, g.q, o.speed_m_per_s, 0.0));
+    return m;
+  }
+  return std::nullopt;
+}
+
+// The tube set down on the goal face that faces up most, drawn back along its axis by the least
+// whole number of radii (up to its length) that takes it clear, then slid in (guarded at the
+// probing force), held and drawn back: for
+// facing faces (a slot under a bar), where drawing the tube back takes it clear of them. None
+// where no such pose is clear, or no goal face takes the tube's side.
+std::optional<Motion> SlideIn(const scene::Scene& scene, core::Core& probe, const Frame& f,
+                              const GoalPose& g, const ExploreOptions& o) {
+  const auto set_down_on =
+      std::max_element(g.targets.begin(), g.targets.end(), [&](const auto& x, const auto& y) {
+        return x.side < y.side || (x.side == y.side && x.n.dot(f.up) < y.n.dot(f.up));
+      });
+  if (!set_down_on->side) return std::nullopt;
+  const Eigen::Vector3d& n_up = set_down_on->n;
+  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
+  const double eps = scene.contact.threshold_m, gap = eps + 3e-3;
+  const Eigen::Vector3d tip = g.Tip(r, 0.5 * eps);
+  for (double back = r; back <= l; back += r) {
+    const Eigen::Isometry3d X = HandFor(scene, g, tip - back * g.axis + gap * n_up);
+    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    Motion m;
+    m.kind = "aim goal";
+    GoOver(f, X.translation(), X.translation(), g.q, o, m);
+    GuardedMoveAndHold(scene, -gap * n_up, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
+    GuardedMoveAndHold(scene, back * g.axis, g.q, 0.25 * o.speed_m_per_s, o.push_N, m);
+    m.moves.push_back(MoveBy(scene, -back * g.axis, g.q, 0.5 * o.speed_m_per_s, 0.0));
+    m.moves.push_back(MoveBy(scene, 2.5 * r * n_up, g.q, o.speed_m_per_s, 0.0));
+    return m;
+  }
+  return std::nullopt;
+}
+
+// The aim at a goal of two or more PCs as a whole: brought in along the goal faces' normals, else
+// slid in along the tube's axis.
 std::vector<Motion> GoalAims(const scene::Scene& scene, core::Core& probe,
                              const ExploreOptions& o) {
   if (scene.goal.contacts.size() < 2) return {};
   const Frame f = StartFrame(scene);
-  const double l = scene.tube.length_m, r = scene.tube.outer_radius_m;
-  const double eps = scene.contact.threshold_m;
   GoalPose g;
   if (!MakeGoalPose(scene, probe, f, g)) return {};
-  Motion m;
-  m.kind = "aim goal";
-  Eigen::Vector3d push = -g.normals.rowwise().sum();
-  // Clear of every element by the gap; a narrower one where the wider does not fit (a tube
-  // seated in a groove's corner has 2 mm to spare on the other side).
-  for (const double gap : {eps + 3e-3, eps + 1e-3}) {
-    if (push.norm() < 1e-6) break;
-    push.normalize();
-    // How far along push until the last element is within reach.
-    double travel = 0.0;
-    for (const GoalPose::Target& t : g.targets)
-      travel = std::max(travel, gap / std::max(-push.dot(t.n), 0.1));
-    const Eigen::Isometry3d X = HandFor(scene, g, g.Tip(r, gap));
-    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
-    GoOver(f, X.translation(), g.q, o, m);
-    TouchAndHold(scene, travel * push, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
-    m.moves.push_back(MoveBy(scene, 3e-3 * push, g.q, 0.5 * o.speed_m_per_s, o.push_N));
-    m.moves.push_back(MoveBy(scene, -2.5 * r * push, g.q, o.speed_m_per_s, 0.0));
-    return {m};
-  }
-  // Set down on the goal face that faces up most, drawn back along the axis by half the tube or
-  // all of it, then slid in.
-  const auto lowest =
-      std::max_element(g.targets.begin(), g.targets.end(), [&](const auto& x, const auto& y) {
-        return x.side < y.side || (x.side == y.side && x.n.dot(f.up) < y.n.dot(f.up));
-      });
-  if (!lowest->side) return {};
-  const Eigen::Vector3d& n_up = lowest->n;
-  const double gap = eps + 3e-3;
-  const Eigen::Vector3d tip = g.Tip(r, 0.5 * eps);
-  for (const double back : {0.5 * l, l}) {
-    const Eigen::Isometry3d X = HandFor(scene, g, tip - back * g.axis + gap * n_up);
-    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
-    GoOver(f, X.translation(), g.q, o, m);
-    TouchAndHold(scene, -gap * n_up, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
-    TouchAndHold(scene, back * g.axis, g.q, 0.25 * o.speed_m_per_s, o.push_N, m);
-    m.moves.push_back(MoveBy(scene, -back * g.axis, g.q, 0.5 * o.speed_m_per_s, 0.0));
-    m.moves.push_back(MoveBy(scene, 2.5 * r * n_up, g.q, o.speed_m_per_s, 0.0));
-    return {m};
-  }
-  return {};
+  std::optional<Motion> m = ApproachTogether(scene, probe, f, g, o);
+  if (!m) m = SlideIn(scene, probe, f, g, o);
+  if (!m) return {};
+  return {std::move(*m)};
 }
 
 // Runs motions [first, first + count) of `motions` on `jobs` threads, one core pair each; motion
