@@ -467,6 +467,18 @@ scene::ElementPoint PointFacingStart(const scene::Scene& scene, const core::Core
                                f.p0 - part.X_WP * scene::BoundsInPart(part).center());
 }
 
+// From the start to over p at a safe height, turned to q; returns where the hand is then.
+Eigen::Vector3d GoOver(const Frame& f, const Eigen::Vector3d& p, const Eigen::Quaterniond& q,
+                       const ExploreOptions& o, Motion& m) {
+  Eigen::Vector3d above = p;
+  above.z() = std::max(f.p0.z(), p.z());
+  Eigen::Vector3d lift = f.p0;
+  lift.z() = above.z();
+  m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
+  m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
+  return above;
+}
+
 // The force that ends an aim's approach: a touch that bends a soft tube by less than the
 // scene's bend threshold.
 constexpr double kTouchGuard_N = 0.02;
@@ -529,12 +541,7 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
           if (InWorkspace(scene, X_entry.translation()) && FreePose(probe, X_entry))
             entry = X_entry.translation();
         }
-        Eigen::Vector3d above = entry;
-        above.z() = std::max(f.p0.z(), entry.z());
-        Eigen::Vector3d lift = f.p0;
-        lift.z() = above.z();
-        m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
-        m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
+        const Eigen::Vector3d above = GoOver(f, entry, q, o, m);
         if (entry != aim.hand)
           m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
         m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, entry));
@@ -628,18 +635,6 @@ Eigen::Isometry3d HandFor(const scene::Scene& scene, const GoalPose& g,
   return X;
 }
 
-// From the start over `from` at a safe height, and from there to `to`.
-void GoOver(const Frame& f, const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-            const Eigen::Quaterniond& q, const ExploreOptions& o, Motion& m) {
-  Eigen::Vector3d above = from;
-  above.z() = std::max(f.p0.z(), from.z());
-  Eigen::Vector3d lift = f.p0;
-  lift.z() = above.z();
-  m.moves.push_back(MoveTo(lift, f.q0, o.speed_m_per_s, 0.0, f.p0));
-  m.moves.push_back(MoveTo(above, q, o.speed_m_per_s, o.push_N, lift));
-  m.moves.push_back(MoveTo(to, q, 0.5 * o.speed_m_per_s, o.push_N, above));
-}
-
 // A move by d that stops where the force against it passes guard_N, then a hold of 100 ms (so
 // the state there counts).
 void GuardedMoveAndHold(const scene::Scene& scene, const Eigen::Vector3d& d,
@@ -670,7 +665,8 @@ std::optional<Motion> ApproachTogether(const scene::Scene& scene, core::Core& pr
     if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
     Motion m;
     m.kind = "aim goal";
-    GoOver(f, X.translation() - travel * push, X.translation(), g.q, o, m);
+    const Eigen::Vector3d above = GoOver(f, X.translation() - travel * push, g.q, o, m);
+    m.moves.push_back(MoveTo(X.translation(), g.q, 0.5 * o.speed_m_per_s, o.push_N, above));
     GuardedMoveAndHold(scene, travel * push, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
     m.moves.push_back(MoveBy(scene, 3e-3 * push, g.q, 0.5 * o.speed_m_per_s, o.push_N));
     m.moves.push_back(
@@ -701,7 +697,8 @@ std::optional<Motion> SlideIn(const scene::Scene& scene, core::Core& probe, cons
     if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
     Motion m;
     m.kind = "aim goal";
-    GoOver(f, X.translation(), X.translation(), g.q, o, m);
+    const Eigen::Vector3d above = GoOver(f, X.translation(), g.q, o, m);
+    m.moves.push_back(MoveTo(X.translation(), g.q, 0.5 * o.speed_m_per_s, o.push_N, above));
     GuardedMoveAndHold(scene, -gap * n_up, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
     GuardedMoveAndHold(scene, back * g.axis, g.q, 0.25 * o.speed_m_per_s, o.push_N, m);
     m.moves.push_back(MoveBy(scene, -back * g.axis, g.q, 0.5 * o.speed_m_per_s, 0.0));
