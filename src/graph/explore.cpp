@@ -676,11 +676,10 @@ std::optional<Motion> ApproachTogether(const scene::Scene& scene, core::Core& pr
   return std::nullopt;
 }
 
-// The tube set down on the goal face that faces up most, drawn back along its axis by the least
-// whole number of radii (up to its length) that takes it clear, then slid in (guarded at the
-// probing force), held and drawn back: for
-// facing faces (a slot under a bar), where drawing the tube back takes it clear of them. None
-// where no such pose is clear, or no goal face takes the tube's side.
+// For facing faces (a slot under a bar): the tube set down on the goal face that faces up most,
+// drawn back along its axis by the fewest whole radii (up to its length) that take it clear,
+// slid in (guarded at the probing force), held and drawn back. None where no such pose is
+// clear, or no goal face takes the tube's side.
 std::optional<Motion> SlideIn(const scene::Scene& scene, core::Core& probe, const Frame& f,
                               const GoalPose& g, const ExploreOptions& o) {
   const auto set_down_on =
