@@ -837,7 +837,7 @@ ContactGraph SweepsAndAims(const std::string& file, int motions) {
 TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
   struct Case {
     const char* file;
-    int motions;  // the sweeps and aims, and the first probes
+    int motions;  // the sweeps and the first aims (the goal's first), or all and the first probes
     const char* goal;
     // The goal's least operator force at most: set down, not pushed in (the aims stop at the
     // first touch of 0.02 N); and the kind of motion whose stay is its witness, where it must be
@@ -855,14 +855,14 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            // The tube lying straight on a table along a wall: aimed at one face, it bends before
            // it meets the other; the aim at the goal's two PCs together lays it in the corner
            // (measured 0.006 N).
-           Case{"corner.yaml", 100, "{Fs - table.top, Fs - wall.xneg}", 0.1, "aim goal"},
+           Case{"corner.yaml", 60, "{Fs - table.top, Fs - wall.xneg}", 0.1, "aim goal"},
            // The tube lying on a floor, its end face against a step's riser: aimed along the
-           // floor into the riser (0.037 N).
-           Case{"step.yaml", 100, "{Fe - step.yneg, Fs - floor.top}", 0.1, "aim goal"},
+           // floor into the riser, the end's touch a little after the side's (0.11 N).
+           Case{"step.yaml", 40, "{Fe - step.yneg, Fs - floor.top}", 0.2, "aim goal"},
            // The tube lying on a floor under a bar: set down short of the bar and slid in along
            // its axis. Within epsilon of both faces the penalty presses from both sides
            // (0.26 N).
-           Case{"slot.yaml", 100, "{Fs - bar.bottom, Fs - floor.top}", 0.5, "aim goal"},
+           Case{"slot.yaml", 40, "{Fs - bar.bottom, Fs - floor.top}", 0.5, "aim goal"},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
