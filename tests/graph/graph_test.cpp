@@ -857,7 +857,7 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            // (measured 0.006 N).
            Case{"corner.yaml", 60, "{Fs - table.top, Fs - wall.xneg}", 0.1, "aim goal"},
            // The tube lying on a floor, its end face against a step's riser: aimed along the
-           // floor into the riser, the end's touch a little after the side's (0.11 N).
+           // floor into the riser (measured 0.11 N).
            Case{"step.yaml", 40, "{Fe - step.yneg, Fs - floor.top}", 0.2, "aim goal"},
            // The tube lying on a floor under a bar: set down short of the bar and slid in along
            // its axis. Within epsilon of both faces the penalty presses from both sides
