@@ -579,10 +579,9 @@ TEST_CASE("A soft side slid across a narrow wall's top, 3 degrees off its edges,
   // The rubber tube lying along a wall's top 4 mm wide, 3 degrees off the wall's edges, pressed
   // about 1.3 N with friction (mu 0.3), then moved across the top at 10 mm/s until it has rolled
   // over the edge and off. Near parallel, the side's point nearest an edge runs along the tube
-  // many times faster than the nodes move; a share fading out only at 0 degrees would, through
-  // its curvature (left out of the Hessian), make Newton overshoot and stop 38 of these 1200
-  // ticks at the iteration cap. A few ticks where the contact set changes may still take the cap
-  // (one does); seven times fewer than 38 is the bound.
+  // many times faster than the nodes move, and the curvature of its share is left out of the
+  // Hessian: the share is gone by 5 degrees (docs/core.md, "Contact points"). A few ticks where
+  // the contact set changes may still take the iteration cap (one does); 5 is the bound.
   scene::Scene s = RubberScene();
   const double r1 = s.tube.outer_radius_m, l = s.tube.length_m;
   const double yaw = 3.0 * kPi / 180.0;

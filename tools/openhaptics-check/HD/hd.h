@@ -1,7 +1,7 @@
 /* A minimal stand-in for OpenHaptics' HD/hd.h, for a compile check only: it declares just the
  * documented HD API types, constants and calls that src/device/openhaptics.cpp uses, with the
  * signatures of the OpenHaptics 3.4 reference. It is not the SDK (which Debian does not
- * package) and nothing links against it; the constants' values are placeholders. */
+ * package) and nothing links against it; its constants' values are not the SDK's. */
 #ifndef TUBEPLAN_OPENHAPTICS_CHECK_HD_H
 #define TUBEPLAN_OPENHAPTICS_CHECK_HD_H
 
