@@ -382,6 +382,34 @@ const ContactGraph& DefaultGraph(int jobs) {
   return graphs[jobs];
 }
 
+// Two explorations give the same graph: motions, nodes, witnesses and arcs.
+void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
+  CHECK(a.saturated == b.saturated);
+  CHECK(a.closing_rounds == b.closing_rounds);
+  CHECK(a.probed == b.probed);
+  CHECK(a.ticks == b.ticks);
+  REQUIRE(a.motions.size() == b.motions.size());
+  for (std::size_t i = 0; i < a.motions.size(); ++i) CHECK(a.motions[i].kind == b.motions[i].kind);
+  REQUIRE(a.nodes.size() == b.nodes.size());
+  REQUIRE(a.arcs.size() == b.arcs.size());
+  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+    CHECK(a.nodes[i].cf == b.nodes[i].cf);
+    CHECK(a.nodes[i].ticks == b.nodes[i].ticks);
+    CHECK(a.nodes[i].witness.motion == b.nodes[i].witness.motion);
+    CHECK(a.nodes[i].witness.tick == b.nodes[i].witness.tick);
+    CHECK(a.nodes[i].energy_J == b.nodes[i].energy_J);
+    // The stays of least force choose what the closing rounds replay.
+    CHECK(a.nodes[i].min_force_N == b.nodes[i].min_force_N);
+    CHECK(a.nodes[i].X_WH_least.matrix() == b.nodes[i].X_WH_least.matrix());
+  }
+  for (std::size_t i = 0; i < a.arcs.size(); ++i) {
+    CHECK(a.arcs[i].from == b.arcs[i].from);
+    CHECK(a.arcs[i].to == b.arcs[i].to);
+    CHECK(a.arcs[i].count == b.arcs[i].count);
+    CHECK(a.arcs[i].simultaneous == b.arcs[i].simultaneous);
+  }
+}
+
 TEST_CASE("A motion's prefix puts the core where the motion had it, bit for bit",
           "[graph][explore]") {
   const scene::Scene s = Groove();
@@ -508,13 +536,15 @@ TEST_CASE("Resuming runs from snapshots explores the same graph as replaying the
   // Probes of the second round start from stays found by probes of the first, whose runs were
   // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
   // prefix and every refinement from the motion's start (an independent path to the same bits).
-  // The groove's floor alone, explored to saturation.
+  // The groove's floor alone, explored into its second probe round.
   const scene::Scene floor = FloorOnly();
   graph::ExploreOptions o;
   o.random_motions = 0;
   // Probing alone: closing rounds resume their runs the same way and would only add time.
   o.closing_motions = 0;
   o.replay_copies = 0;
+  // The sweeps and aims (45 motions), the first probe round (34) and a part of the second.
+  o.max_motions = 90;
   o.jobs = 2;
   const ContactGraph resumed = graph::Explore(floor, o);
   o.resume_runs = false;
@@ -592,46 +622,21 @@ TEST_CASE("A replayed trajectory puts the hand on it at every move's end", "[gra
   CHECK(chord_m > 1e-6);
 }
 
-TEST_CASE("The floor's default exploration: saturated and closed alike on one thread or two",
-          "[graph][explore]") {
-  // One exploration per thread count, shared by the sections.
-  SECTION("The default exploration saturates, the same from one thread and from two") {
-    const ContactGraph& one = DefaultGraph(1);
-    const ContactGraph& two = DefaultGraph(2);
-    // Saturated within the default budget: every node probed, the last round found no new one.
-    CHECK(one.saturated);
-    CHECK(one.probed == static_cast<int>(one.nodes.size()));
-    CHECK(one.motions.size() < std::size_t(graph::ExploreOptions{}.max_motions));
-    WARN("default exploration: " << one.nodes.size() << " CFs, " << one.arcs.size()
-                                 << " transitions, " << one.motions.size() << " motions, "
-                                 << one.ticks << " ticks; " << one.seconds << " s on 1 thread, "
-                                 << two.seconds << " s on 2");
-    CHECK(one.saturated == two.saturated);
-    CHECK(one.motions.size() == two.motions.size());
-    REQUIRE(one.nodes.size() == two.nodes.size());
-    REQUIRE(one.arcs.size() == two.arcs.size());
-    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
-      CHECK(one.nodes[i].cf == two.nodes[i].cf);
-      CHECK(one.nodes[i].ticks == two.nodes[i].ticks);
-      CHECK(one.nodes[i].witness.tick == two.nodes[i].witness.tick);
-      CHECK(one.nodes[i].energy_J == two.nodes[i].energy_J);
-      // The stays of least force choose what the closing rounds replay.
-      CHECK(one.nodes[i].min_force_N == two.nodes[i].min_force_N);
-      CHECK(one.nodes[i].X_WH_least.matrix() == two.nodes[i].X_WH_least.matrix());
-    }
-    for (std::size_t i = 0; i < one.arcs.size(); ++i) {
-      CHECK(one.arcs[i].from == two.arcs[i].from);
-      CHECK(one.arcs[i].to == two.arcs[i].to);
-      CHECK(one.arcs[i].count == two.arcs[i].count);
-      CHECK(one.arcs[i].simultaneous == two.arcs[i].simultaneous);
-    }
-    CHECK(one.ticks == two.ticks);
-    for (std::size_t i = 0; i < one.motions.size() && i < two.motions.size(); ++i)
-      CHECK(one.motions[i].kind == two.motions[i].kind);
+TEST_CASE("The floor's default exploration saturates and closes", "[graph][explore]") {
+  // One exploration, shared by the sections.
+  SECTION("The default exploration saturates within the default budget") {
+    const ContactGraph& g = DefaultGraph(2);
+    // Every node probed, the last round found no new one.
+    CHECK(g.saturated);
+    CHECK(g.probed == static_cast<int>(g.nodes.size()));
+    CHECK(g.motions.size() < std::size_t(graph::ExploreOptions{}.max_motions));
+    WARN("default exploration: " << g.nodes.size() << " CFs, " << g.arcs.size() << " transitions, "
+                                 << g.motions.size() << " motions, " << g.ticks << " ticks; "
+                                 << g.seconds << " s on 2 threads");
   }
 
   SECTION("Closing rounds go on until one adds no state and no transition") {
-    const ContactGraph& g = DefaultGraph(1);
+    const ContactGraph& g = DefaultGraph(2);
     const graph::ExploreOptions o;
     const int round = o.closing_motions;
     REQUIRE(g.saturated);
@@ -661,7 +666,7 @@ TEST_CASE("The floor's default exploration: saturated and closed alike on one th
   SECTION("Perturbed replays of the candidate plans stay inside the explored graph") {
     const scene::Scene s = ExploredScene();
     const graph::ExploreOptions o;
-    const ContactGraph& g = DefaultGraph(1);
+    const ContactGraph& g = DefaultGraph(2);
     // The closing rounds' own replays, run again as the check runs motions: every state they kept
     // for the dwell, and every transition between two such states, was merged into the graph.
     std::vector<graph::Motion> own;
@@ -693,7 +698,7 @@ TEST_CASE("The floor's default exploration: saturated and closed alike on one th
 
   SECTION("The graph's JSON keeps the moves of the motions its witnesses lie in") {
     const scene::Scene s = ExploredScene();
-    const ContactGraph& g = DefaultGraph(1);
+    const ContactGraph& g = DefaultGraph(2);
     const nlohmann::json j =
         report::GraphToJson(g, s, "floor.yaml", graph::ExploreOptions{}, graph::PruneWeights{});
     // The layout docs/graph.md describes.
@@ -758,28 +763,27 @@ TEST_CASE("The floor's default exploration: saturated and closed alike on one th
 
 }  // namespace
 
-namespace {
-
-// Two explorations give the same graph: nodes, witnesses and arcs.
-void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
-  CHECK(a.motions.size() == b.motions.size());
-  CHECK(a.probed == b.probed);
-  REQUIRE(a.nodes.size() == b.nodes.size());
-  REQUIRE(a.arcs.size() == b.arcs.size());
-  for (std::size_t i = 0; i < a.nodes.size(); ++i) {
-    CHECK(a.nodes[i].cf == b.nodes[i].cf);
-    CHECK(a.nodes[i].ticks == b.nodes[i].ticks);
-    CHECK(a.nodes[i].witness.motion == b.nodes[i].witness.motion);
-    CHECK(a.nodes[i].witness.tick == b.nodes[i].witness.tick);
+TEST_CASE("An exploration is the same on one thread and on two", "[graph][explore]") {
+  SECTION("Sweeps, aims, random motions and probe rounds with refinements: the floor") {
+    REQUIRE(SmallGraph(1).refinements > 0);
+    CheckSameGraph(SmallGraph(1), SmallGraph(2));
   }
-  for (std::size_t i = 0; i < a.arcs.size(); ++i) {
-    CHECK(a.arcs[i].from == b.arcs[i].from);
-    CHECK(a.arcs[i].to == b.arcs[i].to);
-    CHECK(a.arcs[i].count == b.arcs[i].count);
+  SECTION("Saturation, then closing rounds with perturbed replays: the rail's default") {
+    io::SceneLoadResult loaded =
+        io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/rail.yaml");
+    REQUIRE(loaded.scene);
+    graph::ExploreOptions o;
+    o.jobs = 1;
+    const ContactGraph one = graph::Explore(*loaded.scene, o);
+    o.jobs = 2;
+    const ContactGraph two = graph::Explore(*loaded.scene, o);
+    REQUIRE(one.saturated);
+    REQUIRE(one.closing_rounds >= 1);
+    REQUIRE(std::any_of(one.motions.begin(), one.motions.end(),
+                        [](const graph::Motion& m) { return m.kind == "replay"; }));
+    CheckSameGraph(one, two);
   }
 }
-
-}  // namespace
 
 TEST_CASE("The budget bounds the motions exactly, the same on any number of threads",
           "[graph][explore]") {
