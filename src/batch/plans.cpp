@@ -36,10 +36,13 @@ std::string WriteCandidate(plan::Candidate& c, int number, const PlansRequest& r
   c.plan.trajectory = name + ".csv";
   std::ostringstream comment;
   comment << "Candidate " << number << " made by `tubeplan plans " << request.scene_path
-          << "` (seed " << request.seed << "), cost " << c.path->cost
-          << ": the hand moves by minimum jerk through the witnesses of its states. Replayed "
-             "when made: "
-          << plan::VerdictText(c) << ".";
+          << "` (seed " << request.seed << "), ";
+  if (c.from_motion)
+    comment << "the explorer's own motion to the goal: the hand moves as it did, retimed.";
+  else
+    comment << "cost " << c.path.cost
+            << ": the hand moves by minimum jerk through the witnesses of its states.";
+  comment << " Replayed when made: " << plan::VerdictText(c) << ".";
   c.plan.comment = comment.str();
   for (const auto& [file, text] :
        {std::pair{out_dir / (name + ".yaml"), io::FormatPlanYaml(c.plan)},
@@ -48,6 +51,27 @@ std::string WriteCandidate(plan::Candidate& c, int number, const PlansRequest& r
       return file.string() + ": error: " + e;
   }
   return {};
+}
+
+// Fewer feasible candidates than asked: the explorer's own motion to the goal is one more, after
+// the feasible ones if it is feasible, else last; not when a feasible one plans its states.
+void AddMotionCandidate(const PlansRequest& request, const scene::Scene& scene,
+                        const graph::ContactGraph& graph, const plan::CandidateOptions& options,
+                        Plans& plans) {
+  const auto feasible = [](const plan::Candidate& c) { return c.judgement.feasible; };
+  if (std::count_if(plans.candidates.begin(), plans.candidates.end(), feasible) >= request.k)
+    return;
+  std::optional<plan::Candidate> c =
+      plan::MotionCandidate(scene, graph, options, io::TrajectoryAsWritten);
+  // Not again what a feasible candidate already plans.
+  if (!c || std::any_of(plans.candidates.begin(), plans.candidates.end(), [&](const auto& o) {
+        return o.judgement.feasible && o.plan.states == c->plan.states;
+      }))
+    return;
+  const auto at = c->judgement.feasible
+                      ? std::find_if_not(plans.candidates.begin(), plans.candidates.end(), feasible)
+                      : plans.candidates.end();
+  plans.candidates.insert(at, std::move(*c));
 }
 
 }  // namespace
@@ -112,6 +136,7 @@ PlansEnd MakePlans(const PlansRequest& request, const scene::Scene& scene,
   // Each replayed as its file will read: what `evaluate` on the written plan sees.
   plans.candidates =
       plan::MakeCandidates(scene, graph, plans.paths, options, io::TrajectoryAsWritten);
+  AddMotionCandidate(request, scene, graph, options, plans);
   plans.feasible = std::count_if(plans.candidates.begin(), plans.candidates.end(),
                                  [](const plan::Candidate& c) { return c.judgement.feasible; });
   int written = 0;

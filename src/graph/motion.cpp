@@ -179,4 +179,23 @@ const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const T
   return core.last();
 }
 
+std::vector<trajectories::HandSample> HandPath(core::Core& core, const Motion& motion, int tick) {
+  const double step_s = core.scene().model.time_step_s;
+  const Eigen::Isometry3d X_start = MotionStart(core.scene());
+  std::vector<trajectories::HandSample> path;
+  path.reserve(std::size_t(std::max(tick, 0)) + 1);
+  auto add = [&](double t_s, const Eigen::Isometry3d& X_W_hand) {
+    path.push_back({t_s, X_W_hand.translation(), Eigen::Quaterniond(X_W_hand.linear())});
+  };
+  add(0.0, X_start);
+  core.Reset(X_start);
+  MotionRunner runner(motion, X_start, step_s);
+  for (int k = 1; k <= tick && !runner.Done(); ++k) {
+    const Eigen::Isometry3d X = runner.Next(core.last());
+    core.Step(k * step_s, X);
+    add(k * step_s, X);
+  }
+  return path;
+}
+
 }  // namespace tubeplan::graph

@@ -3,6 +3,8 @@
 #include <sstream>
 #include <utility>
 
+#include <tubeplan/core/core.hpp>
+#include <tubeplan/graph/motion.hpp>
 #include <tubeplan/plan/candidates.hpp>
 
 namespace tubeplan::plan {
@@ -14,8 +16,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
   std::vector<Candidate> candidates;
   for (std::size_t i = 0; i < paths.size(); ++i) {
     Candidate c;
-    c.path = &paths[i];
-    for (const int n : c.path->nodes) c.plan.states.push_back(graph.nodes[std::size_t(n)].cf);
+    c.path = paths[i];
+    for (const int n : c.path.nodes) c.plan.states.push_back(graph.nodes[std::size_t(n)].cf);
     c.plan.scene = options.scene_ref;
     c.plan.limits.max_force_N = scene.device.max_force_N;
     c.plan.limits.dwell_s = options.dwell_s;
@@ -25,7 +27,7 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     // out), the feasible one of least peak force kept (else the last tried).
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    const auto aims = graph::DistinctAims(scene, graph, *c.path);
+    const auto aims = graph::DistinctAims(scene, graph, c.path);
     int tried = 0;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =
@@ -53,6 +55,88 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
   return candidates;
 }
 
+namespace {
+
+// The states a replay counted from the start up to its first stay in the goal, each loop cut
+// out (back in a state it had left: the states in between are dropped); empty when the goal
+// was not reached.
+std::vector<std::string> LooplessStatesToGoal(const Judgement& seen, const std::string& goal) {
+  std::vector<std::string> states;
+  for (const Observation& o : seen.observed) {
+    const auto again = std::find(states.begin(), states.end(), o.cf);
+    if (again != states.end()) {
+      states.erase(again + 1, states.end());
+      continue;
+    }
+    states.push_back(o.cf);
+    if (o.cf == goal) return states;
+  }
+  return {};
+}
+
+}  // namespace
+
+std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
+                                         const graph::ContactGraph& graph,
+                                         const CandidateOptions& options,
+                                         const AsWritten& as_written) {
+  if (graph.goal < 0 || graph.start < 0) return std::nullopt;
+  const graph::Node& goal = graph.nodes[std::size_t(graph.goal)];
+  const graph::Motion& motion = graph.motions[std::size_t(goal.witness.motion)];
+  if (motion.moves.empty()) return std::nullopt;
+  core::Core core(scene);
+  std::vector<trajectories::HandSample> hand = graph::HandPath(core, motion, goal.witness.tick);
+  if (hand.size() < 2) return std::nullopt;
+  const std::vector<std::string> ends = {graph.nodes[std::size_t(graph.start)].cf, goal.cf};
+  Limits limits;
+  limits.max_force_N = scene.device.max_force_N;
+  limits.dwell_s = options.dwell_s;
+  // Cut in the middle of the goal's first stay: a motion that left the goal and came back
+  // before its witness would have the plan leave its goal.
+  trajectories::Trajectory own;
+  own.samples = hand;
+  const Judgement run = Judge(scene, own, ends, limits);
+  const auto first = std::find_if(run.observed.begin(), run.observed.end(),
+                                  [&](const Observation& o) { return o.cf == goal.cf; });
+  if (first != run.observed.end() && first + 1 != run.observed.end()) {
+    const double cut_s = 0.5 * (first->t_s + (first + 1)->t_s);
+    const auto end =
+        std::find_if(hand.begin(), hand.end(), [&](const auto& h) { return h.t_s >= cut_s; });
+    hand.erase(end == hand.end() ? end : end + 1, hand.end());
+  }
+  Candidate c;
+  c.from_motion = true;
+  c.plan.scene = options.scene_ref;
+  c.plan.limits = limits;
+  trajectories::SynthesisOptions synthesis = options.synthesis;
+  for (std::size_t k = 0; k <= options.slower.size(); ++k) {
+    synthesis.peak_speed_m_per_s =
+        options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
+    Candidate t = c;
+    t.trajectory = trajectories::RetimeHandPath(hand, synthesis);
+    t.duration_s = t.trajectory.samples.back().t_s;
+    t.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
+    t.tries = int(k) + 1;
+    const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
+    if (read) {
+      // Replayed once to see which states it passes, then judged on them.
+      const Judgement seen = Judge(scene, *read, ends, t.plan.limits);
+      t.plan.states = LooplessStatesToGoal(seen, goal.cf);
+      t.judgement =
+          t.plan.states.empty() ? seen : Judge(scene, *read, t.plan.states, t.plan.limits);
+    }
+    if (t.plan.states.empty()) t.plan.states = ends;
+    c = std::move(t);
+    if (c.judgement.feasible) break;
+  }
+  for (const std::string& cf : c.plan.states) {
+    const auto node = std::find_if(graph.nodes.begin(), graph.nodes.end(),
+                                   [&](const graph::Node& n) { return n.cf == cf; });
+    c.path.nodes.push_back(node == graph.nodes.end() ? -1 : int(node - graph.nodes.begin()));
+  }
+  return c;
+}
+
 std::string FirstFailure(const Judgement& j) {
   for (const TransitionVerdict& v : j.transitions)
     if (v.verdict == Verdict::kInfeasible) return v.from + " -> " + v.to + ": " + v.reason;
@@ -67,7 +151,8 @@ std::string VerdictText(const Candidate& c) {
        << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
   if (c.tries > 1)
     text << " (try " << c.tries << ": "
-         << (c.aim == graph::Aim::kHand   ? "the hand's"
+         << (c.from_motion                ? "the explorer's motion"
+             : c.aim == graph::Aim::kHand ? "the hand's"
              : c.aim == graph::Aim::kHeld ? "the held end's poses"
                                           : "the held end's poses of least force")
          << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";

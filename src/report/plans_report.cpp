@@ -11,8 +11,11 @@ namespace {
 void PrintHeader(std::ostream& t, const batch::PlansRequest& request, const std::string& scene_name,
                  const graph::ContactGraph& g, const batch::Plans& plans) {
   const std::size_t paths = plans.paths.size();
-  t << paths << " candidate plan" << (paths == 1 ? "" : "s") << " (of " << request.k
-    << " asked) through the pruned graph of " << scene_name << " (" << g.nodes.size() << " CFs, "
+  const bool motion = std::any_of(plans.candidates.begin(), plans.candidates.end(),
+                                  [](const plan::Candidate& c) { return c.from_motion; });
+  t << paths << " candidate plan" << (paths == 1 ? "" : "s") << " (of " << request.k << " asked)"
+    << (motion ? " and the explorer's own motion to the goal" : "")
+    << " through the pruned graph of " << scene_name << " (" << g.nodes.size() << " CFs, "
     << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
     << " kept arcs), each replayed as `evaluate` would: " << plans.feasible << " feasible"
     << (request.all || plans.feasible == 0 || plans.feasible == long(plans.candidates.size())
@@ -27,9 +30,14 @@ void PrintHeader(std::ostream& t, const batch::PlansRequest& request, const std:
 
 // One candidate's line: its name (or "(not written)"), cost, length, states and verdict.
 void PrintCandidate(std::ostream& t, const plan::Candidate& c) {
-  t << "  " << (c.plan.name.empty() ? "(not written)" : c.plan.name) << ": cost " << c.path->cost
-    << ", " << c.path->nodes.size() - 1
-    << (c.path->nodes.size() == 2 ? " transition, " : " transitions, ") << c.duration_s << " s:";
+  t << "  " << (c.plan.name.empty() ? "(not written)" : c.plan.name) << ": ";
+  if (c.from_motion)
+    t << "the explorer's motion to the goal";
+  else
+    t << "cost " << c.path.cost;
+  const std::size_t transitions = c.plan.states.size() - 1;
+  t << ", " << transitions << (transitions == 1 ? " transition, " : " transitions, ")
+    << c.duration_s << " s:";
   for (const std::string& state : c.plan.states)
     t << " " << state << (&state == &c.plan.states.back() ? "" : " ->");
   t << "; " << plan::VerdictText(c) << "\n";

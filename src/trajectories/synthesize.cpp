@@ -13,6 +13,44 @@ double MinimumJerk(double u) {
   return u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
 }
 
+namespace {
+
+// The operator's tremor and the device's resolution (SynthesisOptions::tremor_m, quantum_m).
+class OperatorNoise {
+ public:
+  explicit OperatorNoise(const SynthesisOptions& o) : o_(o) {
+    std::seed_seq sequence{static_cast<std::uint32_t>(o.seed),
+                           static_cast<std::uint32_t>(o.seed >> 32)};
+    std::mt19937_64 rng(sequence);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int axis = 0; axis < 3; ++axis) {
+      frequency_[std::size_t(axis)] = 8.0 + 4.0 * unit(rng);
+      phase_[std::size_t(axis)] = 2.0 * std::numbers::pi * unit(rng);
+    }
+  }
+
+  void Apply(HandSample& sample) const {
+    if (o_.tremor_m > 0.0) {
+      for (int axis = 0; axis < 3; ++axis) {
+        sample.p_WH_m[axis] +=
+            o_.tremor_m *
+            std::sin(2.0 * std::numbers::pi * frequency_[std::size_t(axis)] * sample.t_s +
+                     phase_[std::size_t(axis)]);
+      }
+    }
+    if (o_.quantum_m > 0.0) {
+      for (int axis = 0; axis < 3; ++axis)
+        sample.p_WH_m[axis] = o_.quantum_m * std::round(sample.p_WH_m[axis] / o_.quantum_m);
+    }
+  }
+
+ private:
+  const SynthesisOptions& o_;
+  std::array<double, 3> frequency_{}, phase_{};
+};
+
+}  // namespace
+
 Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
                                 const SynthesisOptions& o) {
   Trajectory trajectory;
@@ -32,16 +70,7 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
   }
   const double end_s = start_s.back() + o.hold_s;
 
-  std::seed_seq sequence{static_cast<std::uint32_t>(o.seed),
-                         static_cast<std::uint32_t>(o.seed >> 32)};
-  std::mt19937_64 rng(sequence);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::array<double, 3> frequency{}, phase{};
-  for (int axis = 0; axis < 3; ++axis) {
-    frequency[std::size_t(axis)] = 8.0 + 4.0 * unit(rng);
-    phase[std::size_t(axis)] = 2.0 * std::numbers::pi * unit(rng);
-  }
-
+  const OperatorNoise noise(o);
   const long count = static_cast<long>(std::floor(end_s * o.rate_Hz + 1e-9)) + 1;
   trajectory.samples.reserve(static_cast<std::size_t>(count));
   std::size_t k = 0;
@@ -62,19 +91,39 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
       sample.q_WH = Eigen::Quaterniond(A.linear());
     }
     sample.q_WH.normalize();
-    if (o.tremor_m > 0.0) {
-      for (int axis = 0; axis < 3; ++axis) {
-        sample.p_WH_m[axis] +=
-            o.tremor_m * std::sin(2.0 * std::numbers::pi * frequency[std::size_t(axis)] * t +
-                                  phase[std::size_t(axis)]);
-      }
-    }
-    if (o.quantum_m > 0.0) {
-      for (int axis = 0; axis < 3; ++axis)
-        sample.p_WH_m[axis] = o.quantum_m * std::round(sample.p_WH_m[axis] / o.quantum_m);
-    }
+    noise.Apply(sample);
     trajectory.samples.push_back(sample);
   }
+  return trajectory;
+}
+
+Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& o) {
+  Trajectory trajectory;
+  trajectory.device = "synthetic (tubeplan plans): the explorer's hand path, retimed";
+  trajectory.nominal_rate_Hz = o.rate_Hz;
+  if (path.empty()) return trajectory;
+  double speed_m_per_s = 0.0, turn_rad_per_s = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const double dt_s = path[k].t_s - path[k - 1].t_s;
+    speed_m_per_s = std::max(speed_m_per_s, (path[k].p_WH_m - path[k - 1].p_WH_m).norm() / dt_s);
+    turn_rad_per_s =
+        std::max(turn_rad_per_s, path[k].q_WH.angularDistance(path[k - 1].q_WH) / dt_s);
+  }
+  // The clock stretched so that neither speed nor turn passes its asked peak; a path within
+  // them (or within a millionth of them) keeps its own clock: never quicker than it was made.
+  double scale =
+      std::max({1.0, speed_m_per_s / o.peak_speed_m_per_s, turn_rad_per_s / o.peak_turn_rad_per_s});
+  if (scale < 1.0 + 1e-6) scale = 1.0;
+  Trajectory scaled;
+  scaled.samples.reserve(path.size() + 1);
+  for (const HandSample& s : path)
+    scaled.samples.push_back({(s.t_s - path.front().t_s) * scale, s.p_WH_m, s.q_WH});
+  HandSample last = scaled.samples.back();
+  last.t_s += o.hold_s;
+  scaled.samples.push_back(last);
+  const OperatorNoise noise(o);
+  trajectory.samples = Resample(scaled, 1.0 / o.rate_Hz);
+  for (HandSample& sample : trajectory.samples) noise.Apply(sample);
   return trajectory;
 }
 

@@ -145,8 +145,10 @@ TEST_CASE("graph --check measures the graph against motions it did not make", "[
 }
 
 // Runs `plans` on a shipped scene with 300 motions and checks its best candidate: it replays
-// feasible into `goal`, with a peak operator force in (0, max_peak_N), and evaluate agrees.
-void CheckBestPlanFeasible(const std::string& scene, const std::string& goal, double max_peak_N) {
+// feasible into `goal`, with a peak operator force in (0, max_peak_N), and evaluate agrees on
+// every plan written. Returns what `plans` printed.
+std::string CheckBestPlanFeasible(const std::string& scene, const std::string& goal,
+                                  double max_peak_N) {
   const std::string tag = "plans-" + scene;
   const std::filesystem::path dir = tubeplan::testing::ScratchDir(tag) / "out";
   const Outcome r = RunTool({"plans", SourcePath("scenes/" + scene + ".yaml"), "--budget", "300",
@@ -164,6 +166,15 @@ void CheckBestPlanFeasible(const std::string& scene, const std::string& goal, do
   INFO(judged.out);
   CHECK(judged.exit_code == 0);
   std::filesystem::remove_all(tubeplan::testing::ScratchDir(tag));
+  return r.out;
+}
+
+// The states of a candidate's line of `plans`: "{} -> ... -> GOAL".
+std::string PlannedStates(const std::string& out, const std::string& name) {
+  const std::size_t line = out.find(name + ": ");
+  if (line == std::string::npos) return {};
+  const std::size_t from = out.find(" s: ", line) + 4;
+  return out.substr(from, out.find("; ", from) - from);
 }
 
 TEST_CASE("plans: the pocket scene gives a verified plan that puts the tube's end in",
@@ -286,7 +297,18 @@ TEST_CASE("plans: the clip scene gives a verified plan that lays the tube into a
   // A part read from an OBJ file: the tube lowered between the clip's lips onto its floor. 300
   // motions reach the goal (about 16 s); the best candidate's replay ends there within the
   // device's force, and evaluate agrees.
-  CheckBestPlanFeasible("clip", "{Fs n clip.floor}", 8.5);  // the device's force
+  const std::string out = CheckBestPlanFeasible("clip", "{Fs n clip.floor}", 8.5);
+  // Two of the three paths replay feasible: the explorer's own motion into the clip is tried as
+  // one more, and written (so evaluate judged it feasible above), with states of its own.
+  INFO(out);
+  const std::size_t at = out.find("clip-candidate-3: the explorer's motion to the goal, ");
+  REQUIRE(at != std::string::npos);
+  CHECK(out.substr(at, out.find('\n', at) - at).find("-> {Fs n clip.floor}; feasible") !=
+        std::string::npos);
+  const std::string states = PlannedStates(out, "clip-candidate-3");
+  CHECK(states.starts_with("{} -> "));
+  CHECK(states != PlannedStates(out, "clip-candidate-1"));
+  CHECK(states != PlannedStates(out, "clip-candidate-2"));
 }
 
 TEST_CASE("plans: the tilted groove's two-PC goal gives verified plans on a small budget",

@@ -113,6 +113,56 @@ TEST_CASE("Synthesized trajectories pass through the waypoints at the set speed"
   CHECK(peak_speed >= o.peak_speed_m_per_s * (1 - 1e-3));
 }
 
+TEST_CASE("A recorded hand path is retimed to the asked peak speed and held at its end", "[plan]") {
+  // 200 ms along x at 40 mm/s, turning 0.1 rad about z, then 50 ms still: ticks of 1 ms.
+  std::vector<trajectories::HandSample> path;
+  for (int k = 0; k <= 250; ++k) {
+    const double moving_s = std::min(k, 200) * 1e-3;
+    path.push_back(
+        {k * 1e-3, Eigen::Vector3d(0.04 * moving_s, 0.01, 0.02),
+         Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * moving_s, Eigen::Vector3d::UnitZ()))});
+  }
+  const auto peak = [](const trajectories::Trajectory& t) {
+    double speed = 0.0;
+    for (std::size_t i = 1; i < t.samples.size(); ++i)
+      speed = std::max(speed, (t.samples[i].p_WH_m - t.samples[i - 1].p_WH_m).norm() /
+                                  (t.samples[i].t_s - t.samples[i - 1].t_s));
+    return speed;
+  };
+  trajectories::SynthesisOptions o;
+  // Within the asked peaks the path keeps its clock: the same poses at the same ticks, then the
+  // hold at its end pose.
+  o.peak_speed_m_per_s = 0.08;
+  const trajectories::Trajectory same = trajectories::RetimeHandPath(path, o);
+  REQUIRE(same.samples.size() == path.size() + std::size_t(std::lround(o.hold_s * 1e3)));
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    CHECK(same.samples[k].t_s == path[k].t_s);
+    CHECK(same.samples[k].p_WH_m == path[k].p_WH_m);
+  }
+  CHECK(same.samples.back().p_WH_m == path.back().p_WH_m);
+  CHECK(same.samples.back().q_WH.angularDistance(path.back().q_WH) < 1e-12);
+  // Half the path's speed asked: twice its clock, 400 ms, then the hold.
+  o.peak_speed_m_per_s = 0.02;
+  const trajectories::Trajectory slow = trajectories::RetimeHandPath(path, o);
+  CHECK(slow.samples.back().t_s == Approx(0.5 + o.hold_s).margin(1e-9));
+  CHECK(peak(slow) == Approx(0.02).epsilon(1e-9));
+  CHECK((slow.samples.back().p_WH_m - path.back().p_WH_m).norm() < 1e-15);
+  // A turn faster than asked sets the clock: 0.5 rad/s against 0.125 asked, four times.
+  o.peak_speed_m_per_s = 0.08;
+  o.peak_turn_rad_per_s = 0.125;
+  const trajectories::Trajectory turned = trajectories::RetimeHandPath(path, o);
+  CHECK(turned.samples.back().t_s == Approx(1.0 + o.hold_s).margin(1e-9));
+  CHECK(peak(turned) == Approx(0.01).epsilon(1e-9));
+  // Tremor moves the hand during the hold, within its amplitude.
+  o.tremor_m = 1e-4;
+  const trajectories::Trajectory trembling = trajectories::RetimeHandPath(path, o);
+  double largest_m = 0.0;
+  for (const trajectories::HandSample& s : trembling.samples)
+    if (s.t_s > 1.0) largest_m = std::max(largest_m, (s.p_WH_m - path.back().p_WH_m).norm());
+  CHECK(largest_m <= std::sqrt(3.0) * o.tremor_m);
+  CHECK(largest_m > 0.5 * o.tremor_m);
+}
+
 TEST_CASE("Synthesized trajectories round-trip through the CSV format; quantised and trembling",
           "[plan]") {
   std::vector<Eigen::Isometry3d> waypoints(2, Eigen::Isometry3d::Identity());

@@ -1,11 +1,14 @@
 // Candidate plans made from graph paths: each is replayed through the judge aimed at the
 // witnesses' hand poses and at their held end's poses, slower while neither is feasible; the
 // feasible try of least force is kept, and the feasible candidates come first.
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
 
+#include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/motion.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/plan/candidates.hpp>
 
@@ -69,7 +72,7 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   REQUIRE(c.size() == 3);
   // The stretched witness fails aimed at the hand's pose and replays feasible aimed at the held
   // end's, at the asked speed; the feasible come first in the paths' order.
-  CHECK(c[0].path == &paths[1]);
+  CHECK(c[0].path.nodes == paths[1].nodes);
   CHECK(c[0].judgement.feasible);
   CHECK(c[0].tries == 2);
   CHECK(c[0].aim == graph::Aim::kHeld);
@@ -77,7 +80,7 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   CHECK(c[0].judgement.peak_force_N < 1.0);
   // The reachable witness replays feasible at once: its hand and held end are at one pose, so
   // the held aim coincides with the hand's and is not tried again.
-  CHECK(c[1].path == &paths[2]);
+  CHECK(c[1].path.nodes == paths[2].nodes);
   CHECK(c[1].judgement.feasible);
   CHECK(c[1].tries == 1);
   CHECK(c[1].aim == graph::Aim::kHand);
@@ -86,7 +89,7 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   // The witness whose tube was pushed through the floor too (hand and held end at one pose,
   // one aim) stays infeasible after all three speeds, at the device's limit, with the slowest
   // try's longer trajectory.
-  CHECK(c[2].path == &paths[0]);
+  CHECK(c[2].path.nodes == paths[0].nodes);
   CHECK_FALSE(c[2].judgement.feasible);
   CHECK(c[2].tries == 3);
   CHECK(c[2].aim == graph::Aim::kHand);
@@ -160,4 +163,50 @@ TEST_CASE("Candidates: a state's stay of least force is aimed at as another witn
   CHECK(c[0].judgement.peak_force_N < 1.0);
   CHECK(plan::VerdictText(c[0]).find("(try 2: the held end's poses of least force at 80 mm/s)") !=
         std::string::npos);
+}
+
+TEST_CASE("Candidates: the explorer's own motion to the goal is a feasible plan",
+          "[plan][explore]") {
+  // The tube slid under a bar onto the floor beneath: the explorer's aim reaches the goal in its
+  // first 40 motions, through states where the tube's end catches the bar's edge and bends.
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/scenes/slot.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  graph::ExploreOptions explore;
+  explore.max_motions = 40;
+  explore.jobs = 2;
+  const graph::ContactGraph g = graph::Explore(scene, explore);
+  REQUIRE(g.goal >= 0);
+  const graph::Node& goal = g.nodes[std::size_t(g.goal)];
+  plan::CandidateOptions options;
+  options.synthesis.peak_speed_m_per_s = explore.speed_m_per_s;
+  options.dwell_s = explore.dwell_s;
+  options.scene_ref = "slot.yaml";
+  const auto as_is = [](const trajectories::Trajectory& t) {
+    return std::optional<trajectories::Trajectory>(t);
+  };
+  const std::optional<plan::Candidate> c = plan::MotionCandidate(scene, g, options, as_is);
+  REQUIRE(c);
+  INFO(plan::VerdictText(*c));
+  CHECK(c->from_motion);
+  CHECK(c->judgement.feasible);
+  CHECK(c->tries == 1);
+  // Its states: from the start to the goal, each once, each a state of the graph.
+  REQUIRE(c->plan.states.size() >= 3);
+  CHECK(c->plan.states.front() == g.nodes[std::size_t(g.start)].cf);
+  CHECK(c->plan.states.back() == goal.cf);
+  for (std::size_t i = 0; i < c->plan.states.size(); ++i)
+    CHECK(std::count(c->plan.states.begin(), c->plan.states.end(), c->plan.states[i]) == 1);
+  CHECK(std::count(c->path.nodes.begin(), c->path.nodes.end(), -1) == 0);
+  // At the explorer's speed the hand moves as the explorer's did, tick for tick, and the operator
+  // force stays within the explorer's limit, as it did there.
+  core::Core core(scene);
+  const std::vector<trajectories::HandSample> hand =
+      graph::HandPath(core, g.motions[std::size_t(goal.witness.motion)], goal.witness.tick);
+  const std::size_t moving = c->trajectory.samples.size() - 300;
+  REQUIRE(moving <= hand.size());
+  for (std::size_t k = 0; k < moving; k += 7)
+    CHECK(c->trajectory.samples[k].p_WH_m == hand[k].p_WH_m);
+  CHECK(c->judgement.peak_force_N <= graph::ExploreForceLimit(scene, explore));
 }

@@ -130,6 +130,11 @@ std::string RestingFormation(const scene::Scene& scene);
 /// returns the last step's output. The core is left in that state.
 const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const TickRef& ref);
 
+/// The hand's path along `motion` up to tick `tick`, as a run through `core` moves it (its
+/// guards stop moves where the core's forces say): sample k is the hand's pose at tick k, at
+/// t = k T, sample 0 the start pose. Replayed as a trajectory, it runs the core as the motion did.
+std::vector<trajectories::HandSample> HandPath(core::Core& core, const Motion& motion, int tick);
+
 /// Runs ticks 1 .. tick-1 of `motion`, then splits the hand's step of `tick` into `substeps`
 /// sub-ticks and runs them, calling on_substep(j, output) after sub-tick j; stops when it
 /// returns false. ReplayTo uses it, so a refined witness replays bit for bit. With `from` (a

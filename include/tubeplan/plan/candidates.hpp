@@ -37,7 +37,9 @@ struct CandidateOptions {
 };
 
 struct Candidate {
-  const graph::Path* path = nullptr;
+  graph::Path path;  ///< the searched path; for a motion candidate, its states' nodes and no cost
+  /// The explorer's own motion to the goal (MotionCandidate), not a path through the graph.
+  bool from_motion = false;
   Plan plan;  ///< name, trajectory and comment left to the writer
   trajectories::Trajectory trajectory;
   double duration_s = 0.0;
@@ -58,6 +60,17 @@ using AsWritten =
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options, const AsWritten& as_written);
+
+/// The motion the explorer reached the goal's witness with, as a candidate: the hand's path of
+/// that motion up to the witness (graph::HandPath), retimed to the asked peak speed
+/// (trajectories::RetimeHandPath), then slower as MakeCandidates tries; its states are those the
+/// replay counts on the way, loops cut. A repair for a goal no searched path reaches: the
+/// explorer got there within its force limit, so this way exists. Nothing when the graph has
+/// no goal or the witness's motion kept no moves.
+std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
+                                         const graph::ContactGraph& graph,
+                                         const CandidateOptions& options,
+                                         const AsWritten& as_written);
 
 /// "FROM -> TO: reason" of the first infeasible transition, or what stopped the judgement.
 std::string FirstFailure(const Judgement& judgement);

@@ -38,4 +38,10 @@ double MinimumJerk(double u);
 Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
                                 const SynthesisOptions& options);
 
+/// A recorded hand path (samples at strictly increasing times) as a plan's trajectory: its clock
+/// stretched so that neither its speed nor its turn rate passes the options' peaks (a path within
+/// them keeps its clock: never quicker than it was made), held `hold_s` at its end, resampled at
+/// `rate_Hz`, with the options' tremor and quantum.
+Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& options);
+
 }  // namespace tubeplan::trajectories
