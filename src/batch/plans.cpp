@@ -38,7 +38,8 @@ std::string WriteCandidate(plan::Candidate& c, int number, const PlansRequest& r
   comment << "Candidate " << number << " made by `tubeplan plans " << request.scene_path
           << "` (seed " << request.seed << "), ";
   if (c.from_motion)
-    comment << "the explorer's own motion to the goal: the hand moves as it did, retimed.";
+    comment << "the explorer's own motion to the goal: the hand moves as it did, its clock "
+               "stretched where it moved faster than the asked speed.";
   else
     comment << "cost " << c.path.cost
             << ": the hand moves by minimum jerk through the witnesses of its states.";
@@ -61,8 +62,11 @@ void AddMotionCandidate(const PlansRequest& request, const scene::Scene& scene,
   const auto feasible = [](const plan::Candidate& c) { return c.judgement.feasible; };
   if (std::count_if(plans.candidates.begin(), plans.candidates.end(), feasible) >= request.k)
     return;
+  // Its own tremor, as each path's has (MakeCandidates offsets the seed by the path's rank).
+  plan::CandidateOptions own = options;
+  own.synthesis.seed += plans.paths.size();
   std::optional<plan::Candidate> c =
-      plan::MotionCandidate(scene, graph, options, io::TrajectoryAsWritten);
+      plan::MotionCandidate(scene, graph, own, io::TrajectoryAsWritten);
   // Not again what a feasible candidate already plans.
   if (!c || std::any_of(plans.candidates.begin(), plans.candidates.end(), [&](const auto& o) {
         return o.judgement.feasible && o.plan.states == c->plan.states;
@@ -85,7 +89,8 @@ bool PlanFilesApart(const PlansRequest& request, std::ostream& err) {
   if (!scene.scene) return true;
   const fs::path dir = PlansDir(request, scene.scene->name);
   std::vector<io::RolePath> outputs;
-  for (int i = 1; i <= request.k; ++i) {
+  // k paths and, with --all, the explorer's motion after them.
+  for (int i = 1; i <= request.k + 1; ++i) {
     const std::string name = CandidateName(scene.scene->name, i);
     outputs.push_back({"the plan file", dir / (name + ".yaml")});
     outputs.push_back({"the plan's trajectory", dir / (name + ".csv")});

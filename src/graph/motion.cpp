@@ -191,9 +191,9 @@ std::vector<trajectories::HandSample> HandPath(core::Core& core, const Motion& m
   core.Reset(X_start);
   MotionRunner runner(motion, X_start, step_s);
   for (int k = 1; k <= tick && !runner.Done(); ++k) {
-    const Eigen::Isometry3d X = runner.Next(core.last());
-    core.Step(k * step_s, X);
-    add(k * step_s, X);
+    const Eigen::Isometry3d X_W_hand = runner.Next(core.last());
+    core.Step(k * step_s, X_W_hand);
+    add(k * step_s, X_W_hand);
   }
   return path;
 }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <iomanip>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -55,23 +56,33 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
   return candidates;
 }
 
-namespace {
-
-// The states a replay counted from the start up to its first stay in the goal, each loop cut
-// out (back in a state it had left: the states in between are dropped); empty when the goal
-// was not reached.
-std::vector<std::string> LooplessStatesToGoal(const Judgement& seen, const std::string& goal) {
+std::vector<std::string> StatesToGoal(const Judgement& seen, const std::string& goal) {
   std::vector<std::string> states;
+  std::set<std::string> cut;
   for (const Observation& o : seen.observed) {
+    if (cut.contains(o.cf)) continue;
     const auto again = std::find(states.begin(), states.end(), o.cf);
     if (again != states.end()) {
+      cut.insert(again + 1, states.end());
       states.erase(again + 1, states.end());
       continue;
     }
     states.push_back(o.cf);
-    if (o.cf == goal) return states;
+    if (o.cf == goal) break;
   }
-  return {};
+  if (states.size() < 2 || states.back() != goal) return {};
+  return states;
+}
+
+namespace {
+
+// The largest speed between consecutive samples [m/s].
+double PeakSpeed(const trajectories::Trajectory& t) {
+  double peak_m_per_s = 0.0;
+  for (std::size_t i = 1; i < t.samples.size(); ++i)
+    peak_m_per_s = std::max(peak_m_per_s, (t.samples[i].p_WH_m - t.samples[i - 1].p_WH_m).norm() /
+                                              (t.samples[i].t_s - t.samples[i - 1].t_s));
+  return peak_m_per_s;
 }
 
 }  // namespace
@@ -80,7 +91,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
                                          const graph::ContactGraph& graph,
                                          const CandidateOptions& options,
                                          const AsWritten& as_written) {
-  if (graph.goal < 0 || graph.start < 0) return std::nullopt;
+  if (graph.goal < 0 || graph.start < 0 || graph.goal == graph.start) return std::nullopt;
   const graph::Node& goal = graph.nodes[std::size_t(graph.goal)];
   const graph::Motion& motion = graph.motions[std::size_t(goal.witness.motion)];
   if (motion.moves.empty()) return std::nullopt;
@@ -91,8 +102,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
   Limits limits;
   limits.max_force_N = scene.device.max_force_N;
   limits.dwell_s = options.dwell_s;
-  // Cut in the middle of the goal's first stay: a motion that left the goal and came back
-  // before its witness would have the plan leave its goal.
+  // Cut in the middle of the goal's first stay, so that the plan ends in its goal.
   trajectories::Trajectory own;
   own.samples = hand;
   const Judgement run = Judge(scene, own, ends, limits);
@@ -108,20 +118,21 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
   c.from_motion = true;
   c.plan.scene = options.scene_ref;
   c.plan.limits = limits;
+  // On the scene's step, as the explorer ran it.
   trajectories::SynthesisOptions synthesis = options.synthesis;
+  synthesis.rate_Hz = 1.0 / scene.model.time_step_s;
   for (std::size_t k = 0; k <= options.slower.size(); ++k) {
-    synthesis.peak_speed_m_per_s =
-        options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
     Candidate t = c;
-    t.trajectory = trajectories::RetimeHandPath(hand, synthesis);
+    t.trajectory =
+        trajectories::RetimeHandPath(hand, synthesis, k > 0 ? options.slower[k - 1] : 1.0);
     t.duration_s = t.trajectory.samples.back().t_s;
-    t.peak_speed_m_per_s = synthesis.peak_speed_m_per_s;
+    t.peak_speed_m_per_s = PeakSpeed(t.trajectory);
     t.tries = int(k) + 1;
     const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
     if (read) {
       // Replayed once to see which states it passes, then judged on them.
       const Judgement seen = Judge(scene, *read, ends, t.plan.limits);
-      t.plan.states = LooplessStatesToGoal(seen, goal.cf);
+      t.plan.states = StatesToGoal(seen, goal.cf);
       t.judgement =
           t.plan.states.empty() ? seen : Judge(scene, *read, t.plan.states, t.plan.limits);
     }

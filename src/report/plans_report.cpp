@@ -13,11 +13,11 @@ void PrintHeader(std::ostream& t, const batch::PlansRequest& request, const std:
   const std::size_t paths = plans.paths.size();
   const bool motion = std::any_of(plans.candidates.begin(), plans.candidates.end(),
                                   [](const plan::Candidate& c) { return c.from_motion; });
-  t << paths << " candidate plan" << (paths == 1 ? "" : "s") << " (of " << request.k << " asked)"
-    << (motion ? " and the explorer's own motion to the goal" : "")
-    << " through the pruned graph of " << scene_name << " (" << g.nodes.size() << " CFs, "
+  t << paths << " candidate plan" << (paths == 1 ? "" : "s") << " (of " << request.k
+    << " asked) through the pruned graph of " << scene_name << " (" << g.nodes.size() << " CFs, "
     << std::count_if(g.arcs.begin(), g.arcs.end(), [](const auto& a) { return a.kept; })
-    << " kept arcs), each replayed as `evaluate` would: " << plans.feasible << " feasible"
+    << " kept arcs)" << (motion ? " and the explorer's own motion to the goal" : "")
+    << ", each replayed as `evaluate` would: " << plans.feasible << " feasible"
     << (request.all || plans.feasible == 0 || plans.feasible == long(plans.candidates.size())
             ? ""
             : " (the others are not written; --all writes them, marked)")
@@ -35,7 +35,7 @@ void PrintCandidate(std::ostream& t, const plan::Candidate& c) {
     t << "the explorer's motion to the goal";
   else
     t << "cost " << c.path.cost;
-  const std::size_t transitions = c.plan.states.size() - 1;
+  const std::size_t transitions = c.plan.states.empty() ? 0 : c.plan.states.size() - 1;
   t << ", " << transitions << (transitions == 1 ? " transition, " : " transitions, ")
     << c.duration_s << " s:";
   for (const std::string& state : c.plan.states)

@@ -18,7 +18,8 @@ namespace {
 // The operator's tremor and the device's resolution (SynthesisOptions::tremor_m, quantum_m).
 class OperatorNoise {
  public:
-  explicit OperatorNoise(const SynthesisOptions& o) : o_(o) {
+  explicit OperatorNoise(const SynthesisOptions& o)
+      : tremor_m_(o.tremor_m), quantum_m_(o.quantum_m) {
     std::seed_seq sequence{static_cast<std::uint32_t>(o.seed),
                            static_cast<std::uint32_t>(o.seed >> 32)};
     std::mt19937_64 rng(sequence);
@@ -30,22 +31,21 @@ class OperatorNoise {
   }
 
   void Apply(HandSample& sample) const {
-    if (o_.tremor_m > 0.0) {
+    if (tremor_m_ > 0.0) {
       for (int axis = 0; axis < 3; ++axis) {
-        sample.p_WH_m[axis] +=
-            o_.tremor_m *
-            std::sin(2.0 * std::numbers::pi * frequency_[std::size_t(axis)] * sample.t_s +
-                     phase_[std::size_t(axis)]);
+        sample.p_WH_m[axis] += tremor_m_ * std::sin(2.0 * std::numbers::pi *
+                                                        frequency_[std::size_t(axis)] * sample.t_s +
+                                                    phase_[std::size_t(axis)]);
       }
     }
-    if (o_.quantum_m > 0.0) {
+    if (quantum_m_ > 0.0) {
       for (int axis = 0; axis < 3; ++axis)
-        sample.p_WH_m[axis] = o_.quantum_m * std::round(sample.p_WH_m[axis] / o_.quantum_m);
+        sample.p_WH_m[axis] = quantum_m_ * std::round(sample.p_WH_m[axis] / quantum_m_);
     }
   }
 
  private:
-  const SynthesisOptions& o_;
+  double tremor_m_, quantum_m_;
   std::array<double, 3> frequency_{}, phase_{};
 };
 
@@ -97,7 +97,8 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
   return trajectory;
 }
 
-Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& o) {
+Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& o,
+                          double stretch) {
   Trajectory trajectory;
   trajectory.device = "synthetic (tubeplan plans): the explorer's hand path, retimed";
   trajectory.nominal_rate_Hz = o.rate_Hz;
@@ -109,18 +110,21 @@ Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptio
     turn_rad_per_s =
         std::max(turn_rad_per_s, path[k].q_WH.angularDistance(path[k - 1].q_WH) / dt_s);
   }
-  // The clock stretched so that neither speed nor turn passes its asked peak; a path within
-  // them (or within a millionth of them) keeps its own clock: never quicker than it was made.
+  // The clock stretched so that neither speed nor turn passes its asked peak, never shrunk; a
+  // move made at the asked speed reads a millionth faster from rounding and keeps its clock.
   double scale =
       std::max({1.0, speed_m_per_s / o.peak_speed_m_per_s, turn_rad_per_s / o.peak_turn_rad_per_s});
   if (scale < 1.0 + 1e-6) scale = 1.0;
+  scale *= stretch;
   Trajectory scaled;
   scaled.samples.reserve(path.size() + 1);
   for (const HandSample& s : path)
     scaled.samples.push_back({(s.t_s - path.front().t_s) * scale, s.p_WH_m, s.q_WH});
-  HandSample last = scaled.samples.back();
-  last.t_s += o.hold_s;
-  scaled.samples.push_back(last);
+  if (o.hold_s > 0.0) {
+    HandSample last = scaled.samples.back();
+    last.t_s += o.hold_s;
+    scaled.samples.push_back(last);
+  }
   const OperatorNoise noise(o);
   trajectory.samples = Resample(scaled, 1.0 / o.rate_Hz);
   for (HandSample& sample : trajectory.samples) noise.Apply(sample);

@@ -354,8 +354,7 @@ scene::Scene FloorOnly() {
 }
 
 // The scene the exploration tests explore: the floor alone runs the same code as the groove
-// (every kind of motion, probe rounds to saturation, refinements, resumed runs) in a fraction
-// of the time (its default exploration: about 35 s on 2 threads).
+// (every kind of motion, probe rounds to saturation, refinements, resumed runs), sooner.
 scene::Scene ExploredScene() { return FloorOnly(); }
 
 // A small exploration, shared by the tests below (it costs seconds).

@@ -122,12 +122,15 @@ TEST_CASE("A recorded hand path is retimed to the asked peak speed and held at i
         {k * 1e-3, Eigen::Vector3d(0.04 * moving_s, 0.01, 0.02),
          Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * moving_s, Eigen::Vector3d::UnitZ()))});
   }
-  const auto peak = [](const trajectories::Trajectory& t) {
-    double speed = 0.0;
+  // The largest speed between samples [m/s]. Times and speeds below are exact up to rounding
+  // of a few operations on millisecond ticks: 1e-9 relative.
+  const auto peak_m_per_s = [](const trajectories::Trajectory& t) {
+    double speed_m_per_s = 0.0;
     for (std::size_t i = 1; i < t.samples.size(); ++i)
-      speed = std::max(speed, (t.samples[i].p_WH_m - t.samples[i - 1].p_WH_m).norm() /
-                                  (t.samples[i].t_s - t.samples[i - 1].t_s));
-    return speed;
+      speed_m_per_s =
+          std::max(speed_m_per_s, (t.samples[i].p_WH_m - t.samples[i - 1].p_WH_m).norm() /
+                                      (t.samples[i].t_s - t.samples[i - 1].t_s));
+    return speed_m_per_s;
   };
   trajectories::SynthesisOptions o;
   // Within the asked peaks the path keeps its clock: the same poses at the same ticks, then the
@@ -140,20 +143,26 @@ TEST_CASE("A recorded hand path is retimed to the asked peak speed and held at i
     CHECK(same.samples[k].p_WH_m == path[k].p_WH_m);
   }
   CHECK(same.samples.back().p_WH_m == path.back().p_WH_m);
+  // Its orientation passes through slerp: the same up to rounding.
   CHECK(same.samples.back().q_WH.angularDistance(path.back().q_WH) < 1e-12);
   // Half the path's speed asked: twice its clock, 400 ms, then the hold.
   o.peak_speed_m_per_s = 0.02;
   const trajectories::Trajectory slow = trajectories::RetimeHandPath(path, o);
   CHECK(slow.samples.back().t_s == Approx(0.5 + o.hold_s).margin(1e-9));
-  CHECK(peak(slow) == Approx(0.02).epsilon(1e-9));
-  CHECK((slow.samples.back().p_WH_m - path.back().p_WH_m).norm() < 1e-15);
+  CHECK(peak_m_per_s(slow) == Approx(0.02).epsilon(1e-9));
+  CHECK(slow.samples.back().p_WH_m == path.back().p_WH_m);
   // A turn faster than asked sets the clock: 0.5 rad/s against 0.125 asked, four times.
   o.peak_speed_m_per_s = 0.08;
   o.peak_turn_rad_per_s = 0.125;
   const trajectories::Trajectory turned = trajectories::RetimeHandPath(path, o);
   CHECK(turned.samples.back().t_s == Approx(1.0 + o.hold_s).margin(1e-9));
-  CHECK(peak(turned) == Approx(0.01).epsilon(1e-9));
-  // Tremor moves the hand during the hold, within its amplitude.
+  CHECK(peak_m_per_s(turned) == Approx(0.01).epsilon(1e-9));
+  // A slower try stretches it further: three times the turned clock.
+  const trajectories::Trajectory slower = trajectories::RetimeHandPath(path, o, 3.0);
+  CHECK(slower.samples.back().t_s == Approx(3.0 + o.hold_s).margin(1e-9));
+  CHECK(peak_m_per_s(slower) == Approx(0.01 / 3.0).epsilon(1e-9));
+  // Tremor moves the hand during the hold, within its amplitude on each axis; the 0.3 s hold
+  // spans at least 2.4 periods of 8-12 Hz, so each axis passes half its amplitude.
   o.tremor_m = 1e-4;
   const trajectories::Trajectory trembling = trajectories::RetimeHandPath(path, o);
   double largest_m = 0.0;

@@ -199,14 +199,44 @@ TEST_CASE("Candidates: the explorer's own motion to the goal is a feasible plan"
   for (std::size_t i = 0; i < c->plan.states.size(); ++i)
     CHECK(std::count(c->plan.states.begin(), c->plan.states.end(), c->plan.states[i]) == 1);
   CHECK(std::count(c->path.nodes.begin(), c->path.nodes.end(), -1) == 0);
-  // At the explorer's speed the hand moves as the explorer's did, tick for tick, and the operator
-  // force stays within the explorer's limit, as it did there.
+  // At the explorer's speed the hand moves as the explorer's did, tick for tick (every 7th tick
+  // compared: the run is about 6000 ticks), up to the middle of the goal's first stay, at or
+  // before the witness's tick; then it holds, and the replay ends in the goal.
   core::Core core(scene);
   const std::vector<trajectories::HandSample> hand =
       graph::HandPath(core, g.motions[std::size_t(goal.witness.motion)], goal.witness.tick);
-  const std::size_t moving = c->trajectory.samples.size() - 300;
+  const std::size_t held = std::size_t(std::lround(options.synthesis.hold_s * 1e3));
+  REQUIRE(c->trajectory.samples.size() > held);
+  const std::size_t moving = c->trajectory.samples.size() - held;
   REQUIRE(moving <= hand.size());
-  for (std::size_t k = 0; k < moving; k += 7)
+  for (std::size_t k = 0; k < moving; k += 7) {
+    CHECK(c->trajectory.samples[k].t_s == hand[k].t_s);
     CHECK(c->trajectory.samples[k].p_WH_m == hand[k].p_WH_m);
+    CHECK(c->trajectory.samples[k].q_WH.angularDistance(hand[k].q_WH) == 0.0);
+  }
+  CHECK(c->judgement.observed.back().cf == goal.cf);
+  // The operator force stays within the explorer's limit, as it did there.
   CHECK(c->judgement.peak_force_N <= graph::ExploreForceLimit(scene, explore));
+}
+
+TEST_CASE("Candidates: a run's states to its goal, each loop cut out for good", "[plan]") {
+  const auto seen = [](std::initializer_list<const char*> cfs) {
+    plan::Judgement j;
+    double t_s = 0.0;
+    for (const char* cf : cfs) j.observed.push_back({t_s += 0.1, cf});
+    return j;
+  };
+  using States = std::vector<std::string>;
+  // Straight there.
+  CHECK(plan::StatesToGoal(seen({"A", "B", "G"}), "G") == States{"A", "B", "G"});
+  // Back in B: C is cut, and when C comes again it is a detour, not a planned state (planned
+  // after D it would be met before D, and the judge would fail the run).
+  CHECK(plan::StatesToGoal(seen({"A", "B", "C", "B", "D", "C", "G"}), "G") ==
+        States{"A", "B", "D", "G"});
+  // Back at the start: everything since is cut.
+  CHECK(plan::StatesToGoal(seen({"A", "B", "A", "B", "C", "G", "B"}), "G") ==
+        States{"A", "C", "G"});
+  // The goal not reached, or the run starting in it: no plan.
+  CHECK(plan::StatesToGoal(seen({"A", "B", "C"}), "G").empty());
+  CHECK(plan::StatesToGoal(seen({"G", "A"}), "G").empty());
 }

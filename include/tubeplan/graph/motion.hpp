@@ -131,8 +131,8 @@ std::string RestingFormation(const scene::Scene& scene);
 const core::StepOutput& ReplayTo(core::Core& core, const Motion& motion, const TickRef& ref);
 
 /// The hand's path along `motion` up to tick `tick`, as a run through `core` moves it (its
-/// guards stop moves where the core's forces say): sample k is the hand's pose at tick k, at
-/// t = k T, sample 0 the start pose. Replayed as a trajectory, it runs the core as the motion did.
+/// guards stop moves where the core's forces say): sample k is the pose the explorer fed the
+/// core at tick k, at t = k T; sample 0 is the start pose.
 std::vector<trajectories::HandSample> HandPath(core::Core& core, const Motion& motion, int tick);
 
 /// Runs ticks 1 .. tick-1 of `motion`, then splits the hand's step of `tick` into `substeps`

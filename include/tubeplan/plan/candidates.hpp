@@ -3,7 +3,8 @@
 // through the witnesses of each path's states, and every candidate is replayed through the same
 // judge as `evaluate`, aimed at the witnesses' hand poses, at their held end's poses and at the
 // held end's poses of the stays of least force, slower while none is feasible; the feasible try
-// of least force is kept (docs/graph.md, "Plans").
+// of least force is kept; and the explorer's own motion into the goal as one more candidate
+// (docs/graph.md, "Plans").
 
 #include <functional>
 #include <optional>
@@ -37,7 +38,9 @@ struct CandidateOptions {
 };
 
 struct Candidate {
-  graph::Path path;  ///< the searched path; for a motion candidate, its states' nodes and no cost
+  /// The searched path; for a motion candidate, its states' nodes (-1: a state the graph lacks)
+  /// and no cost.
+  graph::Path path;
   /// The explorer's own motion to the goal (MotionCandidate), not a path through the graph.
   bool from_motion = false;
   Plan plan;  ///< name, trajectory and comment left to the writer
@@ -61,16 +64,24 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options, const AsWritten& as_written);
 
-/// The motion the explorer reached the goal's witness with, as a candidate: the hand's path of
-/// that motion up to the witness (graph::HandPath), retimed to the asked peak speed
-/// (trajectories::RetimeHandPath), then slower as MakeCandidates tries; its states are those the
-/// replay counts on the way, loops cut. A repair for a goal no searched path reaches: the
-/// explorer got there within its force limit, so this way exists. Nothing when the graph has
-/// no goal or the witness's motion kept no moves.
+/// The motion the explorer reached the goal's witness with, as a candidate: the hand's poses
+/// of that motion as the explorer fed them to the core (graph::HandPath), cut in the middle of
+/// the goal's first stay, on the scene's step and retimed so as not to pass the asked peak
+/// speed (trajectories::RetimeHandPath); each slower try stretches its clock by the next of
+/// `slower`. Its states are StatesToGoal of its replay. Another way into the goal, tried when
+/// the searched paths give too few feasible plans: the explorer's guards kept it within their
+/// limits, and the judge says whether it holds. Nothing when the graph has no goal, starts in
+/// it, or the witness's motion kept no moves.
 std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
                                          const graph::ContactGraph& graph,
                                          const CandidateOptions& options,
                                          const AsWritten& as_written);
+
+/// The states `seen` counted from its start up to its first stay in `goal`, each loop cut out
+/// (back in a state it had left: the states since are dropped, and are never planned again), so
+/// that the judge, on the same run, meets them in order and every other state as a detour.
+/// Empty when the goal is not reached or is the first state.
+std::vector<std::string> StatesToGoal(const Judgement& seen, const std::string& goal);
 
 /// "FROM -> TO: reason" of the first infeasible transition, or what stopped the judgement.
 std::string FirstFailure(const Judgement& judgement);

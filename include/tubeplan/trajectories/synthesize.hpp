@@ -40,8 +40,10 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
 
 /// A recorded hand path (samples at strictly increasing times) as a plan's trajectory: its clock
 /// stretched so that neither its speed nor its turn rate passes the options' peaks (a path within
-/// them keeps its clock: never quicker than it was made), held `hold_s` at its end, resampled at
-/// `rate_Hz`, with the options' tremor and quantum.
-Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& options);
+/// them keeps its clock: never quicker than it was made), then `stretch` (>= 1) times more (a
+/// slower try), held `hold_s` at its end, resampled at `rate_Hz`, with the options' tremor and
+/// quantum.
+Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& options,
+                          double stretch = 1.0);
 
 }  // namespace tubeplan::trajectories
