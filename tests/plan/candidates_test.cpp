@@ -229,8 +229,8 @@ TEST_CASE("Candidates: a run's states to its goal, each loop cut out for good", 
   using States = std::vector<std::string>;
   // Straight there.
   CHECK(plan::StatesToGoal(seen({"A", "B", "G"}), "G") == States{"A", "B", "G"});
-  // Back in B: C is cut, and when C comes again it is a detour, not a planned state (planned
-  // after D it would be met before D, and the judge would fail the run).
+  // Back in B: C is cut, and met again after D it is a detour, not a planned state (the judge
+  // fails a run that meets a planned state before the one planned ahead of it).
   CHECK(plan::StatesToGoal(seen({"A", "B", "C", "B", "D", "C", "G"}), "G") ==
         States{"A", "B", "D", "G"});
   // Back at the start: everything since is cut.
