@@ -39,7 +39,7 @@ std::string WriteCandidate(plan::Candidate& c, int number, const PlansRequest& r
           << "` (seed " << request.seed << "), ";
   if (c.from_motion)
     comment << "the explorer's own motion to the goal: the hand moves as it did, its clock "
-               "stretched where it moved faster than the asked speed.";
+               "stretched if it moved faster than the asked speed.";
   else
     comment << "cost " << c.path.cost
             << ": the hand moves by minimum jerk through the witnesses of its states.";
