@@ -74,19 +74,6 @@ std::vector<std::string> StatesToGoal(const Judgement& seen, const std::string& 
   return states;
 }
 
-namespace {
-
-// The largest speed between consecutive samples [m/s].
-double PeakSpeed(const trajectories::Trajectory& t) {
-  double peak_m_per_s = 0.0;
-  for (std::size_t i = 1; i < t.samples.size(); ++i)
-    peak_m_per_s = std::max(peak_m_per_s, (t.samples[i].p_WH_m - t.samples[i - 1].p_WH_m).norm() /
-                                              (t.samples[i].t_s - t.samples[i - 1].t_s));
-  return peak_m_per_s;
-}
-
-}  // namespace
-
 std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
                                          const graph::ContactGraph& graph,
                                          const CandidateOptions& options,
@@ -126,7 +113,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
     t.trajectory =
         trajectories::RetimeHandPath(hand, synthesis, k > 0 ? options.slower[k - 1] : 1.0);
     t.duration_s = t.trajectory.samples.back().t_s;
-    t.peak_speed_m_per_s = PeakSpeed(t.trajectory);
+    t.peak_speed_m_per_s = trajectories::PeakSpeed(t.trajectory.samples);
     t.tries = int(k) + 1;
     const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
     if (read) {
@@ -140,11 +127,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
     c = std::move(t);
     if (c.judgement.feasible) break;
   }
-  for (const std::string& cf : c.plan.states) {
-    const auto node = std::find_if(graph.nodes.begin(), graph.nodes.end(),
-                                   [&](const graph::Node& n) { return n.cf == cf; });
-    c.path.nodes.push_back(node == graph.nodes.end() ? -1 : int(node - graph.nodes.begin()));
-  }
+  for (const std::string& cf : c.plan.states) c.path.nodes.push_back(graph.FindNode(cf));
   return c;
 }
 

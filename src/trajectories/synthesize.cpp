@@ -97,19 +97,25 @@ Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
   return trajectory;
 }
 
+double PeakSpeed(std::span<const HandSample> samples) {
+  double peak_m_per_s = 0.0;
+  for (std::size_t k = 1; k < samples.size(); ++k)
+    peak_m_per_s = std::max(peak_m_per_s, (samples[k].p_WH_m - samples[k - 1].p_WH_m).norm() /
+                                              (samples[k].t_s - samples[k - 1].t_s));
+  return peak_m_per_s;
+}
+
 Trajectory RetimeHandPath(std::span<const HandSample> path, const SynthesisOptions& o,
                           double stretch) {
   Trajectory trajectory;
   trajectory.device = "synthetic (tubeplan plans): the explorer's hand path, retimed";
   trajectory.nominal_rate_Hz = o.rate_Hz;
   if (path.empty()) return trajectory;
-  double speed_m_per_s = 0.0, turn_rad_per_s = 0.0;
-  for (std::size_t k = 1; k < path.size(); ++k) {
-    const double dt_s = path[k].t_s - path[k - 1].t_s;
-    speed_m_per_s = std::max(speed_m_per_s, (path[k].p_WH_m - path[k - 1].p_WH_m).norm() / dt_s);
-    turn_rad_per_s =
-        std::max(turn_rad_per_s, path[k].q_WH.angularDistance(path[k - 1].q_WH) / dt_s);
-  }
+  const double speed_m_per_s = PeakSpeed(path);
+  double turn_rad_per_s = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k)
+    turn_rad_per_s = std::max(turn_rad_per_s, path[k].q_WH.angularDistance(path[k - 1].q_WH) /
+                                                  (path[k].t_s - path[k - 1].t_s));
   // The clock stretched so that neither speed nor turn passes its asked peak, never shrunk; a
   // move made at the asked speed reads a millionth faster from rounding and keeps its clock.
   double scale =

@@ -38,6 +38,9 @@ double MinimumJerk(double u);
 Trajectory SynthesizeTrajectory(std::span<const Eigen::Isometry3d> waypoints,
                                 const SynthesisOptions& options);
 
+/// The largest hand speed between consecutive samples [m/s] (0 for fewer than two).
+double PeakSpeed(std::span<const HandSample> samples);
+
 /// A recorded hand path (samples at strictly increasing times) as a plan's trajectory: its clock
 /// stretched so that neither its speed nor its turn rate passes the options' peaks (a path within
 /// them keeps its clock: never quicker than it was made), then `stretch` (>= 1) times more (a
