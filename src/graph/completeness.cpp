@@ -87,14 +87,14 @@ std::vector<Completeness> CheckCompleteness(const scene::Scene& scene, const Con
   found.push_back(CheckCompleteness(scene, graph, RandomMotions(scene, seed, 0, count, explore),
                                     explore.dwell_s, limit_N));
   found.back().motions_of = "random guarded motions";
-  const std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists =
-      CandidateWaypoints(scene, graph, explore);
-  if (waypoint_lists.empty()) return found;
-  const int copies = (count + static_cast<int>(waypoint_lists.size()) - 1) /
-                     static_cast<int>(waypoint_lists.size());
-  found.push_back(CheckCompleteness(
-      scene, graph, PerturbedReplays(scene, waypoint_lists, explore, seed, 0, copies),
-      explore.dwell_s, limit_N));
+  const std::vector<trajectories::Trajectory> nominals =
+      CandidateTrajectories(scene, graph, explore);
+  if (nominals.empty()) return found;
+  const int copies =
+      (count + static_cast<int>(nominals.size()) - 1) / static_cast<int>(nominals.size());
+  found.push_back(CheckCompleteness(scene, graph,
+                                    PerturbedReplays(scene, nominals, explore, seed, 0, copies),
+                                    explore.dwell_s, limit_N));
   found.back().motions_of = "perturbed candidate replays";
   return found;
 }

@@ -1127,46 +1127,78 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   return waypoint_lists;
 }
 
-std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
-                                     std::span<const std::vector<Eigen::Isometry3d>> waypoints,
-                                     const ExploreOptions& options, std::uint64_t seed,
-                                     int first_replicate, int copies) {
+std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
+                                                     const ContactGraph& graph) {
+  const int goal = graph.FindNode(states::ToString(scene.goal));
+  if (goal < 0 || goal == graph.start) return {};
+  const Node& node = graph.nodes[std::size_t(goal)];
+  if (node.from_replay || node.witness.motion < 0 ||
+      std::size_t(node.witness.motion) >= graph.motions.size())
+    return {};
+  core::Core core(scene);
+  return HandPath(core, graph.motions[std::size_t(node.witness.motion)], node.witness.tick);
+}
+
+std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& scene,
+                                                            const ContactGraph& graph,
+                                                            const ExploreOptions& options) {
   trajectories::SynthesisOptions synthesis;
   synthesis.peak_speed_m_per_s = options.speed_m_per_s;
+  std::vector<trajectories::Trajectory> nominals;
+  for (const std::vector<Eigen::Isometry3d>& aim : CandidateWaypoints(scene, graph, options))
+    nominals.push_back(trajectories::SynthesizeTrajectory(aim, synthesis));
+  // The explorer's own motion to the goal, as `plans` retimes it: on the scene's step.
+  const std::vector<trajectories::HandSample> path = GoalMotionPath(scene, graph);
+  synthesis.rate_Hz = 1.0 / scene.model.time_step_s;
+  if (!nominals.empty() && path.size() >= 2)
+    nominals.push_back(trajectories::RetimeHandPath(path, synthesis));
+  return nominals;
+}
+
+std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
+                                     std::span<const trajectories::Trajectory> nominals,
+                                     const ExploreOptions& options, std::uint64_t seed,
+                                     int first_replicate, int copies) {
   trajectories::Perturbation perturbation;
   perturbation.offset_m = options.replay_offset_m;
   std::vector<Motion> motions;
   int replicate = first_replicate;
-  for (const std::vector<Eigen::Isometry3d>& aim : waypoints) {
-    const trajectories::Trajectory nominal = trajectories::SynthesizeTrajectory(aim, synthesis);
+  for (const trajectories::Trajectory& nominal : nominals)
     for (int c = 0; c < copies; ++c)
       motions.push_back(MotionAlong(trajectories::Perturb(nominal, perturbation, seed, replicate++),
                                     scene.model.time_step_s, kReplayTicksPerMove,
                                     options.speed_m_per_s, "replay"));
-  }
   return motions;
 }
 
 namespace {
 
+// Whether two trajectories are the same samples, bit for bit.
+bool SameSamples(std::span<const trajectories::HandSample> a,
+                 std::span<const trajectories::HandSample> b) {
+  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
+    return x.t_s == y.t_s && x.p_WH_m == y.p_WH_m && x.q_WH.coeffs() == y.q_WH.coeffs();
+  });
+}
+
 // A closing round's motions: `closing_motions` random motions of the seed from `next_random`, then
-// `replay_copies` perturbed replays from `next_replicate` of each candidate plan of the graph as
-// it stands and of `planned`, each distinct list of poses once. Advances both counters.
+// `replay_copies` perturbed replays from `next_replicate` of each candidate trajectory of the
+// graph as it stands and of `planned`, each distinct one once. Advances both counters.
 std::vector<Motion> ClosingRound(const scene::Scene& scene, const Box& box,
                                  const ContactGraph& graph,
-                                 std::span<const std::vector<Eigen::Isometry3d>> planned,
+                                 std::span<const trajectories::Trajectory> planned,
                                  const ExploreOptions& o, int& next_random, int& next_replicate) {
-  std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
-  if (o.replay_copies > 0) waypoint_lists = CandidateWaypoints(scene, graph, o);
-  for (const std::vector<Eigen::Isometry3d>& p : planned)
-    if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
-                     [&](const auto& w) { return SamePoses(w, p); }))
-      waypoint_lists.push_back(p);
+  std::vector<trajectories::Trajectory> nominals;
+  if (o.replay_copies > 0) nominals = CandidateTrajectories(scene, graph, o);
+  for (const trajectories::Trajectory& p : planned)
+    if (std::none_of(nominals.begin(), nominals.end(),
+                     [&](const auto& n) { return SameSamples(n.samples, p.samples); }))
+      nominals.push_back(p);
   std::vector<Motion> round =
       RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o);
   next_random += o.closing_motions;
   std::vector<Motion> replays =
-      PerturbedReplays(scene, waypoint_lists, o, o.seed, next_replicate, o.replay_copies);
+      PerturbedReplays(scene, nominals, o, o.seed, next_replicate, o.replay_copies);
   next_replicate += static_cast<int>(replays.size());
   round.insert(round.end(), std::make_move_iterator(replays.begin()),
                std::make_move_iterator(replays.end()));
@@ -1301,9 +1333,9 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   // plans, those of the graph as the round starts and those `plans` makes (of the graph as it is
   // here, before the first round: the one `plans` explores), each round merged and its new nodes
   // probed, until a round adds no node and no arc (saturated), or a limit ends it.
-  const std::vector<std::vector<Eigen::Isometry3d>> planned =
-      o.replay_copies > 0 ? CandidateWaypoints(scene, graph, o)
-                          : std::vector<std::vector<Eigen::Isometry3d>>{};
+  const std::vector<trajectories::Trajectory> planned =
+      o.replay_copies > 0 ? CandidateTrajectories(scene, graph, o)
+                          : std::vector<trajectories::Trajectory>{};
   int next_random = o.random_motions, next_replicate = 0;
   while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();

@@ -4,8 +4,7 @@
 #include <sstream>
 #include <utility>
 
-#include <tubeplan/core/core.hpp>
-#include <tubeplan/graph/motion.hpp>
+#include <tubeplan/graph/explore.hpp>
 #include <tubeplan/plan/candidates.hpp>
 
 namespace tubeplan::plan {
@@ -80,10 +79,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
                                          const AsWritten& as_written) {
   if (graph.goal < 0 || graph.start < 0 || graph.goal == graph.start) return std::nullopt;
   const graph::Node& goal = graph.nodes[std::size_t(graph.goal)];
-  const graph::Motion& motion = graph.motions[std::size_t(goal.witness.motion)];
-  if (motion.moves.empty()) return std::nullopt;
-  core::Core core(scene);
-  std::vector<trajectories::HandSample> hand = graph::HandPath(core, motion, goal.witness.tick);
+  std::vector<trajectories::HandSample> hand = graph::GoalMotionPath(scene, graph);
   if (hand.size() < 2) return std::nullopt;
   const std::vector<std::string> ends = {graph.nodes[std::size_t(graph.start)].cf, goal.cf};
   Limits limits;

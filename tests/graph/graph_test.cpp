@@ -641,14 +641,15 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     REQUIRE(g.saturated);
     REQUIRE(g.closing_rounds >= 1);
     // The last round's motions (nothing new: no probes after them) are the graph's last ones: its
-    // random motions, then its perturbed replays of each candidate plan, aimed up to three ways:
-    // those of the graph as the round started and those of the graph before the first round.
+    // random motions, then its perturbed replays of each candidate plan, aimed up to three ways,
+    // and of the explorer's motion to the goal: those of the graph as the round started and those
+    // of the graph before the first round.
     std::size_t replays = 0;
     while (replays < g.motions.size() && g.motions[g.motions.size() - 1 - replays].kind == "replay")
       ++replays;
     CHECK(replays > 0);
     CHECK(replays % std::size_t(o.replay_copies) == 0);
-    CHECK(replays <= std::size_t(2 * 3 * o.replay_copies * o.replay_paths));
+    CHECK(replays <= std::size_t(2 * (3 * o.replay_paths + 1) * o.replay_copies));
     const std::size_t last = g.saturation.size() - replays;
     REQUIRE(last > std::size_t(round));
     const graph::SaturationPoint& before = g.saturation[last - 1 - std::size_t(round)];
@@ -691,8 +692,24 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     CHECK(c.states_seen >= 3);
     CHECK(double(c.ticks_in_graph) >= 0.95 * double(c.ticks));
 
+    // The trajectories replayed: one per candidate plan's aim, then the explorer's own motion to
+    // the goal, up to the goal's witness tick (sample 0 is the start pose), retimed as `plans`
+    // retimes it: from the same start to the same end.
+    const std::vector<trajectories::Trajectory> nominals = graph::CandidateTrajectories(s, g, o);
+    const std::vector<trajectories::HandSample> path = graph::GoalMotionPath(s, g);
+    const int goal = g.FindNode(states::ToString(s.goal));
+    REQUIRE(goal >= 0);
+    REQUIRE(path.size() >= 2);
+    CHECK(path.size() == std::size_t(g.nodes[std::size_t(goal)].witness.tick) + 1);
+    CHECK(nominals.size() == graph::CandidateWaypoints(s, g, o).size() + 1);
+    CHECK((nominals.back().samples.front().p_WH_m - path.front().p_WH_m).norm() < 1e-12);
+    CHECK((nominals.back().samples.back().p_WH_m - path.back().p_WH_m).norm() < 1e-12);
+    CHECK(nominals.back().samples.back().t_s >= path.back().t_s);
+
     // Without a goal there is no plan to replay.
     CHECK(graph::CandidateWaypoints(s, graph::ContactGraph{}, o).empty());
+    CHECK(graph::CandidateTrajectories(s, graph::ContactGraph{}, o).empty());
+    CHECK(graph::GoalMotionPath(s, graph::ContactGraph{}).empty());
   }
 
   SECTION("The graph's JSON keeps the moves of the motions its witnesses lie in") {

@@ -41,8 +41,8 @@ Completeness CheckCompleteness(const scene::Scene& scene, const ContactGraph& gr
 /// The same over motions the explorer did not make, counted after its dwell: `count` random
 /// guarded motions of another seed (RandomMotions from explore.seed + 1000003), then about
 /// `count` perturbed replays of the candidate plans of `graph` (PerturbedReplays from that seed
-/// through CandidateWaypoints, as many copies of each as make `count`; none without a path to
-/// the goal).
+/// of CandidateTrajectories, as many copies of each as make `count`; none without a path to the
+/// goal).
 std::vector<Completeness> CheckCompleteness(const scene::Scene& scene, const ContactGraph& graph,
                                             const ExploreOptions& explore, int count);
 

@@ -52,7 +52,8 @@ struct ExploreOptions {
   /// plan's trajectory, of the graph as the round starts and of the graph before the first round
   /// (the one `plans` explores with the same options): the `replay_paths` cheapest start -> goal
   /// paths of the graph pruned with `weights`, the hand aimed at each distinct aim of
-  /// graph::Aim (CandidateWaypoints) at `speed_m_per_s`, moved as a whole by up to
+  /// graph::Aim (CandidateWaypoints) at `speed_m_per_s`, and the explorer's motion to the goal
+  /// (CandidateTrajectories), each moved as a whole by up to
   /// `replay_offset_m`, with 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What
   /// an operator following a plan meets is then in the graph. None run before the goal is
   /// reached.
@@ -123,11 +124,26 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
                                                                const ContactGraph& graph,
                                                                const ExploreOptions& options);
 
-/// Perturbed replays (ExploreOptions::replay_copies), motions of kind "replay": `copies` of a
-/// trajectory through each of `waypoints` at the explorer's speed, Perturb's replicates
-/// `first_replicate` on, from `seed`.
+/// The hand's path of the motion whose stay witnesses the goal's state, up to the witness's tick,
+/// as a run through the core moves it (HandPath): the explorer's own way to the goal. Empty
+/// where the graph has no goal, or its witness is not an explorer motion's.
+std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
+                                                     const ContactGraph& graph);
+
+/// The nominal trajectories of the candidate plans of `graph`, which closing rounds and the
+/// completeness check replay perturbed: one through each list of CandidateWaypoints (at
+/// `options.speed_m_per_s`), then the explorer's motion to the goal (GoalMotionPath) retimed to
+/// that speed as `plans` retimes it (trajectories::RetimeHandPath, on the scene's step). Empty
+/// when the graph has no path to the goal.
+std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& scene,
+                                                            const ContactGraph& graph,
+                                                            const ExploreOptions& options);
+
+/// Perturbed replays (ExploreOptions::replay_copies), motions of kind "replay": `copies` of each
+/// of `nominals`, Perturb's replicates `first_replicate` on, from `seed`, followed in chords at
+/// the explorer's speed.
 std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
-                                     std::span<const std::vector<Eigen::Isometry3d>> waypoints,
+                                     std::span<const trajectories::Trajectory> nominals,
                                      const ExploreOptions& options, std::uint64_t seed,
                                      int first_replicate, int copies);
 
