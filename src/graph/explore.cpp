@@ -544,7 +544,9 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         const Eigen::Vector3d above = GoOver(f, entry, q, o, m);
         if (entry != aim.hand)
           m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
-        m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N, entry));
+        // Guarded against what pushes back along the descent, from wherever it starts.
+        m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N,
+                                 entry != aim.hand ? entry : above));
         // Onto the surface, stopped by the first light push (the element touched, the tube not
         // yet bent by it) and held where it stopped, then pressed, slid and backed off, each
         // from where the last move stopped.

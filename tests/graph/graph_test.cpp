@@ -893,6 +893,22 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
     CHECK(goal.min_force_N < c.gentle_N);
     if (c.witness_kind != nullptr)
       CHECK(g.motions[std::size_t(goal.witness.motion)].kind == c.witness_kind);
+    // Every reach of an aim towards its target (past the lift at the start's height) stops
+    // where the operator force pushes back along it with the explorer's push.
+    for (const graph::Motion& m : g.motions) {
+      if (m.kind.rfind("aim", 0) != 0) continue;
+      INFO(m.kind);
+      REQUIRE(!m.moves.empty());
+      Eigen::Vector3d at = m.moves.front().p_W_m;
+      for (std::size_t k = 1; k < m.moves.size() && !m.moves[k].relative; ++k) {
+        const graph::Move& move = m.moves[k];
+        if ((move.p_W_m - at).norm() > 1e-9) {
+          CHECK(move.guard_N == graph::ExploreOptions{}.push_N);
+          CHECK(move.guard_dir_W.dot(move.p_W_m - at) < 0.0);
+        }
+        at = move.p_W_m;
+      }
+    }
   }
 }
 
