@@ -33,7 +33,8 @@ constexpr int kMaxTicksPerMotion = 30000;
 constexpr double kProbeSpeed_m_per_s = 0.15;
 constexpr double kProbeTurn_rad_per_s = 2.0;
 // A replayed trajectory moves the hand along chords of this many ticks (20 ms: within 0.05 mm of
-// the quickest minimum-jerk reach at 80 mm/s sped up 1.25 times, and about 0.03 mm of its tremor).
+// the quickest minimum-jerk reach at 80 mm/s sped up 1.25 times, and about 0.03 mm of its tremor;
+// at a sharp turn of the explorer's own motion a chord cuts the corner by up to about 1 mm).
 constexpr int kReplayTicksPerMove = 20;
 // A motion's run keeps a checkpoint every this many ticks (a core snapshot is ~70 kB, copied in
 // about the time of a tick or two): a refinement or a probe starts from the one before its tick
@@ -544,7 +545,7 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         const Eigen::Vector3d above = GoOver(f, entry, q, o, m);
         if (entry != aim.hand)
           m.moves.push_back(MoveTo(entry, q, 0.5 * o.speed_m_per_s, o.push_N, above));
-        // Guarded against what pushes back along the descent, from wherever it starts.
+        // The descent guarded against what pushes back along it, from the entry or from above.
         m.moves.push_back(MoveTo(aim.hand, q, 0.5 * o.speed_m_per_s, o.push_N,
                                  entry != aim.hand ? entry : above));
         // Onto the surface, stopped by the first light push (the element touched, the tube not
@@ -1149,11 +1150,11 @@ std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& 
   std::vector<trajectories::Trajectory> nominals;
   for (const std::vector<Eigen::Isometry3d>& aim : CandidateWaypoints(scene, graph, options))
     nominals.push_back(trajectories::SynthesizeTrajectory(aim, synthesis));
-  // The explorer's own motion to the goal, as `plans` retimes it: on the scene's step.
+  if (nominals.empty()) return nominals;
+  // The explorer's own motion to the goal, retimed as `plans` retimes it: on the scene's step.
   const std::vector<trajectories::HandSample> path = GoalMotionPath(scene, graph);
   synthesis.rate_Hz = 1.0 / scene.model.time_step_s;
-  if (!nominals.empty() && path.size() >= 2)
-    nominals.push_back(trajectories::RetimeHandPath(path, synthesis));
+  if (path.size() >= 2) nominals.push_back(trajectories::RetimeHandPath(path, synthesis));
   return nominals;
 }
 
@@ -1175,7 +1176,7 @@ std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
 
 namespace {
 
-// Whether two trajectories are the same samples, bit for bit.
+// Whether two trajectories have equal samples.
 bool SameSamples(std::span<const trajectories::HandSample> a,
                  std::span<const trajectories::HandSample> b) {
   return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
@@ -1336,8 +1337,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   // here, before the first round: the one `plans` explores), each round merged and its new nodes
   // probed, until a round adds no node and no arc (saturated), or a limit ends it.
   const std::vector<trajectories::Trajectory> planned =
-      o.replay_copies > 0 ? CandidateTrajectories(scene, graph, o)
-                          : std::vector<trajectories::Trajectory>{};
+      o.replay_copies > 0 && !stopped ? CandidateTrajectories(scene, graph, o)
+                                      : std::vector<trajectories::Trajectory>{};
   int next_random = o.random_motions, next_replicate = 0;
   while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();

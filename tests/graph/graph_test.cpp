@@ -693,8 +693,8 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     CHECK(double(c.ticks_in_graph) >= 0.95 * double(c.ticks));
 
     // The trajectories replayed: one per candidate plan's aim, then the explorer's own motion to
-    // the goal, up to the goal's witness tick (sample 0 is the start pose), retimed as `plans`
-    // retimes it: from the same start to the same end.
+    // the goal, up to the goal's witness tick (sample 0 is the start pose), retimed on the
+    // scene's step within the explorer's speed: from the same start to the same end.
     const std::vector<trajectories::Trajectory> nominals = graph::CandidateTrajectories(s, g, o);
     const std::vector<trajectories::HandSample> path = graph::GoalMotionPath(s, g);
     const int goal = g.FindNode(states::ToString(s.goal));
@@ -705,6 +705,8 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     CHECK((nominals.back().samples.front().p_WH_m - path.front().p_WH_m).norm() < 1e-12);
     CHECK((nominals.back().samples.back().p_WH_m - path.back().p_WH_m).norm() < 1e-12);
     CHECK(nominals.back().samples.back().t_s >= path.back().t_s);
+    CHECK(nominals.back().samples[1].t_s == Approx(s.model.time_step_s).epsilon(1e-9));
+    CHECK(trajectories::PeakSpeed(nominals.back().samples) <= o.speed_m_per_s * (1.0 + 1e-6));
 
     // Without a goal there is no plan to replay.
     CHECK(graph::CandidateWaypoints(s, graph::ContactGraph{}, o).empty());
@@ -886,13 +888,6 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
-    CHECK(g.goal >= 0);
-    if (g.goal < 0) continue;
-    const Node& goal = g.nodes[std::size_t(g.goal)];
-    CHECK(goal.cf == c.goal);
-    CHECK(goal.min_force_N < c.gentle_N);
-    if (c.witness_kind != nullptr)
-      CHECK(g.motions[std::size_t(goal.witness.motion)].kind == c.witness_kind);
     // Every reach of an aim towards its target (past the lift at the start's height) stops
     // where the operator force pushes back along it with the explorer's push.
     for (const graph::Motion& m : g.motions) {
@@ -909,6 +904,13 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
         at = move.p_W_m;
       }
     }
+    CHECK(g.goal >= 0);
+    if (g.goal < 0) continue;
+    const Node& goal = g.nodes[std::size_t(g.goal)];
+    CHECK(goal.cf == c.goal);
+    CHECK(goal.min_force_N < c.gentle_N);
+    if (c.witness_kind != nullptr)
+      CHECK(g.motions[std::size_t(goal.witness.motion)].kind == c.witness_kind);
   }
 }
 

@@ -10,7 +10,8 @@
 //     of the hand along and against three directions and small turns, each held and undone;
 //     every node found is probed in turn until all have been;
 //  5. closing rounds: more random motions and perturbed replays of the candidate plans'
-//     trajectories as the graph then stands, each round's new nodes probed as in 4, until a round
+//     trajectories (CandidateTrajectories) as the graph then stands and as it stood before the
+//     first round, each round's new nodes probed as in 4, until a round
 //     adds no node and no arc (saturated), or until the budget of motions or the time limit is
 //     spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
@@ -53,10 +54,9 @@ struct ExploreOptions {
   /// (the one `plans` explores with the same options): the `replay_paths` cheapest start -> goal
   /// paths of the graph pruned with `weights`, the hand aimed at each distinct aim of
   /// graph::Aim (CandidateWaypoints) at `speed_m_per_s`, and the explorer's motion to the goal
-  /// (CandidateTrajectories), each moved as a whole by up to
-  /// `replay_offset_m`, with 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What
-  /// an operator following a plan meets is then in the graph. None run before the goal is
-  /// reached.
+  /// (CandidateTrajectories), each moved as a whole by up to `replay_offset_m`, with 0.1 mm
+  /// tremor and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a plan
+  /// meets is then in the graph. None run before the goal is reached.
   int replay_copies = 4;
   int replay_paths = 3;
   double replay_offset_m = 0.004;
@@ -126,15 +126,17 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
 
 /// The hand's path of the motion whose stay witnesses the goal's state, up to the witness's tick,
 /// as a run through the core moves it (HandPath): the explorer's own way to the goal. Empty
-/// where the graph has no goal, or its witness is not an explorer motion's.
+/// where the graph has no goal, the goal is the start, or its witness is not an explorer
+/// motion's. (`plans` cuts this path in the goal's first stay, which may come before the
+/// witness's.)
 std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
                                                      const ContactGraph& graph);
 
 /// The nominal trajectories of the candidate plans of `graph`, which closing rounds and the
 /// completeness check replay perturbed: one through each list of CandidateWaypoints (at
-/// `options.speed_m_per_s`), then the explorer's motion to the goal (GoalMotionPath) retimed to
-/// that speed as `plans` retimes it (trajectories::RetimeHandPath, on the scene's step). Empty
-/// when the graph has no path to the goal.
+/// `options.speed_m_per_s`), then the explorer's motion to the goal (GoalMotionPath, uncut)
+/// retimed to that speed by trajectories::RetimeHandPath on the scene's step, as `plans`
+/// retimes its cut. Empty when the graph has no path to the goal.
 std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& scene,
                                                             const ContactGraph& graph,
                                                             const ExploreOptions& options);
