@@ -1135,7 +1135,8 @@ std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
   const int goal = graph.FindNode(states::ToString(scene.goal));
   if (goal < 0 || goal == graph.start) return {};
   const Node& node = graph.nodes[std::size_t(goal)];
-  if (node.from_replay || node.witness.motion < 0 ||
+  // A goal only passed through (no stay of it lasted the dwell) has no stay a plan could end in.
+  if (node.ticks == 0 || node.from_replay || node.witness.motion < 0 ||
       std::size_t(node.witness.motion) >= graph.motions.size())
     return {};
   core::Core core(scene);

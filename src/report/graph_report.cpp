@@ -68,7 +68,11 @@ void PrintReach(std::ostream& t, const graph::ContactGraph& g, const scene::Scen
   t << "start "
     << (g.start >= 0 ? g.nodes[std::size_t(g.start)].cf : "not reached (no motion ended)")
     << "; goal " << states::ToString(scene.goal)
-    << (g.goal >= 0 ? " reached" : " NEVER reached: no plan can be extracted") << "\n";
+    << (g.goal < 0 ? " NEVER reached: no plan can be extracted"
+        : g.nodes[std::size_t(g.goal)].ticks == 0
+            ? " reached only in passing (no stay of it lasted the dwell)"
+            : " reached")
+    << "\n";
   const std::string near = g.goal < 0 ? graph::NearGoalText(g, scene.goal, 4) : "";
   if (!near.empty()) t << "  nearest states reached (least operator force): " << near << "\n";
   t << "part elements touched: " << g.reached_elements.size()

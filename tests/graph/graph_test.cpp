@@ -712,6 +712,14 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     CHECK(graph::CandidateWaypoints(s, graph::ContactGraph{}, o).empty());
     CHECK(graph::CandidateTrajectories(s, graph::ContactGraph{}, o).empty());
     CHECK(graph::GoalMotionPath(s, graph::ContactGraph{}).empty());
+
+    // A goal only passed through (every stay of it shorter than the dwell) has no motion that
+    // ends in it: none is replayed.
+    ContactGraph passed = g;
+    passed.nodes[std::size_t(goal)].ticks = 0;
+    CHECK(graph::GoalMotionPath(s, passed).empty());
+    CHECK(graph::CandidateTrajectories(s, passed, o).size() ==
+          graph::CandidateWaypoints(s, passed, o).size());
   }
 
   SECTION("The graph's JSON keeps the moves of the motions its witnesses lie in") {
