@@ -1,10 +1,10 @@
 // The explorer (Explore): sweeps, aims, random motions, probes and closing rounds, in that order,
-// and the candidate plans its closing rounds replay. Its motions are made in explorer_motions.cpp,
-// run through the core in run_motion.cpp and merged into the graph in merger.cpp.
+// and the candidate plans its closing rounds replay; PcChanges and the force limit its motions
+// keep to. Its motions are made in explorer_motions.cpp, run through the core in run_motion.cpp
+// and merged into the graph in merger.cpp.
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <memory>
 #include <optional>
 #include <set>
@@ -150,8 +150,7 @@ std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
   const int goal = graph.FindNode(states::ToString(scene.goal));
   if (goal < 0 || goal == graph.start) return {};
   const Node& node = graph.nodes[std::size_t(goal)];
-  // A goal only passed through (no stay of it lasted the dwell) has no stay a plan could end in.
-  if (node.ticks == 0 || node.from_replay || node.witness.motion < 0 ||
+  if (node.from_replay || node.witness.motion < 0 ||
       std::size_t(node.witness.motion) >= graph.motions.size())
     return {};
   core::Core core(scene);

@@ -38,7 +38,9 @@ struct Node {
   /// (R_H, R_H,goal) between the witnesses (the tube's middle moves by about l/2 per radian).
   /// Negative when the goal was never reached.
   double distance_m = -1.0;
-  long ticks = 0;  ///< ticks spent in this CF over all motions
+  /// Ticks spent in this CF over all motions, in the stays that count (a stay briefer than the
+  /// dwell, seen only between two counted states, or between sub-ticks, adds none).
+  long ticks = 0;
   bool start = false, goal = false;
   bool from_replay = false;  ///< not found by exploration; seen in a batch replay (ApplyVerdicts)
 };

@@ -126,8 +126,7 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
 
 /// The hand's path of the motion whose stay witnesses the goal's state, up to the witness's tick,
 /// as a run through the core moves it (HandPath): the explorer's own way to the goal. Empty
-/// where the graph has no goal, the goal is the start, no motion stayed in the goal for the
-/// dwell (it was only passed through, Node::ticks == 0), or its witness is not an explorer
+/// where the graph has no goal, the goal is the start, or its witness is not an explorer
 /// motion's. (`plans` cuts this path in the goal's first stay, which may come before the
 /// witness's.)
 std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
