@@ -34,8 +34,8 @@ std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const Expl
 std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
                          const std::vector<int>& elements, const ExploreOptions& o);
 
-// The aim at a goal of two or more PCs as a whole (none for a goal of one PC, or where no pose
-// fits).
+// The aim at a goal of two or more PCs as a whole: brought in along the goal faces' normals, else
+// slid in along the tube's axis (none for a goal of one PC, or where no pose fits).
 std::vector<Motion> GoalAims(const scene::Scene& scene, core::Core& probe, const ExploreOptions& o);
 
 // Random motions [first, first + count) of the seed across the box.
