@@ -11,9 +11,8 @@
 //     every node found is probed in turn until all have been;
 //  5. closing rounds: more random motions and perturbed replays of the candidate plans'
 //     trajectories (CandidateTrajectories) as the graph then stands and as it stood before the
-//     first round, each round's new nodes probed as in 4, until a round
-//     adds no node and no arc (saturated), or until the budget of motions or the time limit is
-//     spent.
+//     first round, each round's new nodes probed as in 4, until a round adds no node and no arc
+//     (saturated), or until the budget of motions or the time limit is spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
 // into sub-ticks; what the sub-ticks produce is recorded, and a change that stays multiple is
 // flagged simultaneous. Motions run in parallel on `jobs` threads, each with its own core, and
