@@ -151,7 +151,7 @@ Eigen::Isometry3d HandPose(double x_m, double y_m, double z_m, double tip_down_d
   return X;
 }
 
-// One core scenario: the hand moves from the scene's start to `at` in 0.5 s, stays 0.3 s, and is
+// One core scenario: the hand moves from the scene's start to `at` (Approach), stays 0.3 s, and is
 // then timed tick by tick while `motion` (a function of the tick index) moves it about there.
 // kReplicas cores take the same ticks (see the top of the file).
 struct CoreRun {
@@ -165,20 +165,12 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
                       std::function<Eigen::Isometry3d(const Eigen::Isometry3d&, long)> motion,
                       bool mesh = false) {
   auto runs = std::make_shared<std::array<CoreRun, kReplicas>>();
-  const Eigen::Isometry3d start = scene.X_WH_start;
   const double T = scene.model.time_step_s;
+  const long ticks = std::lround((kApproach_s + 0.3) / T);
   for (CoreRun& run : *runs) {
     run.core = std::make_shared<core::Core>(scene);
-    for (int i = 0; i <= 800; ++i) {
-      const double u = std::min(1.0, i / 500.0);
-      const double w = u * u * (3.0 - 2.0 * u);
-      Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
-      X.translation() = (1.0 - w) * start.translation() + w * at.translation();
-      X.linear() = Eigen::Quaterniond(start.linear())
-                       .slerp(w, Eigen::Quaterniond(at.linear()))
-                       .toRotationMatrix();
-      run.core->Step(run.t_s += T, X);
-    }
+    for (long i = 0; i <= ticks; ++i)
+      run.core->Step(run.t_s += T, Approach(scene.X_WH_start, at, double(i) * T));
   }
   const auto step = [runs, at, motion, mesh, T](int replica) {
     CoreRun& run = (*runs)[std::size_t(replica)];
@@ -208,13 +200,7 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
   return s;
 }
 
-// The hand's poses of the contact scenarios, for a groove along world y with its floor's top at
-// z = 0 (the shipped scenes' layout), sized by the tube and by the gap between the tube and the
-// wall named `left` (the groove taken as symmetric), so that each scenario reaches the same
-// contact formation on a soft short tube and a stiff long one.
-struct CorePoses {
-  Eigen::Isometry3d end, two_pcs, three_pcs, side_on_floor;
-};
+}  // namespace
 
 CorePoses PosesFor(const scene::Scene& scene) {
   const double l = scene.tube.length_m, r1 = scene.tube.outer_radius_m;
@@ -240,6 +226,26 @@ CorePoses PosesFor(const scene::Scene& scene) {
   return p;
 }
 
+Eigen::Isometry3d Approach(const Eigen::Isometry3d& start, const Eigen::Isometry3d& at,
+                           double t_s) {
+  const double u = std::clamp(t_s / kApproach_s, 0.0, 1.0);
+  const double w = u * u * (3.0 - 2.0 * u);
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = (1.0 - w) * start.translation() + w * at.translation();
+  X.linear() = Eigen::Quaterniond(start.linear())
+                   .slerp(w, Eigen::Quaterniond(at.linear()))
+                   .toRotationMatrix();
+  return X;
+}
+
+Eigen::Isometry3d Dither(const Eigen::Isometry3d& X, long tick) {
+  Eigen::Isometry3d Y = X;
+  Y.translation().z() += 20e-6 * std::sin(0.05 * double(tick));
+  return Y;
+}
+
+namespace {
+
 // Cells along each edge of a face of the mesh floor: 12 * 29^2 = 10,092 triangles, the size of
 // part a tick on a mesh is compared with its box twin at.
 constexpr int kMeshFloorDivisions = 29;
@@ -263,12 +269,7 @@ std::optional<scene::Scene> WithMeshFloor(const scene::Scene& scene) {
 
 std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   std::vector<Scenario> out;
-  // A small dither keeps every tick doing real work without changing the state.
-  const auto dither = [](const Eigen::Isometry3d& X, long k) {
-    Eigen::Isometry3d Y = X;
-    Y.translation().z() += 20e-6 * std::sin(0.05 * double(k));
-    return Y;
-  };
+  const auto dither = [](const Eigen::Isometry3d& X, long k) { return Dither(X, k); };
   const auto slide = [](const Eigen::Isometry3d& X, long k) {
     // Back and forth along the groove, +-10 mm at 20 mm/s: the tip slides except at the turns.
     const double phase = std::fmod(double(k) * 1e-3 * 20e-3, 40e-3);

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include <tubeplan/model/tube.hpp>
@@ -51,6 +52,26 @@ struct Figures {
 Figures Measure(const Scenario& scenario, int samples, double& sink);
 /// The beam models' scenarios for `tube` (linear beam, elastica).
 std::vector<Scenario> MakeScenarios(const model::TubeSpec& tube);
+/// The hand's poses of the contact scenarios, for a groove along world y with its floor's top at
+/// z = 0 (the shipped scenes' layout), sized by the tube and by the gap between the tube and the
+/// wall named `left` (the groove taken as symmetric), so that each scenario reaches the same
+/// contact formation on a soft short tube and a stiff long one.
+struct CorePoses {
+  Eigen::Isometry3d end, two_pcs, three_pcs, side_on_floor;
+};
+CorePoses PosesFor(const scene::Scene& scene);
+
+/// How long a core scenario's hand takes from the scene's start to its pose [s].
+inline constexpr double kApproach_s = 0.5;
+
+/// The hand's pose t_s after a core scenario starts: from `start` to `at` along a smooth step
+/// (3u^2 - 2u^3, positions linearly, orientations by slerp) in kApproach_s, then held at `at`.
+Eigen::Isometry3d Approach(const Eigen::Isometry3d& start, const Eigen::Isometry3d& at, double t_s);
+
+/// The dither of the scenarios held still: 20 um up and down, a period of 126 ticks, so that
+/// every tick does real work without changing the state.
+Eigen::Isometry3d Dither(const Eigen::Isometry3d& X, long tick);
+
 /// The core's tick in `scene`: free, an end stuck and sliding, two and three PCs, a side on a
 /// floor, the end and the side on the floor made a 10,092-triangle mesh (when the scene has a
 /// box named "floor"); each with its targets.
