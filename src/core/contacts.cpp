@@ -277,25 +277,31 @@ class Finder {
   }
 
   // The direction of a section's point nearest the part, and the direction a quarter turn on
-  // (tangent x direction): found when the section first meets the part in a tick and fixed on
-  // the section for the rest of the tick (Material turns them with it).
+  // (tangent x direction). On a part with friction: found when the section first meets the part
+  // in a tick and fixed on the section for the rest of the tick (Material turns them with it),
+  // the material point its friction spring holds. On a frictionless part nothing holds a point
+  // of the section: the point nearest the part at every iterate, so that the tick minimises the
+  // section's own distance from the part (fixed for the tick, a section turning about a
+  // frictionless corner is pushed by where it touched at the tick's start, and swings from side
+  // to side over ticks).
   void SectionFrame(const PartModel& part, int p, int node, const Vec3& c, const Vec3& t,
                     ElementIndex entry, Vec3& rho, Vec3& side) {
     Scratch& s = d_.scratch;
     const double r1 = m_.rod.outer_radius_m;
     const std::size_t k = std::size_t(p * (n_ + 1) + node);
     Vec3& kept = d_.state.section_direction_W[k];
-    if (s.section_chosen[k]) {
+    const bool held = !part.friction.IsFrictionless();
+    if (held && s.section_chosen[k]) {
       rho = kept;
       side = s.section_side_W[k];
       return;
     }
     rho = NearestOnCircle(part, c, t, r1, kept, entry);
-    // A section nearly square to the part keeps last tick's direction: its points are then as
-    // near within a hundredth of epsilon, and a direction chosen afresh would swing with every
-    // small tilt (carrying the friction anchors of the rim's points with it).
+    // A section nearly square to a part with friction keeps last tick's direction: its points
+    // are then as near within a hundredth of epsilon, and a direction chosen afresh would swing
+    // with every small tilt (carrying the friction anchors of the rim's points with it).
     Vec3 last = kept - kept.dot(t) * t;
-    if (last.norm() > 1e-12) {
+    if (held && last.norm() > 1e-12) {
       last.normalize();
       const double gain_m = part.geometry.Distance(c + r1 * last, entry).distance_m -
                             part.geometry.Distance(c + r1 * rho, entry).distance_m;
