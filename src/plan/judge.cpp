@@ -257,7 +257,9 @@ void Judging::Counted() {
     Fail(v, "another state reached instead: " + raw_ + ", planned later, before " + states[at_ + 1],
          raw_since_);
     failed_ = true;
-  } else if (raw_ != states[at_]) {
+  } else if (raw_ != states[at_] || !passed_.empty()) {
+    // Every state passed on the way, in order, returns to the span's start too (a tube that
+    // goes to X, back, and to X again has passed X, the start, X).
     passed_.push_back(raw_);
   }
 }

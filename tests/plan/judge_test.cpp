@@ -6,6 +6,8 @@
 #include <fstream>
 #include <functional>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -345,6 +347,30 @@ TEST_CASE("Ticks beyond the linear range or whose solve stopped short are timed"
   CHECK(j.transitions[0].FlaggedSeconds(core::kNotConverged) == Approx(0.012).margin(1e-12));
   CHECK(j.transitions[0].FlaggedSeconds(core::kSolverFault) == 0.0);
   CHECK(j.transitions[0].verdict == plan::Verdict::kInfeasible);
+}
+
+TEST_CASE("A detour lists every state passed, returns to the span's start too", "[plan]") {
+  // Synthetic ticks, 30 of each state in turn (the dwell is 20): the planned start {}, an
+  // unplanned X, back to {}, X again, then the planned goal. The span {} -> goal passed X, {}, X.
+  plan::Judging judging({"{}", "{Fe - wall.xneg}"}, plan::Limits{}, 1e-3);
+  const std::vector<std::string> texts = {"{}", "{Ee - wall.xneg}", "{Fe - wall.xneg}"};
+  const std::vector<int> sequence = {0, 1, 0, 1, 2};
+  core::StepOutput out;
+  int state = 0, tick = 0;
+  const auto text = [&] { return texts[std::size_t(state)]; };
+  for (const int s : sequence) {
+    state = s;
+    out.contact_count = s == 0 ? 0 : 1;
+    // Another tube element on the same part element: another state's key.
+    out.contacts[0].part_element = 3;
+    out.contacts[0].tube = s == 1 ? states::TubeElement::kEndRim : states::TubeElement::kEndFace;
+    for (int k = 0; k < 30; ++k) judging.Tick(1e-3 * ++tick, out, text);
+  }
+  const plan::Judgement j = judging.Finish();
+  REQUIRE(j.transitions.size() == 1);
+  CHECK(j.transitions[0].verdict == plan::Verdict::kFeasibleWithDetour);
+  CHECK(j.transitions[0].detour ==
+        std::vector<std::string>{"{Ee - wall.xneg}", "{}", "{Ee - wall.xneg}"});
 }
 
 TEST_CASE("A limit's message reads right: one space a word, the device's clamp said", "[plan]") {
