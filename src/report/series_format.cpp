@@ -36,6 +36,12 @@ std::string PcText(const core::Core& core, const core::ContactState& pc) {
          " " + core.elements()[std::size_t(pc.part_element)].name;
 }
 
+// A PC's friction: none where nothing can hold it (a frictionless part: its limit is 0).
+const char* FrictionState(const core::ContactState& pc) {
+  if (!(pc.friction_limit_N > 0.0)) return "none";
+  return pc.sliding ? "sliding" : "stuck";
+}
+
 void AppendPose(std::string& s, const Eigen::Isometry3d& X) {
   const Eigen::Quaterniond q(X.linear());
   for (double v : {X.translation().x(), X.translation().y(), X.translation().z(), q.w(), q.x(),
@@ -132,7 +138,9 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
         s += ',';
         AppendNumber(s, v);
       }
-      s += pc.sliding ? ",sliding," : ",stuck,";
+      s += ',';
+      s += FrictionState(pc);
+      s += ',';
       AppendNumber(s, pc.friction_work_J);
     }
     if (mesh_)
@@ -171,7 +179,7 @@ void SeriesWriter::Add(const core::Core& core, const core::StepOutput& out,
                    {"normal", pc.normal_force_N},
                    {"friction", pc.friction_W_N.norm()},
                    {"limit", pc.friction_limit_N},
-                   {"state", pc.sliding ? "sliding" : "stuck"},
+                   {"state", FrictionState(pc)},
                    {"work", pc.friction_work_J},
                    {"n", {pc.normal_W.x(), pc.normal_W.y(), pc.normal_W.z()}},
                    {"point", {pc.p_WC_m.x(), pc.p_WC_m.y(), pc.p_WC_m.z()}}});
