@@ -277,13 +277,9 @@ class Finder {
   }
 
   // The direction of a section's point nearest the part, and the direction a quarter turn on
-  // (tangent x direction). On a part with friction: found when the section first meets the part
-  // in a tick and fixed on the section for the rest of the tick (Material turns them with it),
-  // the material point its friction spring holds. On a frictionless part nothing holds a point
-  // of the section: the point nearest the part at every iterate, so that the tick minimises the
-  // section's own distance from the part (fixed for the tick, a section turning about a
-  // frictionless corner is pushed by where it touched at the tick's start, and swings from side
-  // to side over ticks).
+  // (tangent x direction): on a part with friction fixed on the section for the tick from where
+  // it first meets the part (Material turns them with it), on a frictionless part found at every
+  // iterate (docs/core.md, "The end rim").
   void SectionFrame(const PartModel& part, int p, int node, const Vec3& c, const Vec3& t,
                     ElementIndex entry, Vec3& rho, Vec3& side) {
     Scratch& s = d_.scratch;

@@ -17,8 +17,9 @@ void FindPartsNear(const Model& model, std::span<const Eigen::Vector3d> x_W, dou
                    Data& data);
 
 /// Where a contact point sits on the tube is chosen when the point is first found in a tick and
-/// kept for the tick. At a trial point of the line search the new choices are pending until the
-/// point is taken (CommitContactChoices), so that a rejected trial leaves nothing behind.
+/// kept for the tick (the rim's on a frictionless part: at every iterate). At a trial point of the
+/// line search the new choices are pending until the point is taken (CommitContactChoices), so that
+/// a rejected trial leaves nothing behind.
 enum class Choices { kKeep, kPending };
 
 /// Fills data.scratch.samples with the contact points at the nodes x_W.

@@ -180,9 +180,10 @@ struct Scratch {
   double far_clearance_m = 0.0;
   std::vector<std::uint8_t> entry_seen;  ///< per (part, node): a contact point there this tick
   /// Where the rim's points sit on a part with friction is chosen once a tick, when the rim first
-  /// meets the part, and kept for the tick's iterations (so that the potential they minimise
-  /// does not change under them; on a frictionless part, at every iterate): per (part, node),
-  /// whether its direction is this tick's, and tangent x direction then.
+  /// meets the part, and kept for the tick's iterations, so that the potential they minimise
+  /// does not change under them (on a frictionless part they are found at every iterate and
+  /// these are not read): per (part, node), whether its direction is this tick's, and tangent x
+  /// direction then.
   std::vector<std::uint8_t> section_chosen;
   std::vector<Eigen::Vector3d> section_side_W;
   /// Choices a trial point of the line search made, kept if the point is taken.

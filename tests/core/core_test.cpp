@@ -605,7 +605,7 @@ TEST_CASE("A soft side slid across a narrow wall's top, 3 degrees off its edges,
 
 TEST_CASE(
     "A frictionless end pushed into a corner of floor and wall settles, retraces and gives back "
-    "the work",
+    "no more work than it took",
     "[core]") {
   // The rubber tube pointing 30 deg down, its end lowered onto a frictionless floor and pushed
   // into a wall in 1 mm steps, then drawn back the same way. Pressed into the corner, the end's
@@ -644,7 +644,8 @@ TEST_CASE(
       const Eigen::Vector3d f_before = c.last().force_W_N;
       const core::StepOutput& out = c.Step(t += 1e-3, Y);
       work_J -= 0.5 * (f_before + out.force_W_N).dot(Y.translation() - before);
-      // The last 200 ticks of the hold: the tube at rest.
+      // The last 200 ticks of the hold: the tube at rest, its force steady to 1 mN and 0.1 % a
+      // tick (a swinging tube jumps by a third).
       if (i > 300 && (out.force_W_N - f_before).norm() > 1e-3 + 1e-3 * out.force_W_N.norm())
         ++unsettled;
     }
@@ -656,7 +657,8 @@ TEST_CASE(
   CHECK(unsettled == 0);
   // Out of the plane: the case this test is for.
   CHECK(widest_m > 2e-3);
-  // Frictionless: the same force at the same pose on the way in and on the way out.
+  // Frictionless: the same force at the same pose on the way in and on the way out, to 1 % and
+  // 1 mN (measured 0.07 %; a tube pushed off its equilibrium by a stale contact 8-11 %).
   for (std::size_t k = 0; k + 1 < in; ++k) {
     INFO("pose " << k << ": " << held_N[k] << " N in, " << held_N[2 * in - 2 - k] << " N out");
     CHECK(held_N[2 * in - 2 - k] == Approx(held_N[k]).epsilon(0.01).margin(1e-3));
