@@ -151,9 +151,11 @@ Eigen::Isometry3d HandPose(double x_m, double y_m, double z_m, double tip_down_d
   return X;
 }
 
-// One core scenario: the hand moves from the scene's start to `at` (Approach), stays 0.3 s, and is
-// then timed tick by tick while `motion` (a function of the tick index) moves it about there.
+// One core scenario: the hand moves from the scene's start to `at` (Approach), stays kSettle_s, and
+// is then timed tick by tick while `motion` (a function of the tick index) moves it about there.
 // kReplicas cores take the same ticks (see the top of the file).
+constexpr double kSettle_s = 0.3;
+
 struct CoreRun {
   std::shared_ptr<core::Core> core;
   double t_s = 0.0;
@@ -166,7 +168,7 @@ Scenario CoreScenario(const scene::Scene& scene, std::string name, std::string w
                       bool mesh = false) {
   auto runs = std::make_shared<std::array<CoreRun, kReplicas>>();
   const double T = scene.model.time_step_s;
-  const long ticks = std::lround((kApproach_s + 0.3) / T);
+  const long ticks = std::lround((kApproach_s + kSettle_s) / T);
   for (CoreRun& run : *runs) {
     run.core = std::make_shared<core::Core>(scene);
     for (long i = 0; i <= ticks; ++i)
@@ -269,7 +271,6 @@ std::optional<scene::Scene> WithMeshFloor(const scene::Scene& scene) {
 
 std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
   std::vector<Scenario> out;
-  const auto dither = [](const Eigen::Isometry3d& X, long k) { return Dither(X, k); };
   const auto slide = [](const Eigen::Isometry3d& X, long k) {
     // Back and forth along the groove, +-10 mm at 20 mm/s: the tip slides except at the turns.
     const double phase = std::fmod(double(k) * 1e-3 * 20e-3, 40e-3);
@@ -287,44 +288,44 @@ std::vector<Scenario> MakeCoreScenarios(const scene::Scene& scene) {
                                return Y;
                              }));
   out.push_back(CoreScenario(scene, "core.end_stuck", "the tip pressed on the floor, stuck",
-                             end_pose, dither));
+                             end_pose, Dither));
   out.push_back(
       CoreScenario(scene, "core.end_sliding", "the tip sliding along the floor", end_pose, slide));
   out.push_back(CoreScenario(scene, "core.two_pcs",
                              "the tip on the floor and the side along the left wall", poses.two_pcs,
-                             dither));
+                             Dither));
   out.push_back(
       CoreScenario(scene, "core.three_pcs",
                    "lying in the groove, turned to touch both walls: floor, left wall, right wall",
-                   poses.three_pcs, dither));
+                   poses.three_pcs, Dither));
   // A line contact: the side lying along the floor, carried by every section on it.
   out.push_back(CoreScenario(scene, "core.side_on_floor",
                              "lying along the floor, pressed onto it (a line contact)",
-                             poses.side_on_floor, dither));
+                             poses.side_on_floor, Dither));
   // The floor a mesh of 10,092 triangles in place of its box: what a mesh part costs a tick.
   if (const std::optional<scene::Scene> meshed = WithMeshFloor(scene)) {
     out.push_back(CoreScenario(*meshed, "core.end_stuck.mesh10k",
                                "core.end_stuck on the floor as a 10,092-triangle mesh", end_pose,
-                               dither));
+                               Dither));
     out.push_back(CoreScenario(*meshed, "core.side_on_floor.mesh10k",
                                "core.side_on_floor on the floor as a 10,092-triangle mesh",
-                               poses.side_on_floor, dither));
+                               poses.side_on_floor, Dither));
   }
   // The same stuck tip without friction, and with the shape asked for every tick.
   scene::Scene frictionless = scene;
   frictionless.friction = scene::Friction{};
   for (scene::Part& part : frictionless.parts) part.friction.reset();
   out.push_back(CoreScenario(frictionless, "core.end_pressed.frictionless",
-                             "core.end_stuck on the scene without friction", end_pose, dither));
+                             "core.end_stuck on the scene without friction", end_pose, Dither));
   out.push_back(CoreScenario(scene, "core.end_stuck.mesh",
                              "core.end_stuck and the centreline (21 points) every tick", end_pose,
-                             dither, true));
+                             Dither, true));
   scene::Scene linear = scene;
   linear.model.tube = scene::TubeModel::kLinear;
   out.push_back(CoreScenario(linear, "core.end_stuck.linear",
-                             "core.end_stuck with the linear beam model", end_pose, dither));
+                             "core.end_stuck with the linear beam model", end_pose, Dither));
   out.push_back(CoreScenario(linear, "core.three_pcs.linear",
-                             "core.three_pcs with the linear beam model", poses.three_pcs, dither));
+                             "core.three_pcs with the linear beam model", poses.three_pcs, Dither));
   return out;
 }
 

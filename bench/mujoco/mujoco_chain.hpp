@@ -40,8 +40,8 @@ struct ChainRun {
 };
 
 /// Builds the chain of `elements` capsules for `c`, finds the longest stable time step that
-/// divides 1 ms (the settled force then agrees with half the step's to 0.2 %), calibrates the
-/// contact's softness to K, settles and times `samples` simulated ms each way.
+/// divides 1 ms (the settled force then agrees with the next shorter one's to 0.2 %), calibrates
+/// the contact's softness to K, settles and times `samples` simulated ms each way.
 ChainRun RunChain(const ChainCase& c, int elements, int samples);
 
 }  // namespace tubeplan::bench::mujoco

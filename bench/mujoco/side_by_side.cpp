@@ -1,9 +1,9 @@
-// A side-by-side of tubeplan's core and MuJoCo 2.2.2 on one contact case (README.md, "MuJoCo
-// side by side"). The case is `tubeplan bench`'s core.end_stuck pose in a scene: the hand brought
-// in 0.5 s from the scene's start to the bench's pose, the tube's end pressed on the floor, then
-// held still; without friction unless --friction (core.end_pressed.frictionless, core.end_stuck).
-// For each engine and element count it prints the settled vertical operator force, its error
-// against the exact elastica of the same case (the shooting reference,
+// A side-by-side of tubeplan's core and MuJoCo 2.2.2 on one contact case (docs/accuracy.md,
+// "MuJoCo side by side"). The case is `tubeplan bench`'s core.end_stuck pose in a scene: the hand
+// brought in 0.5 s from the scene's start to the bench's pose, the tube's end pressed on the floor,
+// then held still; without friction unless --friction (core.end_pressed.frictionless,
+// core.end_stuck). For each engine and element count it prints the settled vertical operator force,
+// its error against the exact elastica of the same case (the shooting reference,
 // reference/shooting_elastica.hpp, followed along the same hand path), and the wall time per
 // 1 ms of simulated time, median over many ms after settling. Not part of the default build.
 #include <algorithm>
@@ -173,7 +173,16 @@ int main(int argc, char** argv) {
     if (arg == "--friction") {
       with_friction = true;
     } else if (arg == "--samples" && i + 1 < argc) {
-      samples = std::stoi(argv[++i]);
+      const std::string n = argv[++i];
+      if (n.empty() || n.size() > 7 || n.find_first_not_of("0123456789") != std::string::npos ||
+          std::stoi(n) < 10) {
+        std::fprintf(stderr,
+                     "mujoco_side_by_side: error: --samples '%s', expected a whole number from 10 "
+                     "to 9999999\n",
+                     n.c_str());
+        return 2;
+      }
+      samples = std::stoi(n);
     } else if (arg.starts_with("-")) {
       std::fprintf(stderr,
                    "usage: mujoco_side_by_side [SCENE] [--friction] [--samples N] (default %s, "
@@ -193,7 +202,7 @@ int main(int argc, char** argv) {
     // The case is judged without friction by default (bench's core.end_pressed.frictionless):
     // its answer is the pose's alone. With friction (core.end_stuck) it depends on where the
     // end stuck on its way in, which a quasi-static reference, tubeplan's ticks and MuJoCo's
-    // dynamics each decide their own way (README.md, "MuJoCo side by side").
+    // dynamics each decide their own way (docs/accuracy.md, "MuJoCo side by side").
     scene::Scene scene = *loaded.scene;
     if (!with_friction) {
       scene.friction = scene::Friction{};
