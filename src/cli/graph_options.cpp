@@ -86,9 +86,11 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub->add_option("--time-limit", o.time_limit_s,
-                  "stop exploring after this many seconds of wall time, saturated or not (said in "
-                  "the output; default: no limit)")
-      ->check(CLI::Range(0.001, 1e7));
+                  "stop exploring after this many seconds of wall time once the goal state has "
+                  "been reached, saturated or not (said in the output); a goal not reached yet is "
+                  "explored for within the budget (0: no limit)")
+      ->check(CLI::Range(0.0, 1e7))
+      ->capture_default_str();
   sub->add_option("--jobs", o.jobs, "threads (default: the machine's cores)")
       ->check(CLI::Range(1, 256));
   sub->add_option("--weights", o.weights,

@@ -28,8 +28,8 @@ struct GraphOptions {
   int closing = 30;  // random motions per closing round (plans: none; see plans_command.cpp)
   int replays = 4;   // perturbed copies of each candidate plan per closing round (plans: none)
   int budget = 3000;
-  double time_limit_s = 0.0;  // 0: none
-  int jobs = 0;               // 0: the machine's cores
+  double time_limit_s = 10.0;  // 0: none; holds once the goal is reached
+  int jobs = 0;                // 0: the machine's cores
   std::string weights;
   std::optional<double> tolerance;
   std::string verdicts_path;  // graph only: an evaluate report

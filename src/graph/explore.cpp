@@ -232,11 +232,16 @@ double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& option
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
                      const std::function<void(const SaturationPoint&)>& progress) {
   const auto clock_start = Clock::now();
-  Deadline deadline;
-  if (o.time_limit_s > 0.0)
-    deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
-                                    std::chrono::duration<double>(o.time_limit_s));
   ContactGraph graph;
+  // The time limit counts from the start but holds only once the goal is a node: a scene whose
+  // goal takes longer to reach is explored until it is, within the budget.
+  Deadline deadline;
+  const std::string goal_cf = states::ToString(scene.goal);
+  const auto arm_deadline = [&] {
+    if (o.time_limit_s > 0.0 && !deadline.at && graph.FindNode(goal_cf) >= 0)
+      deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
+                                      std::chrono::duration<double>(o.time_limit_s));
+  };
   Merger merger(graph, ExploreForceLimit(scene, o));
   std::vector<std::unique_ptr<core::Core>> cores;
   cores.push_back(std::make_unique<core::Core>(scene));
@@ -263,7 +268,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   };
   // Runs a group of motions whole, or as much of it as the budget leaves, and merges the results
   // in motion order up to the first the time limit stopped (that one and those after it are
-  // dropped, and so is the rest of the exploration). Returns how many were merged.
+  // dropped, and so is the rest of the exploration); arms the limit once the goal is a node.
+  // Returns how many were merged.
   const auto run = [&](std::vector<Motion> group, const std::vector<RunPointPtr>& resumes) {
     if (stopped == ExploreEnd::kTimeLimit) return 0;
     if (static_cast<int>(group.size()) > room()) {
@@ -291,6 +297,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
       graph.motions.resize(std::size_t(first + merged));
       stop(ExploreEnd::kTimeLimit);
     }
+    arm_deadline();
     status(first + merged, first + merged);
     return merged;
   };

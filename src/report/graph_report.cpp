@@ -55,7 +55,8 @@ void PrintSaturation(std::ostream& t, const graph::ContactGraph& g,
   } else if (g.end == graph::ExploreEnd::kTimeLimit) {
     t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
       << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
-      << " states probed, " << g.closing_rounds << " closing rounds)\n";
+      << " states probed, " << g.closing_rounds
+      << " closing rounds; a larger --time-limit, or 0, explores on to the budget)\n";
   } else {
     t << "  (NOT saturated: stopped by the budget of " << explore.max_motions << " motions, with "
       << g.probed << " of " << g.nodes.size() << " states probed, " << g.closing_rounds

@@ -46,8 +46,9 @@ TEST_CASE("graph --svg writes the picture Graphviz draws of the DOT", "[cli][gra
   std::filesystem::create_directories(dir);
   const std::string svg = (dir / "g.svg").string(), dot = (dir / "g.dot").string();
   // A small budget: the picture is what is tested here, not the exploration.
-  const testing::Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "20",
-                                      "--svg", svg, "--dot", dot, "--jobs", "1"});
+  const testing::Outcome r =
+      RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "20", "--time-limit", "0",
+               "--svg", svg, "--dot", dot, "--jobs", "1"});
   INFO(r.err);
   REQUIRE(r.exit_code <= 1);
   CHECK(r.out.find("SVG (Graphviz dot) written to " + svg) != std::string::npos);

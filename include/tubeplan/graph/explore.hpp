@@ -66,9 +66,11 @@ struct ExploreOptions {
   /// of ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
   /// node's ten probes after its prefix). The graph says whether it saturated within it.
   int max_motions = 3000;
-  /// Wall time bound [s] (0: none). Once passed, no motion starts and those under way stop
-  /// within 64 ticks and are dropped with every motion after the first of them: the graph is the
-  /// one `max_motions` set to the motions kept would give, on any number of threads.
+  /// Wall time bound [s] from the start (0: none), holding once the goal is a node: a goal not yet
+  /// reached is explored for, within max_motions. Once it holds and has passed, no motion starts
+  /// and those under way stop within 64 ticks and are dropped with every motion after the first
+  /// of them: the graph is the one `max_motions` set to the motions kept would give, on any
+  /// number of threads.
   double time_limit_s = 0.0;
   /// Called on the calling thread about every `status_interval_s` while motions run, and once
   /// after each group (may be empty; --jobs does not change what is explored).
