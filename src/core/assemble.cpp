@@ -156,6 +156,34 @@ EaseIn EaseInOf(double distance_m, double eps, double tau) {
   return {factor, tau * 6.0 * x * (1.0 - x) / (factor * band)};
 }
 
+// The second derivative over the end's element vector e of c . o, o the offset o0 of a rim point
+// turned with the end's tangent t = e / |e| as Material turns it (o = |o0| v / |v|, v = (I - t t^T)
+// o0), c fixed: the turn's share of the rim's Hessian, about F r1 / h^2 (docs/core.md, "The end
+// rim").
+Mat3 OffsetTurnHessian(const Vec3& o0, const Vec3& e, const Vec3& c) {
+  const Mat3 I = Mat3::Identity();
+  const double le = e.norm(), l0 = o0.norm();
+  const Vec3 t = e / le;
+  const double a = o0.dot(t);
+  const Vec3 v = o0 - a * t;
+  const double lv = v.norm();
+  if (!(lv > 0.0)) return Mat3::Zero();
+  const Vec3 vh = v / lv;
+  const Vec3 c_across = c - c.dot(vh) * vh;
+  // Over t: the gradient g and its derivative M, through v / |v| and |v|^2 = |o0|^2 - a^2.
+  const Vec3 w = c.dot(t) * o0 + a * c_across;
+  const Vec3 g = -(l0 / lv) * w;
+  const Mat3 dvh_dt = -((I - vh * vh.transpose()) / lv) * (t * o0.transpose() + a * I);
+  const Mat3 dc_across_dt = -(vh * c.transpose() + c.dot(vh) * I) * dvh_dt;
+  const Mat3 M = -l0 * ((a / (lv * lv * lv)) * w * o0.transpose() +
+                        (o0 * c.transpose() + c_across * o0.transpose() + a * dc_across_dt) / lv);
+  // Over e, through t = e / |e|: T^T M T and g's share of the unit vector's curvature.
+  const Mat3 T = (I - t * t.transpose()) / le;
+  return T * (0.5 * (M + M.transpose())) * T -
+         (g * t.transpose() + t * g.transpose() + g.dot(t) * (I - 3.0 * t * t.transpose())) /
+             (le * le);
+}
+
 // The rim's points on one part, samples [first, end): one contact whose distance is the smooth
 // minimum d = -tau log sum exp(-d_j / tau) of theirs (each eased in as it joins: EaseInOf), with
 // the paper's K (eps - d)+ shared by the softmin's weights. Tilted, the nearest point takes it all
@@ -189,29 +217,91 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
   for (int j = 0; j < count; ++j) w[std::size_t(j)] /= sum;
   const double force = K * depth;
   for (int j = 0; j < count; ++j) s[j].normal_force_N = force * w[std::size_t(j)];
-  if (a.gradient()) {
-    // d distance / d (x_{N-1}, x_N) of each point, their weighted mean, and the softmin's
-    // curvature: H = K m m^T + (F / tau) (sum w g g^T - m m^T).
-    Eigen::Matrix<double, 6, 1> mean = Eigen::Matrix<double, 6, 1>::Zero();
-    Eigen::Matrix<double, 6, 6> spread = Eigen::Matrix<double, 6, 6>::Zero();
-    for (int j = 0; j < count; ++j) {
-      if (!(w[std::size_t(j)] > 0.0)) continue;
-      const MaterialPoint mp =
-          Material(Carrier::kEndNode, x_W, s[j].node, 0.0, s[j].moving_offset_W);
-      const Eigen::Matrix<double, 6, 1> g = (1.0 + ease[std::size_t(j)].slope) *
-                                            (mp.jacobian.leftCols<6>().transpose() * s[j].normal_W);
-      mean += w[std::size_t(j)] * g;
-      spread += w[std::size_t(j)] * g * g.transpose();
+  if (!a.gradient()) return 0.5 * K * depth * depth;
+  // d distance / d (x_{N-1}, x_N) of each point g_j, their weighted mean m, and the softmin's
+  // curvature: H = K m m^T + (F / tau) (sum w g g^T - m m^T). On a frictionless part, where the
+  // ring is placed afresh at every iterate with its first point the nearest, also each point's own
+  // - F sum mu_j d2 d_j, mu_j = w_j (1 + ease slope), of the part's distance about it and of its
+  // turn with the end, and the ring's turn theta with the nodes where the nearest point bears
+  // (docs/core.md, "The end rim").
+  const int n = model.rod.elements;
+  const Vec3 e = x_W[std::size_t(n)] - x_W[std::size_t(n - 1)];
+  const Vec3 t_end = e.normalized();
+  const bool placed = model.parts[std::size_t(s[0].part)].friction.IsFrictionless();
+  using Vec6 = Eigen::Matrix<double, 6, 1>;
+  using Mat6 = Eigen::Matrix<double, 6, 6>;
+  Vec6 mean = Vec6::Zero(), mean_x_theta = Vec6::Zero(), own_x_theta = Vec6::Zero();
+  Mat6 spread = Mat6::Zero(), own = Mat6::Zero();
+  Mat3 turn = Mat3::Zero();
+  double mean_theta = 0.0, spread_theta = 0.0, own_theta = 0.0;
+  Vec6 nearest_x_theta = Vec6::Zero();
+  double nearest_theta_theta = 0.0, nearest_share = 0.0;
+  for (int j = 0; j < count; ++j) {
+    if (!(w[std::size_t(j)] > 0.0)) continue;
+    const double slope = 1.0 + ease[std::size_t(j)].slope;
+    const double mu = w[std::size_t(j)] * slope;
+    const Vec3& n_j = s[j].normal_W;
+    const Mat3& C = s[j].curvature_per_m;
+    const MaterialPoint mp = Material(Carrier::kEndNode, x_W, s[j].node, 0.0, s[j].moving_offset_W);
+    const Eigen::Matrix<double, 3, 6> J = mp.jacobian.leftCols<6>();
+    const Vec6 g = slope * (J.transpose() * n_j);
+    mean += w[std::size_t(j)] * g;
+    spread += w[std::size_t(j)] * g * g.transpose();
+    if (!a.hessian() || !placed) continue;
+    own += mu * (J.transpose() * C * J);
+    turn += OffsetTurnHessian(s[j].moving_offset_W, e, -force * mu * n_j);
+    // The point's distance over the ring's turn theta (its offset o turning to t x o).
+    const Vec3 o = mp.offset_W, q = t_end.cross(o);
+    Eigen::Matrix<double, 3, 6> Jq =
+        Material(Carrier::kEndNode, x_W, s[j].node, 0.0, t_end.cross(s[j].moving_offset_W))
+            .jacobian.leftCols<6>();
+    Jq.rightCols<3>() -= Mat3::Identity();
+    const double d_theta = n_j.dot(q);
+    const Vec6 d_x_theta = J.transpose() * (C * q) + Jq.transpose() * n_j;
+    const double d_theta_theta = q.dot(C * q) - n_j.dot(o);
+    mean_theta += w[std::size_t(j)] * slope * d_theta;
+    spread_theta += w[std::size_t(j)] * slope * slope * d_theta * d_theta;
+    mean_x_theta += w[std::size_t(j)] * slope * d_theta * g;
+    own_x_theta += mu * d_x_theta;
+    own_theta += mu * d_theta_theta;
+    if (s[j].feature == 0) {
+      nearest_x_theta = d_x_theta;
+      nearest_theta_theta = d_theta_theta;
+      nearest_share = w[std::size_t(j)];
     }
-    StencilTerm t;
-    t.first = model.rod.elements - 1;
-    t.nodes = 2;
-    t.gradient.head<6>() = -force * mean;
-    if (a.hessian())
-      t.hessian.topLeftCorner<6, 6>() =
-          K * mean * mean.transpose() + (force / tau) * (spread - mean * mean.transpose());
-    a.AddStencil(t);
   }
+  StencilTerm t;
+  t.first = n - 1;
+  t.nodes = 2;
+  t.gradient.head<6>() = -force * mean;
+  if (a.hessian()) {
+    Mat6 H = K * mean * mean.transpose() + (force / tau) * (spread - mean * mean.transpose()) -
+             force * own;
+    H.block<3, 3>(0, 0) += turn;
+    H.block<3, 3>(3, 3) += turn;
+    H.block<3, 3>(0, 3) -= turn;
+    H.block<3, 3>(3, 0) -= turn;
+    // Where the end lies flat the points share the load, and the nearest point is not defined
+    // (its turn grows without bound as the tilt vanishes): the term fades in as that point
+    // takes over, from half the load to 90 % of it.
+    const double x = std::clamp((nearest_share - 0.5) / 0.4, 0.0, 1.0);
+    const double fade = x * x * (3.0 - 2.0 * x);
+    if (placed && nearest_theta_theta > 0.0 && fade > 0.0) {
+      // The nearest point's turn theta*(x): d theta* / dx = -d_x_theta / d_theta_theta; the
+      // energy's own derivatives over theta, as over x.
+      const Vec6 e_x_theta = K * mean * mean_theta +
+                             (force / tau) * (mean_x_theta - mean * mean_theta) -
+                             force * own_x_theta;
+      const double e_theta_theta = K * mean_theta * mean_theta +
+                                   (force / tau) * (spread_theta - mean_theta * mean_theta) -
+                                   force * own_theta;
+      const Vec6 theta_x = -nearest_x_theta / nearest_theta_theta;
+      H += fade * (e_x_theta * theta_x.transpose() + theta_x * e_x_theta.transpose() +
+                   e_theta_theta * theta_x * theta_x.transpose());
+    }
+    t.hessian.topLeftCorner<6, 6>() = H;
+  }
+  a.AddStencil(t);
   return 0.5 * K * depth * depth;
 }
 

@@ -245,3 +245,77 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
     }
   }
 }
+
+TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative",
+          "[core][gradient]") {
+  // The rubber tube straight, 30 deg from plumb, its end's rim pressed 0.1 mm into a frictionless
+  // floor: one rim point bears about 1 N. The ring is placed afresh at the nearest point at every
+  // iterate, so turning the end moves the bearing point on the rim to second order, by about
+  // F r1 / h^2 (~100 N/m against the contact's K = 1e4 and bending's EI / h^3 ~ 1e4 N/m), both as
+  // a material point turning with the end and as the ring turning to the nearest point. Steps
+  // across the tube at every node (the stiff axial springs of the straight tube do not resist
+  // them to first order) must see both in H v as in the central difference of the gradient.
+  scene::Scene s;
+  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
+  s.contact = {1e4, 1e-3, 1e-4};
+  s.device.coupling_stiffness_N_per_m = 400.0;
+  s.device.coupling_damping_Ns_per_m = 0.0;
+  const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
+  scene::Part floor;
+  floor.name = "floor";
+  floor.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
+  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, -0.01);
+  s.parts = {floor};
+  const double tilt = 30.0 * kPi / 180.0;
+  const Eigen::Vector3d d(std::sin(tilt), 0.0, -std::cos(tilt));
+  s.X_WH_start.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), d).toRotationMatrix();
+  core::Model model;
+  core::Data data;
+  Build(s, model, data);
+  const int n = model.rod.elements;
+  // The rim's lowest point is r1 sin(tilt) below the end's centre; it is put eps - 0.1 mm above
+  // the floor's top.
+  const double end_z = eps - 1e-4 + r1 * std::sin(tilt);
+  std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
+  for (int k = 0; k <= n; ++k)
+    x[std::size_t(k)] = Eigen::Vector3d(0.0, 0.0, end_z) - (n - k) * model.rod.segment_m * d;
+  data.input.p_hand_W = x[0];
+  data.input.tangent_held_W = d;
+  core::FindContacts(model, x, data, core::Choices::kKeep);
+  core::Assemble(model, data, x, core::Derivatives::kHessian);
+  const core::Scratch& sc = data.scratch;
+  double rim_force_N = 0.0;
+  for (int k = 0; k < sc.sample_count; ++k)
+    if (sc.samples[std::size_t(k)].kind == core::SampleKind::kRim)
+      rim_force_N += sc.samples[std::size_t(k)].normal_force_N;
+  CHECK(rim_force_N == Approx(1.0).epsilon(0.01));
+  REQUIRE(sc.factors.low_rank_count == 0);
+  const core::BandMatrix band = sc.hessian;
+  const auto gradient_at = [&](const Eigen::VectorXd& step) {
+    std::vector<Eigen::Vector3d> y = x;
+    for (int k = 0; k <= n; ++k) y[std::size_t(k)] += step.segment<3>(3 * k);
+    core::FindContacts(model, y, data, core::Choices::kPending);
+    core::Assemble(model, data, y, core::Derivatives::kGradient);
+    return Eigen::VectorXd(data.scratch.gradient);
+  };
+  std::mt19937_64 rng(20261205);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const Eigen::Vector3d across_1 = d.unitOrthogonal(), across_2 = d.cross(across_1);
+  for (int trial = 0; trial < 6; ++trial) {
+    Eigen::VectorXd v(3 * (n + 1));
+    for (int k = 0; k <= n; ++k)
+      v.segment<3>(3 * k) = (u01(rng) - 0.5) * across_1 + (u01(rng) - 0.5) * across_2;
+    Eigen::VectorXd Hv(v.size());
+    band.Multiply(v, Hv);
+    // A step far inside the rim's smooth minimum's width (0.2 um): the gradient's rounding
+    // (1e-16 of ~1 N over 2e-9 m) and the truncation leave ~1e-7 of H v's ~1e4 N/m.
+    const double h = 1e-9;
+    const Eigen::VectorXd fd = (gradient_at(h * v) - gradient_at(-h * v)) / (2.0 * h);
+    const double scale = Hv.lpNorm<Eigen::Infinity>();
+    INFO("trial " << trial << ": |H v| " << scale << " N/m, |H v - fd| "
+                  << (Hv - fd).lpNorm<Eigen::Infinity>() << " N/m");
+    // 1e-4 of H v: a hundredth of the turn's term.
+    CHECK((Hv - fd).lpNorm<Eigen::Infinity>() < 1e-4 * scale);
+  }
+}
