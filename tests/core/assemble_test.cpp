@@ -40,6 +40,33 @@ void Build(const scene::Scene& s, core::Model& model, core::Data& data) {
   core::InitData(model, s.X_WH_start, data);
 }
 
+// The rubber tube of scenes/groove.yaml (18 elements) on an undamped coupling, over a floor: a
+// box of the given size whose top is at z = 0, centred over (x, y).
+scene::Scene RubberOverFloor(const Eigen::Vector3d& size_m, double x_m, double y_m) {
+  scene::Scene s;
+  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
+  s.contact = {1e4, 1e-3, 1e-4};
+  s.device.coupling_stiffness_N_per_m = 400.0;
+  s.device.coupling_damping_Ns_per_m = 0.0;
+  scene::Part floor;
+  floor.name = "floor";
+  floor.size_m = size_m;
+  floor.X_WP.translation() = Eigen::Vector3d(x_m, y_m, -0.5 * size_m.z());
+  s.parts = {floor};
+  return s;
+}
+
+// The solve's gradient with the nodes x moved by `step`, the contacts found again (the sections'
+// choices pending, as within a tick).
+Eigen::VectorXd GradientAt(const core::Model& model, core::Data& data,
+                           const std::vector<Eigen::Vector3d>& x, const Eigen::VectorXd& step) {
+  std::vector<Eigen::Vector3d> y = x;
+  for (std::size_t k = 0; k < y.size(); ++k) y[k] += step.segment<3>(3 * int(k));
+  core::FindContacts(model, y, data, core::Choices::kPending);
+  core::Assemble(model, data, y, core::Derivatives::kGradient);
+  return data.scratch.gradient;
+}
+
 }  // namespace
 
 TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core][gradient]") {
@@ -182,17 +209,8 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
   // coupling every node (the rank-one term the solve adds to the band). Tipped up by 0.5 mm
   // over its length, its held end bears alone and the term fits in the band. Either way, H v
   // must be the central difference of the gradient along v.
-  scene::Scene s;
-  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
-  s.contact = {1e4, 1e-3, 1e-4};
-  s.device.coupling_stiffness_N_per_m = 400.0;
-  s.device.coupling_damping_Ns_per_m = 0.0;
+  scene::Scene s = RubberOverFloor({0.4, 0.2, 0.02}, 0.1, 0.0);
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m;
-  scene::Part floor;
-  floor.name = "floor";
-  floor.size_m = Eigen::Vector3d(0.4, 0.2, 0.02);
-  floor.X_WP.translation() = Eigen::Vector3d(0.1, 0.0, -0.01);
-  s.parts = {floor};
   s.X_WH_start.linear() =
       Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitX())
           .toRotationMatrix();
@@ -221,13 +239,6 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
       u.push_back(sc.factors.low_rank_u[std::size_t(i)]);
       c.push_back(sc.factors.low_rank_c[std::size_t(i)]);
     }
-    const auto gradient_at = [&](const Eigen::VectorXd& step) {
-      std::vector<Eigen::Vector3d> y = x;
-      for (int k = 0; k <= n; ++k) y[std::size_t(k)] += step.segment<3>(3 * k);
-      core::FindContacts(model, y, data, core::Choices::kPending);
-      core::Assemble(model, data, y, core::Derivatives::kGradient);
-      return Eigen::VectorXd(data.scratch.gradient);
-    };
     for (int trial = 0; trial < 6; ++trial) {
       Eigen::VectorXd v(3 * (n + 1));
       for (int i = 0; i < v.size(); ++i) v[i] = u01(rng) - 0.5;
@@ -238,7 +249,8 @@ TEST_CASE("The solve's Hessian, band and rank-one terms, is its gradient's deriv
       // weights change smoothly; the gradient's rounding (1e-16 of ~1 N over 2e-11 m) is ~1e-5
       // of H v's ~F / tau.
       const double h = 1e-11;
-      const Eigen::VectorXd fd = (gradient_at(h * v) - gradient_at(-h * v)) / (2.0 * h);
+      const Eigen::VectorXd fd =
+          (GradientAt(model, data, x, h * v) - GradientAt(model, data, x, -h * v)) / (2.0 * h);
       const double scale = Hv.lpNorm<Eigen::Infinity>();
       INFO("trial " << trial);
       CHECK((Hv - fd).lpNorm<Eigen::Infinity>() < 1e-4 * scale);
@@ -255,17 +267,8 @@ TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative
   // a material point turning with the end and as the ring turning to the nearest point. Steps
   // across the tube at every node (the stiff axial springs of the straight tube do not resist
   // them to first order) must see both in H v as in the central difference of the gradient.
-  scene::Scene s;
-  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
-  s.contact = {1e4, 1e-3, 1e-4};
-  s.device.coupling_stiffness_N_per_m = 400.0;
-  s.device.coupling_damping_Ns_per_m = 0.0;
+  scene::Scene s = RubberOverFloor({0.4, 0.4, 0.02}, 0.0, 0.0);
   const double r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
-  scene::Part floor;
-  floor.name = "floor";
-  floor.size_m = Eigen::Vector3d(0.4, 0.4, 0.02);
-  floor.X_WP.translation() = Eigen::Vector3d(0.0, 0.0, -0.01);
-  s.parts = {floor};
   const double tilt = 30.0 * kPi / 180.0;
   const Eigen::Vector3d d(std::sin(tilt), 0.0, -std::cos(tilt));
   s.X_WH_start.linear() =
@@ -292,13 +295,6 @@ TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative
   CHECK(rim_force_N == Approx(1.0).epsilon(0.01));
   REQUIRE(sc.factors.low_rank_count == 0);
   const core::BandMatrix band = sc.hessian;
-  const auto gradient_at = [&](const Eigen::VectorXd& step) {
-    std::vector<Eigen::Vector3d> y = x;
-    for (int k = 0; k <= n; ++k) y[std::size_t(k)] += step.segment<3>(3 * k);
-    core::FindContacts(model, y, data, core::Choices::kPending);
-    core::Assemble(model, data, y, core::Derivatives::kGradient);
-    return Eigen::VectorXd(data.scratch.gradient);
-  };
   std::mt19937_64 rng(20261205);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   const Eigen::Vector3d across_1 = d.unitOrthogonal(), across_2 = d.cross(across_1);
@@ -311,7 +307,8 @@ TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative
     // A step far inside the rim's smooth minimum's width (0.2 um): the gradient's rounding
     // (1e-16 of ~1 N over 2e-9 m) and the truncation leave ~1e-7 of H v's ~1e4 N/m.
     const double h = 1e-9;
-    const Eigen::VectorXd fd = (gradient_at(h * v) - gradient_at(-h * v)) / (2.0 * h);
+    const Eigen::VectorXd fd =
+        (GradientAt(model, data, x, h * v) - GradientAt(model, data, x, -h * v)) / (2.0 * h);
     const double scale = Hv.lpNorm<Eigen::Infinity>();
     INFO("trial " << trial << ": |H v| " << scale << " N/m, |H v - fd| "
                   << (Hv - fd).lpNorm<Eigen::Infinity>() << " N/m");
