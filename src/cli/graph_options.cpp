@@ -86,9 +86,9 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   sub->add_option("--time-limit", o.time_limit_s,
-                  "stop exploring after this many seconds of wall time once the goal state has "
-                  "been reached, saturated or not (said in the output); a goal not reached yet is "
-                  "explored for within the budget (0: no limit)")
+                  "stop exploring this many seconds of wall time after the start, saturated or not "
+                  "(said in the output), once the goal state has a stay; until then up to 60 s "
+                  "more (0: no limit)")
       ->check(CLI::Range(0.0, 1e7))
       ->capture_default_str();
   sub->add_option("--jobs", o.jobs, "threads (default: the machine's cores)")

@@ -233,14 +233,21 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
                      const std::function<void(const SaturationPoint&)>& progress) {
   const auto clock_start = Clock::now();
   ContactGraph graph;
-  // The time limit counts from the start but holds only once the goal is a node: a scene whose
-  // goal takes longer to reach is explored until it is, within the budget.
+  // The time limit counts from the start and holds once the goal has a stay; until then the
+  // exploration may go on kGoalSearch_s longer.
+  const auto after = [&](double seconds) {
+    return clock_start +
+           std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  };
   Deadline deadline;
+  if (o.time_limit_s > 0.0) deadline.at = after(o.time_limit_s + kGoalSearch_s);
+  bool goal_held = false;
   const std::string goal_cf = states::ToString(scene.goal);
   const auto arm_deadline = [&] {
-    if (o.time_limit_s > 0.0 && !deadline.at && graph.FindNode(goal_cf) >= 0)
-      deadline.at = clock_start + std::chrono::duration_cast<Clock::duration>(
-                                      std::chrono::duration<double>(o.time_limit_s));
+    if (!(o.time_limit_s > 0.0) || goal_held) return;
+    const int goal = graph.FindNode(goal_cf);
+    goal_held = goal >= 0 && graph.nodes[std::size_t(goal)].ticks > 0;
+    if (goal_held) deadline.at = after(o.time_limit_s);
   };
   Merger merger(graph, ExploreForceLimit(scene, o));
   std::vector<std::unique_ptr<core::Core>> cores;
@@ -298,6 +305,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
       stop(ExploreEnd::kTimeLimit);
     }
     arm_deadline();
+    if (deadline.Passed()) stop(ExploreEnd::kTimeLimit);
     status(first + merged, first + merged);
     return merged;
   };

@@ -3,7 +3,9 @@
 #include <iomanip>
 #include <numbers>
 #include <sstream>
+#include <string>
 
+#include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/summary.hpp>
 #include <tubeplan/report/graph_report.hpp>
 #include <tubeplan/states/contact_formation.hpp>
@@ -53,8 +55,12 @@ void PrintSaturation(std::ostream& t, const graph::ContactGraph& g,
       t << "the last round found no new state; no closing rounds)\n";
     }
   } else if (g.end == graph::ExploreEnd::kTimeLimit) {
-    t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s after "
-      << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
+    const bool goal_held = g.goal >= 0 && g.nodes[std::size_t(g.goal)].ticks > 0;
+    t << "  (NOT saturated: stopped by the time limit of " << explore.time_limit_s << " s"
+      << (goal_held ? ""
+                    : " and the " + std::to_string(int(graph::kGoalSearch_s)) +
+                          " s more it allows while the goal has no stay")
+      << " after " << g.motions.size() << " motions, with " << g.probed << " of " << g.nodes.size()
       << " states probed, " << g.closing_rounds
       << " closing rounds; a larger --time-limit, or 0, explores on to the budget)\n";
   } else {

@@ -371,7 +371,8 @@ const ContactGraph& SmallGraph(int jobs) {
   return graphs[jobs];
 }
 
-// The exploration with the default options, as `tubeplan graph scenes/groove.yaml` runs it.
+// The exploration with the library's default options, as `tubeplan graph scenes/groove.yaml
+// --time-limit 0` runs it.
 const ContactGraph& DefaultGraph(int jobs) {
   static std::map<int, ContactGraph> graphs;
   if (!graphs.contains(jobs)) {
@@ -941,17 +942,12 @@ TEST_CASE("The time limit stops exploring; the graph is the one of the motions k
   const ContactGraph limited = graph::Explore(FloorOnly(), o);
   CHECK(limited.end == graph::ExploreEnd::kTimeLimit);
   CHECK_FALSE(limited.saturated);
-  // The motions under way at the limit stop within 64 ticks: well within a second here.
-  CHECK(limited.seconds < 0.5 + 1.0);
+  // The limit holds once the goal has a stay: it has one, whatever the machine's speed.
+  REQUIRE(limited.goal >= 0);
+  CHECK(limited.nodes[std::size_t(limited.goal)].ticks > 0);
   REQUIRE(!seen.empty());
   CHECK(seen.back().motions_done == int(limited.motions.size()));
   CHECK(seen.back().nodes == int(limited.nodes.size()));
-  if (limited.motions.empty()) {
-    // Nothing ended in time (a very busy machine): no start, no goal, an empty graph.
-    CHECK(limited.start == -1);
-    CHECK(limited.nodes.empty());
-    return;
-  }
   // A budget of the motions it kept explores the same graph.
   graph::ExploreOptions b;
   b.jobs = 1;

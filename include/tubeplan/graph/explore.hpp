@@ -66,11 +66,11 @@ struct ExploreOptions {
   /// of ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
   /// node's ten probes after its prefix). The graph says whether it saturated within it.
   int max_motions = 3000;
-  /// Wall time bound [s] from the start (0: none), holding once the goal is a node: a goal not yet
-  /// reached is explored for, within max_motions. Once it holds and has passed, no motion starts
-  /// and those under way stop within 64 ticks and are dropped with every motion after the first
-  /// of them: the graph is the one `max_motions` set to the motions kept would give, on any
-  /// number of threads.
+  /// Wall time bound [s] from the start (0: none), holding once the goal has a stay: until then
+  /// the exploration may go on kGoalSearch_s longer. Once passed, no motion starts and those
+  /// under way stop within 64 ticks and are dropped with every motion after the first of them:
+  /// the graph is the one `max_motions` set to the motions kept would give, on any number of
+  /// threads.
   double time_limit_s = 0.0;
   /// Called on the calling thread about every `status_interval_s` while motions run, and once
   /// after each group (may be empty; --jobs does not change what is explored).
@@ -102,6 +102,9 @@ struct ExploreOptions {
 /// The neighbour probes of a node: a step along and against each of three directions and a turn
 /// either way about two axes (ExploreOptions::probe_step_m, probe_turn_rad).
 inline constexpr int kProbesPerNode = 2 * 3 + 2 * 2;
+
+/// How much longer than its time limit an exploration may go on while the goal has no stay [s].
+inline constexpr double kGoalSearch_s = 60.0;
 
 /// Number of PC changes between two CFs: a PC added, removed or re-marked counts one; a PC that
 /// keeps one of its elements and changes the other (Ee -> Fe on the same face, a rim sliding
