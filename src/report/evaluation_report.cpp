@@ -16,8 +16,8 @@ namespace tubeplan::report {
 namespace {
 
 // The graph section of the HTML report: each scene's pruned contact-state graph, explored with the
-// core as `tubeplan graph SCENE` does (same defaults), coloured by this run's verdicts, drawn by
-// Graphviz's dot. On failure returns false with `error`.
+// core as `tubeplan graph SCENE --closing 0 --replays 0 --time-limit 0` does, coloured by this
+// run's verdicts, drawn by Graphviz's dot. On failure returns false with `error`.
 bool GraphSections(const std::vector<batch::Evaluated>& results,
                    const std::vector<io::PlanLoadResult>& loaded, int jobs, HtmlOptions& html,
                    std::string& error) {
