@@ -163,6 +163,7 @@ EaseIn EaseInOf(double distance_m, double eps, double tau) {
 Mat3 OffsetTurnHessian(const Vec3& o0, const Vec3& e, const Vec3& c) {
   const Mat3 I = Mat3::Identity();
   const double le = e.norm(), l0 = o0.norm();
+  if (!(le > 0.0)) return Mat3::Zero();
   const Vec3 t = e / le;
   const double a = o0.dot(t);
   const Vec3 v = o0 - a * t;
@@ -281,14 +282,11 @@ double AddRim(const Model& model, Data& data, std::span<const Vec3> x_W, int fir
     H.block<3, 3>(3, 3) += turn;
     H.block<3, 3>(0, 3) -= turn;
     H.block<3, 3>(3, 0) -= turn;
-    // Where the end lies flat the points share the load, and the nearest point is not defined
-    // (its turn grows without bound as the tilt vanishes): the term fades in as that point
-    // takes over, from half the load to 90 % of it.
+    // The ring's turn fades in as the nearest point takes over, from half the load to 90 %.
     const double x = std::clamp((nearest_share - 0.5) / 0.4, 0.0, 1.0);
     const double fade = x * x * (3.0 - 2.0 * x);
-    if (placed && nearest_theta_theta > 0.0 && fade > 0.0) {
-      // The nearest point's turn theta*(x): d theta* / dx = -d_x_theta / d_theta_theta; the
-      // energy's own derivatives over theta, as over x.
+    if (placed && nearest_theta_theta > tau && fade > 0.0) {
+      // theta*(x), the nearest point's turn: d theta* / dx = -d_x_theta / d_theta_theta.
       const Vec6 e_x_theta = K * mean * mean_theta +
                              (force / tau) * (mean_x_theta - mean * mean_theta) -
                              force * own_x_theta;

@@ -304,8 +304,9 @@ TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative
       v.segment<3>(3 * k) = (u01(rng) - 0.5) * across_1 + (u01(rng) - 0.5) * across_2;
     Eigen::VectorXd Hv(v.size());
     band.Multiply(v, Hv);
-    // A step far inside the rim's smooth minimum's width (0.2 um): the gradient's rounding
-    // (1e-16 of ~1 N over 2e-9 m) and the truncation leave ~1e-7 of H v's ~1e4 N/m.
+    // A step far inside the rim's smooth minimum's width (0.2 um): the rounding of the stiff
+    // axial springs' forces (1.8e7 N/m times ~1e-17 m over 2e-9 m) leaves 0.2-0.5 N/m, 1e-5 of
+    // H v's ~6e4 N/m; the turn's terms are ~100 N/m.
     const double h = 1e-9;
     const Eigen::VectorXd fd =
         (GradientAt(model, data, x, h * v) - GradientAt(model, data, x, -h * v)) / (2.0 * h);

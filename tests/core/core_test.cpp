@@ -760,14 +760,13 @@ TEST_CASE(
   CHECK(branch_holds >= 70);
 }
 
-TEST_CASE("A frictionless column on its rim past its buckling load converges in every tick",
-          "[core]") {
+TEST_CASE("A frictionless column on its rim past its buckling load converges", "[core]") {
   // The rubber tube held 1 degree off plumb over a frictionless floor and lowered 45 mm: its
   // end lands flat, tips onto its rim, and the column bends on, the rim's nearest point sliding
-  // round as the end turns. Every tick converges (the ring's turn to its nearest point is in the
-  // Hessian: without it nearly every tick on the rim stopped short of the tolerance), and on its
+  // round as the end turns. The solve converges in all but the ticks where the end tips (the
+  // ring's turn to its nearest point is in the Hessian; docs/core.md, "The end rim"), and on its
   // post-buckling branch the column bears at least the clamped-free Euler load pi^2 EI / 4 l^2:
-  // the elastica's load rises from there as it bends.
+  // the elastica's load rises from there as it bends (measured 14-39 % above it here).
   scene::Scene s = RubberScene();
   s.friction = scene::Friction{};
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m;
@@ -791,6 +790,8 @@ TEST_CASE("A frictionless column on its rim past its buckling load converges in 
     ++branch_holds;
     CHECK(out.force_W_N.z() >= euler_N);
   }
+  // It lands flat and stays on its face to about 3.5 N before it tips: on its rim in 38 of the 60
+  // holds.
   CHECK(branch_holds >= 30);
   INFO(tally.unconverged << " of " << tally.ticks << " ticks unconverged");
   // A tick or two where the end tips from its face onto its rim, with no equilibrium near.
