@@ -275,7 +275,7 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   };
   // Runs a group of motions whole, or as much of it as the budget leaves, and merges the results
   // in motion order up to the first the time limit stopped (that one and those after it are
-  // dropped, and so is the rest of the exploration); arms the limit once the goal is a node.
+  // dropped, and so is the rest of the exploration); arms the limit once the goal has a stay.
   // Returns how many were merged.
   const auto run = [&](std::vector<Motion> group, const std::vector<RunPointPtr>& resumes) {
     if (stopped == ExploreEnd::kTimeLimit) return 0;
@@ -305,7 +305,6 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
       stop(ExploreEnd::kTimeLimit);
     }
     arm_deadline();
-    if (deadline.Passed()) stop(ExploreEnd::kTimeLimit);
     status(first + merged, first + merged);
     return merged;
   };
