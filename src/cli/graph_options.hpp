@@ -25,8 +25,8 @@ struct GraphOptions {
   bool unpruned = false;
   std::uint64_t seed = 1;
   int random = 120;
-  int closing = 30;  // random motions per closing round (plans: none; see plans_command.cpp)
-  int replays = 4;   // perturbed copies of each candidate plan per closing round (plans: none)
+  int closing = 30;  // random motions per closing round
+  int replays = 4;   // perturbed copies of each candidate plan per probe group and closing round
   int budget = 3000;
   double time_limit_s = 10.0;  // 0: none; holds once the goal is reached
   int jobs = 0;                // 0: the machine's cores

@@ -117,10 +117,6 @@ Command AddPlansCommand(CLI::App& app, Streams streams) {
                   "amplitude of 8-12 Hz tremor added to the hand, e.g. \"0.1 mm\" (default none)");
   sub->add_option("--quantum", options->quantum,
                   "round positions to this device resolution, e.g. \"0.03 mm\" (default none)");
-  // Plans need paths to the goal, which probing finds: no closing rounds unless asked for (they
-  // make the graph complete and take several times as long).
-  options->graph.closing = 0;
-  options->graph.replays = 0;
   AddGraphOptions(sub, options->graph);
   return {sub, [options, streams] { return RunPlans(*options, streams); }};
 }

@@ -1,13 +1,14 @@
 // The explorer (Explore): sweeps, aims, random motions, probes and closing rounds, in that order,
-// and the candidate plans its closing rounds replay; PcChanges and the force limit its motions
-// keep to. Its motions are made in explorer_motions.cpp, run through the core in run_motion.cpp
-// and merged into the graph in merger.cpp.
+// and the candidate plans it replays between groups of probes and in closing rounds; PcChanges and
+// the force limit its motions keep to. Its motions are made in explorer_motions.cpp, run through
+// the core in run_motion.cpp and merged into the graph in merger.cpp.
 
 #include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
 #include <set>
+#include <span>
 #include <utility>
 
 #include <tubeplan/graph/explore.hpp>
@@ -34,6 +35,10 @@ using explorer::RunPointPtr;
 // the quickest minimum-jerk reach at 80 mm/s sped up 1.25 times, and about 0.03 mm of its tremor;
 // at a sharp turn of the explorer's own motion a chord cuts the corner by up to about 1 mm).
 constexpr int kReplayTicksPerMove = 20;
+
+// Nodes probed in one group, after which the candidate plans are replayed: about as many motions
+// each (four copies of four to seven candidates).
+constexpr int kProbeGroup = 16;
 
 std::set<std::string> ReachedElements(const ContactGraph& graph) {
   std::set<std::string> reached;
@@ -111,16 +116,26 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
 
 }  // namespace
 
-std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
-                                                               const ContactGraph& graph,
-                                                               const ExploreOptions& options) {
-  // The candidate paths of the graph as it stands, pruned as `plans` prunes it; of the explored
-  // graph only (a state seen only in an evaluate report has no witness to aim at).
-  ContactGraph marked;
+namespace {
+
+// The candidate paths of a graph: its explored states (a state seen only in an evaluate report
+// has no witness to aim at), pruned as `plans` prunes them, and the cheapest start -> goal paths
+// through what is kept; `explored_node` maps the pruned graph's nodes back to the graph's.
+struct CandidatePaths {
+  ContactGraph pruned;
+  std::vector<int> explored_node;
+  std::vector<Path> paths;
+};
+
+CandidatePaths FindCandidatePaths(const scene::Scene& scene, const ContactGraph& graph,
+                                  const ExploreOptions& options) {
+  CandidatePaths c;
+  ContactGraph& marked = c.pruned;
   std::vector<int> index(graph.nodes.size(), -1);
   for (std::size_t i = 0; i < graph.nodes.size(); ++i) {
     if (graph.nodes[i].from_replay) continue;
     index[i] = static_cast<int>(marked.nodes.size());
+    c.explored_node.push_back(static_cast<int>(i));
     marked.nodes.push_back(graph.nodes[i]);
   }
   for (const Arc& a : graph.arcs) {
@@ -131,14 +146,49 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   }
   marked.start = graph.start >= 0 ? index[std::size_t(graph.start)] : -1;
   MarkStartAndGoal(scene, marked);
-  if (marked.start < 0 || marked.goal < 0 || marked.goal == marked.start) return {};
+  if (marked.start < 0 || marked.goal < 0 || marked.goal == marked.start) return c;
   const PruneWeights weights =
       options.weights.value_or(PruneWeights{scene.heuristics.friction, scene.heuristics.energy,
                                             scene.heuristics.distance, scene.heuristics.tolerance});
   Prune(marked, weights);
+  c.paths = KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths);
+  return c;
+}
+
+// The nodes not yet probed, in the order they are to be: those on the candidate paths (cheapest
+// path first, start to goal), then those witnessed in a perturbed replay of a candidate, then the
+// rest as they were found. What an operator following a plan a little off its line meets is so
+// probed first.
+std::vector<int> ProbeOrder(const scene::Scene& scene, const ContactGraph& graph,
+                            const ExploreOptions& options, std::span<const char> probed) {
+  std::vector<char> queued(probed.begin(), probed.end());
+  std::vector<int> order;
+  const auto add = [&](int n) {
+    if (queued[std::size_t(n)]) return;
+    queued[std::size_t(n)] = 1;
+    order.push_back(n);
+  };
+  const CandidatePaths c = FindCandidatePaths(scene, graph, options);
+  for (const Path& path : c.paths)
+    for (const int n : path.nodes) add(c.explored_node[std::size_t(n)]);
+  for (std::size_t n = 0; n < graph.nodes.size(); ++n) {
+    const int motion = graph.nodes[n].witness.motion;
+    if (motion >= 0 && graph.motions[std::size_t(motion)].kind == "replay")
+      add(static_cast<int>(n));
+  }
+  for (std::size_t n = 0; n < graph.nodes.size(); ++n) add(static_cast<int>(n));
+  return order;
+}
+
+}  // namespace
+
+std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
+                                                               const ContactGraph& graph,
+                                                               const ExploreOptions& options) {
+  const CandidatePaths c = FindCandidatePaths(scene, graph, options);
   std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
-  for (const Path& path : KShortestPaths(marked, ArcCosts(marked, weights), options.replay_paths))
-    for (auto& aimed : DistinctAims(scene, marked, path))
+  for (const Path& path : c.paths)
+    for (auto& aimed : DistinctAims(scene, c.pruned, path))
       if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
                        [&](const auto& a) { return SamePoses(a, aimed.second); }))
         waypoint_lists.push_back(std::move(aimed.second));
@@ -157,9 +207,12 @@ std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
   return HandPath(core, graph.motions[std::size_t(node.witness.motion)], node.witness.tick);
 }
 
-std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& scene,
-                                                            const ContactGraph& graph,
-                                                            const ExploreOptions& options) {
+namespace {
+
+// CandidateTrajectories, with the explorer's motion to the goal given (GoalMotionPath's).
+std::vector<trajectories::Trajectory> CandidateTrajectoriesWith(
+    const scene::Scene& scene, const ContactGraph& graph, const ExploreOptions& options,
+    std::span<const trajectories::HandSample> goal_path) {
   trajectories::SynthesisOptions synthesis;
   synthesis.peak_speed_m_per_s = options.speed_m_per_s;
   std::vector<trajectories::Trajectory> nominals;
@@ -167,10 +220,17 @@ std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& 
     nominals.push_back(trajectories::SynthesizeTrajectory(aim, synthesis));
   if (nominals.empty()) return nominals;
   // The explorer's own motion to the goal, retimed as `plans` retimes it: on the scene's step.
-  const std::vector<trajectories::HandSample> path = GoalMotionPath(scene, graph);
   synthesis.rate_Hz = 1.0 / scene.model.time_step_s;
-  if (path.size() >= 2) nominals.push_back(trajectories::RetimeHandPath(path, synthesis));
+  if (goal_path.size() >= 2) nominals.push_back(trajectories::RetimeHandPath(goal_path, synthesis));
   return nominals;
+}
+
+}  // namespace
+
+std::vector<trajectories::Trajectory> CandidateTrajectories(const scene::Scene& scene,
+                                                            const ContactGraph& graph,
+                                                            const ExploreOptions& options) {
+  return CandidateTrajectoriesWith(scene, graph, options, GoalMotionPath(scene, graph));
 }
 
 std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
@@ -191,27 +251,12 @@ std::vector<Motion> PerturbedReplays(const scene::Scene& scene,
 
 namespace {
 
-// Whether two trajectories have equal samples.
-bool SameSamples(std::span<const trajectories::HandSample> a,
-                 std::span<const trajectories::HandSample> b) {
-  return std::equal(a.begin(), a.end(), b.begin(), b.end(), [](const auto& x, const auto& y) {
-    return x.t_s == y.t_s && x.p_WH_m == y.p_WH_m && x.q_WH.coeffs() == y.q_WH.coeffs();
-  });
-}
-
 // A closing round's motions: `closing_motions` random motions of the seed from `next_random`, then
-// `replay_copies` perturbed replays from `next_replicate` of each candidate trajectory of the
-// graph as it stands and of `planned`, each distinct one once. Advances both counters.
+// `replay_copies` perturbed replays from `next_replicate` of each of `nominals`, the candidate
+// trajectories of the graph as it stands. Advances both counters.
 std::vector<Motion> ClosingRound(const scene::Scene& scene, const Box& box,
-                                 const ContactGraph& graph,
-                                 std::span<const trajectories::Trajectory> planned,
+                                 std::span<const trajectories::Trajectory> nominals,
                                  const ExploreOptions& o, int& next_random, int& next_replicate) {
-  std::vector<trajectories::Trajectory> nominals;
-  if (o.replay_copies > 0) nominals = CandidateTrajectories(scene, graph, o);
-  for (const trajectories::Trajectory& p : planned)
-    if (std::none_of(nominals.begin(), nominals.end(),
-                     [&](const auto& n) { return SameSamples(n.samples, p.samples); }))
-      nominals.push_back(p);
   std::vector<Motion> round =
       explorer::RandomMotionsIn(scene, box, o.seed, next_random, o.closing_motions, o);
   next_random += o.closing_motions;
@@ -254,7 +299,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
   cores.push_back(std::make_unique<core::Core>(scene));
   core::Core& probe = *cores.front();
   const Box box = explorer::PartsBox(scene, probe.reachable_parts());
-  std::size_t probed = 0;  // nodes [0, probed) have had their probe motion
+  std::vector<char> probed;  // per node: whether it has had its probe motion
+  std::size_t probed_count = 0;
   // Read by the threads of a group, while the merger stands still.
   const explorer::MayEnter may_enter = [&](const std::string& cf, bool refined, int ticks) {
     return merger.MayEnter(cf, refined, ticks, probed);
@@ -337,43 +383,72 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     phase = "random motions";
     run(explorer::RandomMotionsIn(scene, box, o.seed, 0, o.random_motions, o), {});
   }
-  // Neighbour probing in rounds, each probing the nodes found since the last, until a round finds
-  // no new node. Every node has then been probed, and probing one again from the same stay
+  // The candidate plans' trajectories of the graph as it stands (none before the goal is
+  // reached). The explorer's motion to the goal is replayed through the core once per witness of
+  // the goal.
+  TickRef goal_witness{-1, 0, 0, 0};
+  std::vector<trajectories::HandSample> goal_path;
+  const auto candidates = [&] {
+    const int goal = graph.FindNode(goal_cf);
+    const TickRef w = goal >= 0 ? graph.nodes[std::size_t(goal)].witness : TickRef{-1, 0, 0, 0};
+    if (w.motion != goal_witness.motion || w.tick != goal_witness.tick) {
+      goal_path = GoalMotionPath(scene, graph);
+      goal_witness = w;
+    }
+    return CandidateTrajectoriesWith(scene, graph, o, goal_path);
+  };
+  // Perturbed replays of the candidate plans, `replay_copies` of each.
+  int next_replicate = 0;
+  const auto replay_candidates = [&] {
+    if (stopped || o.replay_copies <= 0) return;
+    std::vector<Motion> replays =
+        PerturbedReplays(scene, candidates(), o, o.seed, next_replicate, o.replay_copies);
+    next_replicate += static_cast<int>(replays.size());
+    phase = "replays";
+    run(std::move(replays), {});
+  };
+  // Neighbour probing in groups of kProbeGroup nodes in ProbeOrder, each followed by replays of
+  // the candidate plans, until every node is probed. Probing a node again from the same stay
   // replays the same motion (the core is deterministic), which finds nothing new.
   const auto probe_new_nodes = [&] {
-    phase = "probes";
-    while (!stopped && probed < graph.nodes.size()) {
-      const int wanted = static_cast<int>(graph.nodes.size() - probed);
+    while (!stopped && probed_count < graph.nodes.size()) {
+      if (room() == 0) {
+        stop(ExploreEnd::kBudget);
+        break;
+      }
+      probed.resize(graph.nodes.size(), 0);
+      const std::vector<int> order = ProbeOrder(scene, graph, o, probed);
+      const int wanted = std::min(kProbeGroup, static_cast<int>(order.size()));
       const int count = std::min(wanted, room());
       if (count < wanted) stop(ExploreEnd::kBudget);
-      if (count <= 0) break;
       // Each goes on from the run point kept at its start stay, if there is one: the same bits
       // as replaying its prefix.
       std::vector<Motion> group;
       std::vector<RunPointPtr> resumes;
       for (int i = 0; i < count; ++i) {
-        group.push_back(merger.ProbeMotion(static_cast<int>(probed) + i, scene, o));
-        resumes.push_back(merger.TakeProbePoint(static_cast<int>(probed) + i));
+        const int node = order[std::size_t(i)];
+        group.push_back(merger.ProbeMotion(node, scene, o));
+        resumes.push_back(merger.TakeProbePoint(node));
+        probed[std::size_t(node)] = 1;
       }
-      probed += std::size_t(count);
+      phase = "probes";
       const int merged = run(std::move(group), resumes);
-      probed -= std::size_t(count - merged);
+      for (int i = merged; i < count; ++i) probed[std::size_t(order[std::size_t(i)])] = 0;
+      probed_count += std::size_t(merged);
+      replay_candidates();
     }
   };
   probe_new_nodes();
   // Closing rounds: more random motions of the same seed and perturbed replays of the candidate
-  // plans, those of the graph as the round starts and those `plans` makes (of the graph as it is
-  // here, before the first round: the one `plans` explores), each round merged and its new nodes
-  // probed, until a round adds no node and no arc (saturated), or a limit ends it.
-  const std::vector<trajectories::Trajectory> planned =
-      o.replay_copies > 0 && !stopped ? CandidateTrajectories(scene, graph, o)
-                                      : std::vector<trajectories::Trajectory>{};
-  int next_random = o.random_motions, next_replicate = 0;
+  // plans of the graph as the round starts, each round merged and its new nodes probed, until a
+  // round adds no node and no arc (saturated), or a limit ends it.
+  int next_random = o.random_motions;
   while (!stopped && (o.closing_motions > 0 || o.replay_copies > 0)) {
     const std::size_t nodes_before = graph.nodes.size(), arcs_before = graph.arcs.size();
     phase = "closing rounds";
-    std::vector<Motion> round =
-        ClosingRound(scene, box, graph, planned, o, next_random, next_replicate);
+    const std::vector<trajectories::Trajectory> nominals =
+        o.replay_copies > 0 ? candidates() : std::vector<trajectories::Trajectory>{};
+    std::vector<Motion> round = ClosingRound(scene, box, nominals, o, next_random, next_replicate);
     // Nothing to run (no random motions, and no plan before the goal is reached): no round.
     if (round.empty()) break;
     run(std::move(round), {});
@@ -381,9 +456,9 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& o,
     probe_new_nodes();
     if (graph.nodes.size() == nodes_before && graph.arcs.size() == arcs_before) break;
   }
-  graph.probed = static_cast<int>(probed);
+  graph.probed = static_cast<int>(probed_count);
   graph.end = stopped.value_or(ExploreEnd::kSaturated);
-  graph.saturated = !stopped && probed == graph.nodes.size();
+  graph.saturated = !stopped && probed_count == graph.nodes.size();
 
   MarkStartGoalAndReach(scene, probe, graph);
   graph.seconds = std::chrono::duration<double>(Clock::now() - clock_start).count();

@@ -73,10 +73,11 @@ bool Merger::Add(const MotionResult& r) {
   return graph_.nodes.size() > nodes || graph_.arcs.size() > arcs;
 }
 
-bool Merger::MayEnter(const std::string& cf, bool refined, int ticks, std::size_t probed) const {
+bool Merger::MayEnter(const std::string& cf, bool refined, int ticks,
+                      std::span<const char> probed) const {
   const auto it = node_of_.find(cf);
   if (it == node_of_.end()) return true;
-  if (std::size_t(it->second) < probed) return false;
+  if (std::size_t(it->second) < probed.size() && probed[std::size_t(it->second)]) return false;
   const Entry& entry = entry_[std::size_t(it->second)];
   return entry.ticks < 0 || (entry.refined && !refined) ||
          (entry.refined == refined && ticks < entry.ticks);

@@ -4,6 +4,7 @@
 // (src/graph/explore.cpp).
 
 #include <map>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,9 +34,9 @@ class Merger {
   RunPointPtr TakeProbePoint(int i) { return std::move(entry_[std::size_t(i)].point); }
 
   // Whether a stay of `cf` (refined or not, at `ticks` of its motion) would become the place its
-  // probe starts from, as Add chooses it, if no stay merged after now beat it; nodes [0, probed)
-  // have had their probe.
-  bool MayEnter(const std::string& cf, bool refined, int ticks, std::size_t probed) const;
+  // probe starts from, as Add chooses it, if no stay merged after now beat it; `probed` says which
+  // nodes have had their probe.
+  bool MayEnter(const std::string& cf, bool refined, int ticks, std::span<const char> probed) const;
 
   // Node i's probe motion: the prefix of the motion of its quickest stay to replay, then the
   // neighbour probes from the hand pose there.

@@ -32,7 +32,7 @@ bool GraphSections(const std::vector<batch::Evaluated>& results,
     const scene::Scene& s = *loaded[members.front()].scene;
     graph::ExploreOptions explore;
     explore.jobs = jobs;
-    // The picture of the states, as `plans` explores: probing, without the closing rounds.
+    // The picture of the states: probing alone, without replays or closing rounds.
     explore.closing_motions = 0;
     explore.replay_copies = 0;
     graph::ContactGraph g = graph::Explore(s, explore);

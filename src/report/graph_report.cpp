@@ -52,7 +52,7 @@ void PrintSaturation(std::ostream& t, const graph::ContactGraph& g,
         t << explore.replay_copies << " perturbed replays of each candidate plan";
       t << ", the last adding no state and no transition)\n";
     } else {
-      t << "the last round found no new state; no closing rounds)\n";
+      t << "every state probed; no closing rounds)\n";
     }
   } else if (g.end == graph::ExploreEnd::kTimeLimit) {
     const bool goal_held = g.goal >= 0 && g.nodes[std::size_t(g.goal)].ticks > 0;

@@ -17,6 +17,7 @@
 #include <tubeplan/graph/completeness.hpp>
 #include <tubeplan/graph/dot.hpp>
 #include <tubeplan/graph/explore.hpp>
+#include <tubeplan/graph/paths.hpp>
 #include <tubeplan/graph/summary.hpp>
 #include <tubeplan/graph/verdicts.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
@@ -355,7 +356,7 @@ scene::Scene FloorOnly() {
 }
 
 // The scene the exploration tests explore: the floor alone runs the same code as the groove
-// (every kind of motion, probe rounds to saturation, refinements, resumed runs), sooner.
+// (every kind of motion, probes to saturation, refinements, resumed runs), sooner.
 scene::Scene ExploredScene() { return FloorOnly(); }
 
 // A small exploration, shared by the tests below (it costs seconds).
@@ -364,7 +365,7 @@ const ContactGraph& SmallGraph(int jobs) {
   if (!graphs.contains(jobs)) {
     graph::ExploreOptions o;
     o.random_motions = 5;
-    o.max_motions = 110;  // the sweeps and aims, 5 random motions and probe motions
+    o.max_motions = 110;  // the sweeps and aims, 5 random motions, probes and their replays
     o.jobs = jobs;
     graphs[jobs] = graph::Explore(ExploredScene(), o);
   }
@@ -534,24 +535,24 @@ TEST_CASE("Every node's witness, replayed through the core, gives that node's CF
 
 TEST_CASE("Resuming runs from snapshots explores the same graph as replaying them",
           "[graph][explore]") {
-  // Probes of the second round start from stays found by probes of the first, whose runs were
+  // Probes of nodes that probes found start from stays those probes found, whose runs were
   // themselves resumed: the chain the snapshots cut short. Against the explorer replaying every
   // prefix and every refinement from the motion's start (an independent path to the same bits).
-  // The groove's floor alone, explored into its second probe round.
+  // The groove's floor alone, explored until it probes nodes that probes found.
   const scene::Scene floor = FloorOnly();
   graph::ExploreOptions o;
   o.random_motions = 0;
   // Probing alone: closing rounds resume their runs the same way and would only add time.
   o.closing_motions = 0;
   o.replay_copies = 0;
-  // The sweeps and aims (45 motions), the first probe round (34) and a part of the second.
+  // The sweeps and aims (45 motions), a probe of each node they found (34) and some more.
   o.max_motions = 90;
   o.jobs = 2;
   const ContactGraph resumed = graph::Explore(floor, o);
   o.resume_runs = false;
   const ContactGraph replayed = graph::Explore(floor, o);
-  // The budget reaches into the second probe round: more motions than the sweeps and aims and
-  // a probe for every node they found.
+  // The budget reaches the probes of nodes that probes found: more motions than the sweeps and
+  // aims and a probe for every node they found.
   const std::size_t before_probes = std::size_t(
       std::count_if(resumed.motions.begin(), resumed.motions.end(),
                     [](const graph::Motion& m) { return m.kind.rfind("probe", 0) != 0; }));
@@ -627,13 +628,58 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
   // One exploration, shared by the sections.
   SECTION("The default exploration saturates within the default budget") {
     const ContactGraph& g = DefaultGraph(2);
-    // Every node probed, the last round found no new one.
+    // Every node probed, the last closing round found no new one.
     CHECK(g.saturated);
     CHECK(g.probed == static_cast<int>(g.nodes.size()));
     CHECK(g.motions.size() < std::size_t(graph::ExploreOptions{}.max_motions));
     WARN("default exploration: " << g.nodes.size() << " CFs, " << g.arcs.size() << " transitions, "
                                  << g.motions.size() << " motions, " << g.ticks << " ticks; "
                                  << g.seconds << " s on 2 threads");
+  }
+
+  SECTION("Probing starts on the candidate plans' paths, each group followed by their replays") {
+    const scene::Scene s = ExploredScene();
+    const ContactGraph& g = DefaultGraph(2);
+    std::size_t first_probe = 0;
+    while (first_probe < g.motions.size() && !g.motions[first_probe].kind.starts_with("probe "))
+      ++first_probe;
+    REQUIRE(first_probe < g.motions.size());
+    // The graph as probing started: the same exploration, its budget ending there. Its cheapest
+    // paths, pruned as `plans` prunes: their states are the first probed, path by path, in order.
+    graph::ExploreOptions o;
+    o.jobs = 2;
+    o.max_motions = static_cast<int>(first_probe);
+    ContactGraph before = graph::Explore(s, o);
+    REQUIRE(before.goal >= 0);
+    const graph::PruneWeights w{s.heuristics.friction, s.heuristics.energy, s.heuristics.distance,
+                                s.heuristics.tolerance};
+    graph::Prune(before, w);
+    std::vector<std::string> on_paths;
+    for (const graph::Path& p :
+         graph::KShortestPaths(before, graph::ArcCosts(before, w), o.replay_paths))
+      for (const int n : p.nodes)
+        if (std::find(on_paths.begin(), on_paths.end(), before.nodes[std::size_t(n)].cf) ==
+            on_paths.end())
+          on_paths.push_back(before.nodes[std::size_t(n)].cf);
+    REQUIRE(on_paths.size() >= 2);
+    for (std::size_t i = 0; i < std::min<std::size_t>(on_paths.size(), 16); ++i)
+      CHECK(g.motions[first_probe + i].kind == "probe " + on_paths[i]);
+    // Up to the first closing round: groups of at most 16 probes, each followed by perturbed
+    // copies of every candidate plan.
+    int groups = 0;
+    std::size_t i = first_probe;
+    while (i < g.motions.size() && g.motions[i].kind.starts_with("probe ")) {
+      std::size_t probes = 0, replays = 0;
+      for (; i < g.motions.size() && g.motions[i].kind.starts_with("probe "); ++i) ++probes;
+      for (; i < g.motions.size() && g.motions[i].kind == "replay"; ++i) ++replays;
+      CHECK(probes <= 16);
+      CHECK(replays > 0);
+      CHECK(replays % std::size_t(o.replay_copies) == 0);
+      ++groups;
+    }
+    CHECK(groups >= 2);
+    REQUIRE(i < g.motions.size());
+    CHECK(g.motions[i].kind == "random");
   }
 
   SECTION("Closing rounds go on until one adds no state and no transition") {
@@ -644,14 +690,13 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     REQUIRE(g.closing_rounds >= 1);
     // The last round's motions (nothing new: no probes after them) are the graph's last ones: its
     // random motions, then its perturbed replays of each candidate plan, aimed up to three ways,
-    // and of the explorer's motion to the goal: those of the graph as the round started and those
-    // of the graph before the first round.
+    // and of the explorer's motion to the goal, of the graph as the round started.
     std::size_t replays = 0;
     while (replays < g.motions.size() && g.motions[g.motions.size() - 1 - replays].kind == "replay")
       ++replays;
     CHECK(replays > 0);
     CHECK(replays % std::size_t(o.replay_copies) == 0);
-    CHECK(replays <= std::size_t(2 * (3 * o.replay_paths + 1) * o.replay_copies));
+    CHECK(replays <= std::size_t((3 * o.replay_paths + 1) * o.replay_copies));
     const std::size_t last = g.saturation.size() - replays;
     REQUIRE(last > std::size_t(round));
     const graph::SaturationPoint& before = g.saturation[last - 1 - std::size_t(round)];
@@ -669,7 +714,7 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     const scene::Scene s = ExploredScene();
     const graph::ExploreOptions o;
     const ContactGraph& g = DefaultGraph(2);
-    // The closing rounds' own replays, run again as the check runs motions: every state they kept
+    // The explorer's own replays, run again as the check runs motions: every state they kept
     // for the dwell, and every transition between two such states, was merged into the graph.
     std::vector<graph::Motion> own;
     for (const graph::Motion& m : g.motions)
@@ -682,7 +727,7 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
     CHECK(mine.transitions_in_graph == mine.transitions_seen);
 
     // The completeness check's second measure: replays of another seed, counted after the same
-    // dwell. Offsets of up to 4 mm near the floor's edge reach rare states the closing rounds'
+    // dwell. Offsets of up to 4 mm near the floor's edge reach rare states the explorer's own
     // copies did not (the end on the top and the side face at once); the share by use, the ticks
     // an operator following the plans spends in states the graph has, must stay high.
     const std::vector<graph::Completeness> found = graph::CheckCompleteness(s, g, o, 24);
@@ -799,7 +844,7 @@ TEST_CASE("The floor's default exploration saturates and closes", "[graph][explo
 }  // namespace
 
 TEST_CASE("An exploration is the same on one thread and on two", "[graph][explore]") {
-  SECTION("Sweeps, aims, random motions and probe rounds with refinements: the floor") {
+  SECTION("Sweeps, aims, random motions and probes with refinements: the floor") {
     REQUIRE(SmallGraph(1).refinements > 0);
     CheckSameGraph(SmallGraph(1), SmallGraph(2));
   }

@@ -8,10 +8,13 @@
 //  3. `random_motions` random guarded motions from a seed;
 //  4. neighbour probes: from a stay of each node (its motion resumed there), small moves
 //     of the hand along and against three directions and small turns, each held and undone;
-//     every node found is probed in turn until all have been;
+//     nodes are probed in groups of 16, those on the candidate plans' paths first, then those
+//     witnessed in their replays, then the rest as found; after each group, perturbed replays of
+//     the candidate plans' trajectories (CandidateTrajectories) of the graph as it then stands;
+//     until every node has been probed;
 //  5. closing rounds: more random motions and perturbed replays of the candidate plans'
-//     trajectories (CandidateTrajectories) as the graph then stands and as it stood before the
-//     first round, each round's new nodes probed as in 4, until a round adds no node and no arc
+//     trajectories of the graph as it then stands, each round's new nodes probed as in 4,
+//     until a round adds no node and no arc
 //     (saturated), or until the budget of motions or the time limit is spent.
 // A step that changes more than one PC is re-run from the tick before with the hand's step split
 // into sub-ticks; what the sub-ticks produce is recorded, and a change that stays multiple is
@@ -33,7 +36,7 @@ namespace tubeplan::graph {
 
 /// Where an exploration is, for a progress display.
 struct ExploreStatus {
-  std::string phase;        ///< "sweeps", "aims", "random motions", "probes"
+  std::string phase;  ///< "sweeps", "aims", "random motions", "probes", "replays", "closing rounds"
   int motions_done = 0;     ///< motions run to their end so far
   int motions_started = 0;  ///< motions handed to the threads so far (done ones included)
   int nodes = 0, arcs = 0;  ///< the graph as merged so far (it grows after each group)
@@ -48,21 +51,21 @@ struct ExploreOptions {
   /// sequence, continued) run, each followed by probing the nodes it found, until a round adds
   /// no node and no arc (0: none).
   int closing_motions = 30;
-  /// Each closing round also replays this many perturbed copies (0: none) of each candidate
-  /// plan's trajectory, of the graph as the round starts and of the graph before the first round
-  /// (the one `plans` explores with the same options): the `replay_paths` cheapest start -> goal
-  /// paths of the graph pruned with `weights`, the hand aimed at each distinct aim of
-  /// graph::Aim (CandidateWaypoints) at `speed_m_per_s`, and the explorer's motion to the goal
-  /// (CandidateTrajectories), each moved as a whole by up to `replay_offset_m`, with 0.1 mm
-  /// tremor and 0.8-1.25x the speed (trajectories::Perturb). What an operator following a plan
-  /// meets is then in the graph. None run before the goal is reached.
+  /// After each group of probes, and in each closing round, this many perturbed copies (0: none)
+  /// of each candidate plan's trajectory of the graph as it then stands run: the `replay_paths`
+  /// cheapest start -> goal paths of the graph pruned with `weights`, the hand aimed at each
+  /// distinct aim of graph::Aim (CandidateWaypoints) at `speed_m_per_s`, and the explorer's
+  /// motion to the goal (CandidateTrajectories), each moved as a whole by up to
+  /// `replay_offset_m`, with 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What
+  /// an operator following a plan meets is then in the graph. None run before the goal is
+  /// reached.
   int replay_copies = 4;
   int replay_paths = 3;
   double replay_offset_m = 0.004;
   /// The heuristics' weights of the candidate paths (nothing: the scene's).
   std::optional<PruneWeights> weights;
-  /// At most this many motions run, whatever happens (sweeps, aims, random, replay and probe
-  /// motions together, in that order: a group is cut where the budget ends). A motion is one entry
+  /// At most this many motions run, whatever happens (sweeps, aims, random motions, then probes
+  /// and replays, together: a group is cut where the budget ends). A motion is one entry
   /// of ContactGraph::motions: one list of guarded moves from the start pose (a probe motion is one
   /// node's ten probes after its prefix). The graph says whether it saturated within it.
   int max_motions = 3000;
@@ -136,7 +139,7 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
 std::vector<trajectories::HandSample> GoalMotionPath(const scene::Scene& scene,
                                                      const ContactGraph& graph);
 
-/// The nominal trajectories of the candidate plans of `graph`, which closing rounds and the
+/// The nominal trajectories of the candidate plans of `graph`, which the explorer and the
 /// completeness check replay perturbed: one through each list of CandidateWaypoints (at
 /// `options.speed_m_per_s`), then the explorer's motion to the goal (GoalMotionPath, uncut)
 /// retimed to that speed by trajectories::RetimeHandPath on the scene's step, as `plans`
