@@ -397,6 +397,10 @@ class Finder {
     }
   }
 
+  // The band at the end face's edges over which a vertex's share of K fades: the rim's points
+  // take over outside, nothing inside the bore.
+  double FaceBand() const { return 0.1 * m_.rod.outer_radius_m; }
+
   // The length over which an edge's share fades towards the tube's ends and behind the edge's
   // face planes.
   double Ramp() const { return std::min(0.25 * m_.rod.outer_radius_m, 0.5 * m_.rod.segment_m); }
@@ -650,25 +654,53 @@ class Finder {
     if (part.geometry.Distance(c).distance_m - r1 >= eps) return;
     const Vec3 t = CarrierTangent(Carrier::kEndNode, x_, n_);
     const auto& vertices = part.geometry.vertices_W();
-    // A band at the annulus' edges over which a vertex's share of K fades: the rim's points take
-    // over outside, nothing inside the bore.
-    const double band_m = 0.1 * r1;
+    const double band_m = FaceBand();
+    const double length_m = (c - x_[std::size_t(n_ - 1)]).norm();
     for (int v = 0; v < int(vertices.size()); ++v) {
       const Vec3 w = vertices[std::size_t(v)] - c;
       const double ahead_m = w.dot(t);
       const Vec3 radial = w - ahead_m * t;
       const double rr = radial.norm();
       if (ahead_m >= eps || ahead_m < -0.5 * r1) continue;
-      const double weight =
-          SmoothStep((r1 - rr) / band_m) * (r2 > 0.0 ? SmoothStep((rr - r2) / band_m) : 1.0);
+      const double outer = (r1 - rr) / band_m, inner = (rr - r2) / band_m;
+      const double weight = SmoothStep(outer) * (r2 > 0.0 ? SmoothStep(inner) : 1.0);
       if (weight <= 0.0) continue;
       PartDistance at;
       at.distance_m = ahead_m;
       at.normal_W = -t;
       at.point_W = vertices[std::size_t(v)];
       at.element = part.geometry.vertex_elements()[std::size_t(v)];
-      Record(SampleKind::kEndFace, p, n_, v, 0.0, weight, at,
-             Material(Carrier::kEndNode, x_, n_, 0.0, radial, false), radial);
+      Sample* smp = Record(SampleKind::kEndFace, p, n_, v, 0.0, weight, at,
+                           Material(Carrier::kEndNode, x_, n_, 0.0, radial, false), radial);
+      if (smp != nullptr && rr > 0.0)
+        FadeWithRadius(*smp, radial / rr, ahead_m / length_m, outer, inner);
+    }
+  }
+
+  // An end-face sample's share fades with its vertex's distance rr from the tube's axis: its
+  // gradient over the end element's nodes, rr changing by -(1 + a/l) rhat.dx_N + (a/l)
+  // rhat.dx_{N-1} (a the vertex's distance ahead, l the element's length), and the curvature of
+  // the fade across the rim's band where it bends the share up (docs/core.md, "The end face").
+  void FadeWithRadius(Sample& smp, const Vec3& rhat, double ahead_per_length, double outer,
+                      double inner) const {
+    const double band_m = FaceBand();
+    const bool bore = m_.rod.inner_radius_m > 0.0;
+    // The smooth step's first and second derivatives.
+    const auto slope = [](double x) { return x > 0.0 && x < 1.0 ? 6.0 * x * (1.0 - x) : 0.0; };
+    const auto bend_of = [](double x) { return x > 0.0 && x < 1.0 ? 6.0 - 12.0 * x : 0.0; };
+    const double s_outer = SmoothStep(outer), s_inner = bore ? SmoothStep(inner) : 1.0;
+    const double d_weight_d_rr =
+        (-slope(outer) * s_inner + (bore ? s_outer * slope(inner) : 0.0)) / band_m;
+    Eigen::Matrix<double, 6, 1> d_rr;
+    d_rr << ahead_per_length * rhat, -(1.0 + ahead_per_length) * rhat;
+    smp.weight_gradient.head<6>() = d_weight_d_rr * d_rr;
+    smp.weight_first = n_ - 1;
+    smp.weight_nodes = 2;
+    const double bend =
+        std::max(0.0, s_inner * bend_of(outer) + (bore ? s_outer * bend_of(inner) : 0.0));
+    if (bend > 0.0) {
+      smp.weight_curve = bend / (band_m * band_m);
+      smp.weight_curve_gradient.head<6>() = d_rr;
     }
   }
 
