@@ -48,6 +48,10 @@ double SmoothStep(double a) {
   return a * a * (3.0 - 2.0 * a);
 }
 
+// The smooth step's first and second derivatives (0 outside (0, 1)).
+double SmoothStepSlope(double a) { return a > 0.0 && a < 1.0 ? 6.0 * a * (1.0 - a) : 0.0; }
+double SmoothStepBend(double a) { return a > 0.0 && a < 1.0 ? 6.0 - 12.0 * a : 0.0; }
+
 // A lower bound on the distance from segment [p0, p1] to the edge: the edge lies in its faces'
 // planes, so no point is nearer the edge than it is to either plane, and a segment wholly on one
 // side of a plane is no nearer than its nearer end. 0 for a round side's axis (it has no faces).
@@ -677,27 +681,29 @@ class Finder {
     }
   }
 
-  // An end-face sample's share fades with its vertex's distance rr from the tube's axis: its
-  // gradient over the end element's nodes, rr changing by -(1 + a/l) rhat.dx_N + (a/l)
-  // rhat.dx_{N-1} (a the vertex's distance ahead, l the element's length), and the curvature of
-  // the fade across the rim's band where it bends the share up (docs/core.md, "The end face").
+  // An end-face sample's share w = S(outer) S(inner) fades with its vertex's distance rr from the
+  // tube's axis (outer = (r1 - rr) / band, inner = (rr - r2) / band): its gradient over the end
+  // element's nodes, rr changing by -(1 + a/h) rhat.dx_N + (a/h) rhat.dx_{N-1} (a the vertex's
+  // distance ahead, h the element's length), and where w bends up across either band, the
+  // leading part of its curvature, d2w/drr2 grad rr grad rr^T (docs/core.md, "The end face").
   void FadeWithRadius(Sample& smp, const Vec3& rhat, double ahead_per_length, double outer,
                       double inner) const {
     const double band_m = FaceBand();
     const bool bore = m_.rod.inner_radius_m > 0.0;
-    // The smooth step's first and second derivatives.
-    const auto slope = [](double x) { return x > 0.0 && x < 1.0 ? 6.0 * x * (1.0 - x) : 0.0; };
-    const auto bend_of = [](double x) { return x > 0.0 && x < 1.0 ? 6.0 - 12.0 * x : 0.0; };
     const double s_outer = SmoothStep(outer), s_inner = bore ? SmoothStep(inner) : 1.0;
-    const double d_weight_d_rr =
-        (-slope(outer) * s_inner + (bore ? s_outer * slope(inner) : 0.0)) / band_m;
+    const double slope_outer = SmoothStepSlope(outer),
+                 slope_inner = bore ? SmoothStepSlope(inner) : 0.0;
+    const double d_weight_d_rr = (s_outer * slope_inner - slope_outer * s_inner) / band_m;
+    const double bend =
+        std::max(0.0, s_inner * SmoothStepBend(outer) - 2.0 * slope_outer * slope_inner +
+                          (bore ? s_outer * SmoothStepBend(inner) : 0.0));
+    // A vertex well inside the annulus: its share is whole and does not move.
+    if (d_weight_d_rr == 0.0 && bend == 0.0) return;
     Eigen::Matrix<double, 6, 1> d_rr;
     d_rr << ahead_per_length * rhat, -(1.0 + ahead_per_length) * rhat;
     smp.weight_gradient.head<6>() = d_weight_d_rr * d_rr;
     smp.weight_first = n_ - 1;
     smp.weight_nodes = 2;
-    const double bend =
-        std::max(0.0, s_inner * bend_of(outer) + (bore ? s_outer * bend_of(inner) : 0.0));
     if (bend > 0.0) {
       smp.weight_curve = bend / (band_m * band_m);
       smp.weight_curve_gradient.head<6>() = d_rr;

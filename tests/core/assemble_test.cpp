@@ -6,6 +6,7 @@
 #include "core/assemble.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -188,7 +189,8 @@ TEST_CASE("An end face on a part's corner: its share fades with the gradient of 
           .toRotationMatrix();
   std::mt19937_64 rng(20261206);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
-  int fading = 0, checked = 0;
+  std::array<int, 2> fading{};  // trials whose share fades in the rim's band, in the bore's
+  int checked = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const double rr = (trial % 2 == 0 ? r1 - band_m : r2) + band_m * u01(rng);
     const double ahead_m = -0.5e-3 + 1.4e-3 * u01(rng);
@@ -223,13 +225,14 @@ TEST_CASE("An end face on a part's corner: its share fades with the gradient of 
       fades = fades || (smp.kind == core::SampleKind::kEndFace && smp.distance_m < 1e-3 &&
                         smp.weight > 0.0 && smp.weight < 1.0);
     }
-    fading += fades;
+    fading[std::size_t(trial % 2)] += fades;
     INFO("trial " << trial << ": corner " << rr * 1e3 << " mm from the axis, " << ahead_m * 1e3
                   << " mm ahead");
     checked += CheckGradientByDifferences(model, data, x, gradient);
   }
-  // Most trials press a fading share (the jiggle can move the corner out of its band).
-  CHECK(fading >= 10);
+  // Most trials of each band press a fading share (the jiggle can move the corner out of it).
+  CHECK(fading[0] >= 5);
+  CHECK(fading[1] >= 5);
   CHECK(checked == 20 * 3 * 19);
 }
 
