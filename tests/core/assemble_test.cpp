@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -42,14 +43,20 @@ void Build(const scene::Scene& s, core::Model& model, core::Data& data) {
   core::InitData(model, s.X_WH_start, data);
 }
 
-// The rubber tube of scenes/groove.yaml (18 elements) on an undamped coupling, over a floor: a
-// box of the given size whose top is at z = 0, centred over (x, y).
-scene::Scene RubberOverFloor(const Eigen::Vector3d& size_m, double x_m, double y_m) {
+// The rubber tube of scenes/groove.yaml (18 elements) on an undamped coupling, nothing else.
+scene::Scene Rubber() {
   scene::Scene s;
   s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
   s.contact = {1e4, 1e-3, 1e-4};
   s.device.coupling_stiffness_N_per_m = 400.0;
   s.device.coupling_damping_Ns_per_m = 0.0;
+  return s;
+}
+
+// The rubber tube of scenes/groove.yaml (18 elements) on an undamped coupling, over a floor: a
+// box of the given size whose top is at z = 0, centred over (x, y).
+scene::Scene RubberOverFloor(const Eigen::Vector3d& size_m, double x_m, double y_m) {
+  scene::Scene s = Rubber();
   scene::Part floor;
   floor.name = "floor";
   floor.size_m = size_m;
@@ -67,6 +74,21 @@ Eigen::VectorXd GradientAt(const core::Model& model, core::Data& data,
   core::FindContacts(model, y, data, core::Choices::kPending);
   core::Assemble(model, data, y, core::Derivatives::kGradient);
   return data.scratch.gradient;
+}
+
+// The nodes on the centreline `along` (its point at arc length s), each but the held end's moved
+// by up to 0.2 mm at random.
+std::vector<Eigen::Vector3d> JiggledNodes(const core::Model& model,
+                                          const std::function<Eigen::Vector3d(double)>& along,
+                                          std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const int n = model.rod.elements;
+  std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
+  for (int k = 0; k <= n; ++k) {
+    const Eigen::Vector3d jiggle(u01(rng) - 0.5, u01(rng) - 0.5, u01(rng) - 0.5);
+    x[std::size_t(k)] = along(k * model.rod.segment_m) + (k == 0 ? 0.0 : 0.4e-3) * jiggle;
+  }
+  return x;
 }
 
 // Checks the gradient at x against central differences of the energy, the contact points found
@@ -97,11 +119,7 @@ int CheckGradientByDifferences(const core::Model& model, core::Data& data,
 TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core][gradient]") {
   // The rubber tube of scenes/groove.yaml (18 elements), held at the origin along +z and bent
   // in the x-z plane; an edge along y beside it (a cube turned 45 deg), a wall across its end.
-  scene::Scene s;
-  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
-  s.contact = {1e4, 1e-3, 1e-4};
-  s.device.coupling_stiffness_N_per_m = 400.0;
-  s.device.coupling_damping_Ns_per_m = 0.0;
+  scene::Scene s = Rubber();
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, eps = s.contact.threshold_m;
   std::mt19937_64 rng(20261202);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -135,12 +153,7 @@ TEST_CASE("The solve's gradient is its energy's derivative, in contact", "[core]
     core::Model model;
     core::Data data;
     Build(s, model, data);
-    const int n = model.rod.elements;
-    std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
-    for (int k = 0; k <= n; ++k) {
-      const Eigen::Vector3d jiggle(u01(rng) - 0.5, u01(rng) - 0.5, u01(rng) - 0.5);
-      x[std::size_t(k)] = arc(k * model.rod.segment_m) + (k == 0 ? 0.0 : 0.4e-3) * jiggle;
-    }
+    const std::vector<Eigen::Vector3d> x = JiggledNodes(model, arc, rng);
     data.input.p_hand_W = Eigen::Vector3d(0.3e-3, -0.2e-3, 0.1e-3);
 
     core::FindContacts(model, x, data, core::Choices::kKeep);
@@ -176,11 +189,7 @@ TEST_CASE("An end face on a part's corner: its share fades with the gradient of 
   // bore (5-5.8 mm), from 0.5 mm into the face to 0.9 mm off it. The share moves with the end
   // element as the corner's distance from the axis does: a gradient without that would hide the
   // energy's slope across the band (K eps^2 / 2 over 0.8 mm, ~6 N) from the solve.
-  scene::Scene s;
-  s.tube = {8e-3, 5e-3, 0.15, 3e6, 0.5};
-  s.contact = {1e4, 1e-3, 1e-4};
-  s.device.coupling_stiffness_N_per_m = 400.0;
-  s.device.coupling_damping_Ns_per_m = 0.0;
+  scene::Scene s = Rubber();
   const double l = s.tube.length_m, r1 = s.tube.outer_radius_m, r2 = s.tube.inner_radius_m;
   const double band_m = 0.1 * r1, size_m = 0.02;
   const Eigen::Matrix3d corner_down =
@@ -208,13 +217,8 @@ TEST_CASE("An end face on a part's corner: its share fades with the gradient of 
     core::Model model;
     core::Data data;
     Build(s, model, data);
-    const int n = model.rod.elements;
-    std::vector<Eigen::Vector3d> x(std::size_t(n) + 1);
-    for (int k = 0; k <= n; ++k) {
-      const Eigen::Vector3d jiggle(u01(rng) - 0.5, u01(rng) - 0.5, u01(rng) - 0.5);
-      x[std::size_t(k)] =
-          Eigen::Vector3d(0.0, 0.0, k * model.rod.segment_m) + (k == 0 ? 0.0 : 0.4e-3) * jiggle;
-    }
+    const std::vector<Eigen::Vector3d> x = JiggledNodes(
+        model, [](double s_m) { return Eigen::Vector3d(0.0, 0.0, s_m); }, rng);
     data.input.p_hand_W = Eigen::Vector3d(0.3e-3, -0.2e-3, 0.1e-3);
     core::FindContacts(model, x, data, core::Choices::kKeep);
     core::Assemble(model, data, x, core::Derivatives::kGradient);
