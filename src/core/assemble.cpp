@@ -185,6 +185,25 @@ Mat3 OffsetTurnHessian(const Vec3& o0, const Vec3& e, const Vec3& c) {
              (le * le);
 }
 
+// The second derivative over (x_{N-1}, x_N) of the end face's distance a = (v - x_N) . t to a
+// vertex v, t = e / |e| the end's tangent, e = x_N - x_{N-1}, r = (I - t t^T)(v - x_N) the
+// vertex's offset from the axis: the face turns with the end (docs/core.md, "The end face").
+Eigen::Matrix<double, 6, 6> FaceTurnHessian(const Vec3& r, double a, const Vec3& e) {
+  const double le = e.norm();
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  if (!(le > 0.0)) return H;
+  const Vec3 t = e / le;
+  const Mat3 P = Mat3::Identity() - t * t.transpose();
+  // d2a = -(2 / |e|) dx_N^T P de - (2 (t.de)(r.de) + a de^T P de) / |e|^2, de = dx_N - dx_{N-1}.
+  const Mat3 ee = -(t * r.transpose() + r * t.transpose() + a * P) / (le * le);
+  const Mat3 ne = -P / le;
+  H.block<3, 3>(0, 0) = ee;
+  H.block<3, 3>(0, 3) = -ee - ne;
+  H.block<3, 3>(3, 0) = -ee - ne;
+  H.block<3, 3>(3, 3) = ee + 2.0 * ne;
+  return H;
+}
+
 // The rim's points on one part, samples [first, end): one contact whose distance is the smooth
 // minimum d = -tau log sum exp(-d_j / tau) of theirs (each eased in as it joins: EaseInOf), with
 // the paper's K (eps - d)+ shared by the softmin's weights. Tilted, the nearest point takes it all
@@ -554,6 +573,16 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
+    if (smp.kind == SampleKind::kEndFace && a.hessian()) {
+      StencilTerm t;
+      t.first = smp.node - 1;
+      t.nodes = 2;
+      t.hessian.topLeftCorner<6, 6>() =
+          -kw * depth *
+          FaceTurnHessian(smp.moving_offset_W, smp.distance_m,
+                          x_W[std::size_t(smp.node)] - x_W[std::size_t(smp.node - 1)]);
+      a.AddStencil(t);
+    }
     // A share that fades: its change moves the energy too, with the cross terms of its change
     // and the distance's in the Hessian (the share's own curvature is left out).
     if (smp.weight_nodes > 0) AddFadingShare(mp, smp, K, depth, a);

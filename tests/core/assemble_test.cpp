@@ -1,8 +1,8 @@
 // The solve's gradient against central differences of its own energy, on random bent tubes
 // near an edge and a wall: every contact term (a node's sphere and its fading share, the smooth
 // side about a node on the edge, the end's rim, the end face on a corner) and the rod's and the
-// coupling's; and its Hessian (band and rank-one terms) against central differences of the
-// gradient.
+// coupling's; and its Hessian (band and rank-one terms, the rim's and the end face's turn with
+// the end) against central differences of the gradient.
 #include "core/assemble.hpp"
 
 #include <algorithm>
@@ -397,5 +397,75 @@ TEST_CASE("On a frictionless part the rim's Hessian is its gradient's derivative
                   << (Hv - fd).lpNorm<Eigen::Infinity>() << " N/m");
     // 1e-4 of H v: a hundredth of the turn's term.
     CHECK((Hv - fd).lpNorm<Eigen::Infinity>() < 1e-4 * scale);
+  }
+}
+
+TEST_CASE("An end face on a part's corner: its Hessian is its gradient's derivative",
+          "[core][gradient]") {
+  // The rubber tube held along +z, its nodes moved up to 0.2 mm at random (the end turns), its
+  // end face pressed by the corner of a cube that points down the tube, the corner well inside
+  // the annulus (5.9-6.6 mm from the axis, its share whole) and 0.4-0.9 mm ahead of the face:
+  // the rim, at least 1.4 mm across the cube's rising faces from the corner, stays beyond eps.
+  // The face turns with the end element, so its distance to the corner curves with the end's two
+  // nodes: K (eps - d) d'' is ~100-700 N/m here (F / h, F 1-6 N, h 8.3 mm). Steps across the tube
+  // at every node (the stiff axial springs do not resist them to first order) must see it in H v
+  // as in the central difference of the gradient.
+  scene::Scene s = Rubber();
+  const double l = s.tube.length_m, size_m = 0.02;
+  const Eigen::Matrix3d corner_down =
+      Eigen::Quaterniond::FromTwoVectors(-Eigen::Vector3d::Ones().normalized(),
+                                         -Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  std::mt19937_64 rng(20261207);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int trial = 0; trial < 10; ++trial) {
+    const double rr = 5.9e-3 + 0.7e-3 * u01(rng);
+    const double ahead_m = 0.4e-3 + 0.5e-3 * u01(rng);
+    const Eigen::Vector3d corner_W(rr * std::cos(trial), rr * std::sin(trial), l + ahead_m);
+    scene::Part cube;
+    cube.name = "cube";
+    cube.size_m = Eigen::Vector3d::Constant(size_m);
+    cube.friction = {0.5, 0.3, 1.0, 1.0};
+    cube.X_WP.linear() = corner_down;
+    cube.X_WP.translation() = corner_W + 0.5 * std::sqrt(3.0) * size_m * Eigen::Vector3d::UnitZ();
+    s.parts = {cube};
+    s.X_WH_start = Eigen::Isometry3d::Identity();
+    core::Model model;
+    core::Data data;
+    Build(s, model, data);
+    const int n = model.rod.elements;
+    const std::vector<Eigen::Vector3d> x = JiggledNodes(
+        model, [](double s_m) { return Eigen::Vector3d(0.0, 0.0, s_m); }, rng);
+    data.input.p_hand_W = Eigen::Vector3d(0.3e-3, -0.2e-3, 0.1e-3);
+    core::FindContacts(model, x, data, core::Choices::kKeep);
+    core::Assemble(model, data, x, core::Derivatives::kHessian);
+    const core::Scratch& sc = data.scratch;
+    // One contact point within eps: the corner on the face, its share whole.
+    int faces = 0, others = 0;
+    for (int k = 0; k < sc.sample_count; ++k) {
+      const core::Sample& smp = sc.samples[std::size_t(k)];
+      if (!(smp.distance_m < s.contact.threshold_m)) continue;
+      const bool whole_face = smp.kind == core::SampleKind::kEndFace && smp.weight == 1.0;
+      faces += whole_face;
+      others += !whole_face;
+    }
+    INFO("trial " << trial << ": corner " << rr * 1e3 << " mm from the axis, " << ahead_m * 1e3
+                  << " mm ahead");
+    CHECK(faces == 1);
+    CHECK(others == 0);
+    REQUIRE(sc.factors.low_rank_count == 0);
+    Eigen::VectorXd v(3 * (n + 1));
+    for (int i = 0; i < v.size(); ++i) v[i] = i % 3 == 2 ? 0.0 : u01(rng) - 0.5;
+    Eigen::VectorXd Hv(v.size());
+    sc.hessian.Multiply(v, Hv);
+    // The rounding of the stiff axial springs' forces over 2h leaves ~0.03 N/m.
+    const double h = 1e-9;
+    const Eigen::VectorXd fd =
+        (GradientAt(model, data, x, h * v) - GradientAt(model, data, x, -h * v)) / (2.0 * h);
+    const double scale = Hv.lpNorm<Eigen::Infinity>();
+    INFO("|H v| " << scale << " N/m, |H v - fd| " << (Hv - fd).lpNorm<Eigen::Infinity>() << " N/m");
+    // 1e-5 of H v (~5e5 N/m, the axial springs' first-order response to the jiggled tube): a
+    // tenth of the turn's term at its least.
+    CHECK((Hv - fd).lpNorm<Eigen::Infinity>() < 1e-5 * scale);
   }
 }
