@@ -240,10 +240,11 @@ void CopyFactors(const HessianFactors& from, HessianFactors& to) {
 
 // A solve that starts with the contacts of the last factored Hessian first tries its factors (a
 // chord step): where the hand moved little since, it is balanced there, or one full step with
-// them lands within the tolerance, and no Hessian is assembled or factored. Otherwise nothing
-// is kept of the try, and the solve goes on from where it started. The factors were positive
-// definite; a straight column past its buckling load (a saddle whose gradient stays zero) is
-// found by the factorisation after kKeptSolves solves. True when converged.
+// them lands within the tolerance, and no Hessian is assembled or factored. A step that lowers
+// the energy but lands short of the tolerance is kept, and Newton's method goes on from there;
+// one that does not is dropped. The factors were positive definite; a straight column past its
+// buckling load (a saddle whose gradient stays zero) is found by the factorisation after
+// kKeptSolves solves. True when converged.
 bool StepWithKeptFactors(const Model& model, Data& data) {
   KeptFactors& kept = data.state.kept;
   Scratch& s = data.scratch;
@@ -261,11 +262,11 @@ bool StepWithKeptFactors(const Model& model, Data& data) {
   if (StepFraction(model, s, s.step) == 1.0) {
     const double e = TrialEnergy(model, data, 1.0, Derivatives::kGradient);
     const double residual_N = s.gradient.lpNorm<Eigen::Infinity>();
-    if (FallsEnough(e, energy, 1.0, slope) && residual_N <= model.solver.tolerance_N) {
+    if (FallsEnough(e, energy, 1.0, slope)) {
       TakeTrial(data);
       ++report.iterations;
       report.residual_N = residual_N;
-      return true;
+      return residual_N <= model.solver.tolerance_N;
     }
     FindContacts(model, data.state.x_W, data);
   }
