@@ -188,14 +188,14 @@ Mat3 OffsetTurnHessian(const Vec3& o0, const Vec3& e, const Vec3& c) {
 // The second derivative over (x_{N-1}, x_N) of the end face's distance a = (v - x_N) . t to a
 // vertex v, t = e / |e| the end's tangent, e = x_N - x_{N-1}, r = (I - t t^T)(v - x_N) the
 // vertex's offset from the axis: the face turns with the end (docs/core.md, "The end face").
-Eigen::Matrix<double, 6, 6> FaceTurnHessian(const Vec3& r, double a, const Vec3& e) {
-  const double le = e.norm();
+Eigen::Matrix<double, 6, 6> FaceTurnHessian(const Vec3& r_W, double a_m, const Vec3& e_W) {
+  const double le = e_W.norm();
   Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
   if (!(le > 0.0)) return H;
-  const Vec3 t = e / le;
+  const Vec3 t = e_W / le;
   const Mat3 P = Mat3::Identity() - t * t.transpose();
   // d2a = -(2 / |e|) dx_N^T P de - (2 (t.de)(r.de) + a de^T P de) / |e|^2, de = dx_N - dx_{N-1}.
-  const Mat3 ee = -(t * r.transpose() + r * t.transpose() + a * P) / (le * le);
+  const Mat3 ee = -(t * r_W.transpose() + r_W * t.transpose() + a_m * P) / (le * le);
   const Mat3 ne = -P / le;
   H.block<3, 3>(0, 0) = ee;
   H.block<3, 3>(0, 3) = -ee - ne;
@@ -573,6 +573,7 @@ double Assemble(const Model& model, Data& data, std::span<const Vec3> x_W,
         Material(CarrierOf(smp.kind), x_W, smp.node, smp.theta, smp.moving_offset_W);
     a.AddAtPoint(mp.jacobian, mp.first, mp.nodes, -kw * depth * smp.normal_W,
                  kw * (smp.normal_W * smp.normal_W.transpose() - depth * smp.curvature_per_m));
+    // The end face turns with the end element: its distance's own curvature.
     if (smp.kind == SampleKind::kEndFace && a.hessian()) {
       StencilTerm t;
       t.first = smp.node - 1;

@@ -240,9 +240,10 @@ void CopyFactors(const HessianFactors& from, HessianFactors& to) {
 
 // A solve that starts with the contacts of the last factored Hessian first tries its factors (a
 // chord step): where the hand moved little since, it is balanced there, or one full step with
-// them lands within the tolerance, and no Hessian is assembled or factored. A step that lowers
-// the energy but lands short of the tolerance is kept, and Newton's method goes on from there;
-// one that does not is dropped. The factors were positive definite; a straight column past its
+// them (where no point moves beyond the step cap) lowers the energy and lands within the
+// tolerance, and no Hessian is assembled or factored. A step that lowers the energy but lands
+// short of the tolerance is kept, as an iteration, and Newton's method goes on from there; one
+// that does not is dropped. The factors were positive definite; a straight column past its
 // buckling load (a saddle whose gradient stays zero) is found by the factorisation after
 // kKeptSolves solves. True when converged.
 bool StepWithKeptFactors(const Model& model, Data& data) {
@@ -298,6 +299,8 @@ void SolveEquilibrium(const Model& model, Data& data) {
     report.converged = true;
     return;
   }
+  // The contact forces and derivatives where the solve stands (the friction stage reads the
+  // forces even when the iterations are spent).
   double energy = AssembleHessian(model, data, x);
   // The iterations left of the tick's budget, which its friction passes share.
   while (report.iterations < model.solver.max_iterations) {

@@ -95,7 +95,7 @@ struct StepOutput {
   double energy_J = 0.0;          ///< elastic (bending) energy of the tube
   double max_strain = 0.0;        ///< largest bending strain (outer fibre) [-]
   double tip_deflection_m = 0.0;  ///< lateral deflection of the free end from the straight tube
-  int iterations = 0;             ///< Newton iterations of the tick's solve
+  int iterations = 0;             ///< Newton iterations of the tick's solve (kept steps too)
   double residual_N = 0.0;        ///< largest generalised force left unbalanced [N]
   std::uint32_t flags = 0;        ///< StepFlag bits
   std::span<const ContactState> Contacts() const {
