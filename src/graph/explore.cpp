@@ -188,7 +188,7 @@ std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scen
   const CandidatePaths c = FindCandidatePaths(scene, graph, options);
   std::vector<std::vector<Eigen::Isometry3d>> waypoint_lists;
   for (const Path& path : c.paths)
-    for (auto& aimed : DistinctAims(scene, c.pruned, path))
+    for (auto& aimed : DistinctAims(scene, c.pruned, path, kReplayAims))
       if (std::none_of(waypoint_lists.begin(), waypoint_lists.end(),
                        [&](const auto& a) { return SamePoses(a, aimed.second); }))
         waypoint_lists.push_back(std::move(aimed.second));

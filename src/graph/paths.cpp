@@ -10,6 +10,7 @@
 #include <boost/graph/filtered_graph.hpp>
 
 #include <tubeplan/graph/paths.hpp>
+#include <tubeplan/states/contact_formation.hpp>
 
 namespace tubeplan::graph {
 
@@ -127,11 +128,26 @@ std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<do
   return found;
 }
 
+namespace {
+
+// Whether a CF's text has a PC on the tube's end (its face or a rim).
+bool EndTouches(const std::string& cf) {
+  const states::ParseResult parsed = states::ParseContactFormation(cf);
+  if (!parsed.cf) return false;
+  return std::any_of(
+      parsed.cf->contacts.begin(), parsed.cf->contacts.end(),
+      [](const states::PrincipalContact& pc) { return pc.tube != states::TubeElement::kSide; });
+}
+
+}  // namespace
+
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim) {
   std::vector<Eigen::Isometry3d> waypoints = {scene.X_WH_start};
+  const double back_m = scene.tube.outer_radius_m + scene.contact.threshold_m;
   for (std::size_t j = 1; j < path.nodes.size(); ++j) {
     const Node& node = graph.nodes[std::size_t(path.nodes[j])];
+    const Eigen::Isometry3d& least = std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH;
     switch (aim) {
       case Aim::kHand:
         waypoints.push_back(node.X_W_hand);
@@ -140,18 +156,26 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
         waypoints.push_back(node.X_WH);
         break;
       case Aim::kLeastForce:
-        waypoints.push_back(std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH);
+        waypoints.push_back(least);
+        break;
+      case Aim::kAlongAxis:
+        if (EndTouches(node.cf) && !EndTouches(graph.nodes[std::size_t(path.nodes[j - 1])].cf)) {
+          Eigen::Isometry3d back = least;
+          back.translation() -= back_m * least.linear().col(2);
+          waypoints.push_back(back);
+        }
+        waypoints.push_back(least);
         break;
     }
   }
   return waypoints;
 }
 
-std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(const scene::Scene& scene,
-                                                                         const ContactGraph& graph,
-                                                                         const Path& path) {
+std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(
+    const scene::Scene& scene, const ContactGraph& graph, const Path& path,
+    std::span<const Aim> wanted) {
   std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> aims;
-  for (const Aim aim : {Aim::kHand, Aim::kHeld, Aim::kLeastForce}) {
+  for (const Aim aim : wanted) {
     std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, graph, path, aim);
     if (std::none_of(aims.begin(), aims.end(),
                      [&](const auto& a) { return SamePoses(a.second, w); }))

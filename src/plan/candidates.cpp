@@ -22,12 +22,13 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     c.plan.limits.max_force_N = scene.device.max_force_N;
     c.plan.limits.dwell_s = options.dwell_s;
     // At the asked speed, then each slower one until a replay is feasible: the hand aimed at
-    // the witnesses' hand poses, at their held end's poses and at the held end's poses of the
-    // stays of least force (each aim once: those that coincide with an earlier one are left
-    // out), the feasible one of least peak force kept (else the last tried).
+    // the witnesses' hand poses, at their held end's poses, at the held end's poses of the
+    // stays of least force, and at those with the end brought in along the tube (each aim
+    // once: those that coincide with an earlier one are left out), the feasible one of least
+    // peak force kept (else the last tried).
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
-    const auto aims = graph::DistinctAims(scene, graph, c.path);
+    const auto aims = graph::DistinctAims(scene, graph, c.path, graph::kPlanAims);
     int tried = 0;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =
@@ -144,7 +145,9 @@ std::string VerdictText(const Candidate& c) {
          << (c.from_motion                ? "the explorer's motion"
              : c.aim == graph::Aim::kHand ? "the hand's"
              : c.aim == graph::Aim::kHeld ? "the held end's poses"
-                                          : "the held end's poses of least force")
+             : c.aim == graph::Aim::kLeastForce
+                 ? "the held end's poses of least force"
+                 : "the held end's poses of least force, the end brought in along the tube")
          << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";
   text << "; peak operator force " << c.judgement.peak_force_N << " N";
   return text.str();

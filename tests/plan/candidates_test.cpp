@@ -1,7 +1,9 @@
-// Candidate plans made from graph paths: each is replayed through the judge aimed at the
-// witnesses' hand poses and at their held end's poses, slower while neither is feasible; the
-// feasible try of least force is kept, and the feasible candidates come first.
+// Candidate plans made from graph paths: each is replayed through the judge at each distinct
+// aim (the witnesses' hand poses, their held end's poses, the stays of least force, the end
+// brought in along the tube), slower while none is feasible; the feasible try of least force is
+// kept, and the feasible candidates come first.
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -9,12 +11,15 @@
 
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/motion.hpp>
+#include <tubeplan/graph/paths.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/plan/candidates.hpp>
 
 namespace {
 
 using namespace tubeplan;
+
+constexpr double kPi = 3.14159265358979323846;
 
 // The groove's start and goal as a two-node graph whose goal witness has the hand at height z
 // over the floor and the held end at height held_z, with the tube turned as the shipped lay-flat
@@ -162,6 +167,64 @@ TEST_CASE("Candidates: a state's stay of least force is aimed at as another witn
   CHECK(c[0].peak_speed_m_per_s == 0.08);
   CHECK(c[0].judgement.peak_force_N < 1.0);
   CHECK(plan::VerdictText(c[0]).find("(try 2: the held end's poses of least force at 80 mm/s)") !=
+        std::string::npos);
+}
+
+TEST_CASE("Candidates: an end brought in along the tube keeps the state a slanting reach bends",
+          "[plan]") {
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/scenes/ramp.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  // The goal's stay of least force as the explorer found it (`plans --budget 300 --time-limit 0`
+  // on this scene): the held end 151 mm out along the ramp's normal n, 42 mm down the slope and
+  // 2 mm aside from the origin. The start is 165 mm out, 20 mm the other way aside: a straight
+  // reach comes in at 72 deg to n.
+  const Eigen::Vector3d n(0.0, -std::sin(kPi / 12.0), std::cos(kPi / 12.0));
+  graph::ContactGraph g;
+  g.nodes.resize(2);
+  g.nodes[0].cf = "{}";
+  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
+  g.nodes[1].cf = "{Fe - ramp.top}";
+  Eigen::Isometry3d X_goal = scene.X_WH_start;
+  X_goal.translation() = Eigen::Vector3d(-1.855182e-3, -79.205638e-3, 135.090790e-3);
+  g.nodes[1].X_W_hand = g.nodes[1].X_WH = g.nodes[1].X_WH_least = X_goal;
+  g.nodes[1].min_force_N = 0.2;
+  g.start = 0;
+  g.goal = 1;
+  const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
+  // The straight reach at the goal's pose: the end meets the ramp moving sideways, its rim
+  // first, and it never lies flat.
+  const std::vector<Eigen::Isometry3d> straight =
+      graph::PathWaypoints(scene, g, paths[0], graph::Aim::kLeastForce);
+  const std::vector<Eigen::Isometry3d> along =
+      graph::PathWaypoints(scene, g, paths[0], graph::Aim::kAlongAxis);
+  REQUIRE(straight.size() == 2);
+  REQUIRE(along.size() == 3);
+  // Drawn back along the held end's axis by r1 + eps (9 mm), then straight in.
+  CHECK((along[1].translation() - (X_goal.translation() + 9e-3 * n)).norm() < 1e-12);
+  trajectories::SynthesisOptions synthesis;
+  synthesis.peak_speed_m_per_s = 0.08;
+  plan::Limits limits;
+  limits.max_force_N = scene.device.max_force_N;
+  limits.dwell_s = 0.02;
+  const plan::Judgement slanting =
+      plan::Judge(scene, trajectories::SynthesizeTrajectory(straight, synthesis),
+                  {"{}", g.nodes[1].cf}, limits);
+  INFO(plan::FirstFailure(slanting));
+  CHECK_FALSE(slanting.feasible);
+  CHECK(plan::FirstFailure(slanting).find("{Fe - ramp.top} never reached") != std::string::npos);
+  // The candidate tries the hand's pose (the held end's and the least force's are the same
+  // poses) and then the end brought in along the tube, which holds the goal, straight.
+  int replays = 0;
+  const std::vector<plan::Candidate> c = CountedCandidates(scene, g, paths, replays);
+  REQUIRE(c.size() == 1);
+  INFO(plan::VerdictText(c[0]));
+  CHECK(replays == 2);
+  CHECK(c[0].judgement.feasible);
+  CHECK(c[0].aim == graph::Aim::kAlongAxis);
+  CHECK(c[0].judgement.peak_force_N < 1.0);
+  CHECK(plan::VerdictText(c[0]).find("the end brought in along the tube at 80 mm/s") !=
         std::string::npos);
 }
 

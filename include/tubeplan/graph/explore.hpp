@@ -54,7 +54,7 @@ struct ExploreOptions {
   /// After each group of probes, and in each closing round, this many perturbed copies (0: none)
   /// of each candidate plan's trajectory of the graph as it then stands run: the `replay_paths`
   /// cheapest start -> goal paths of the graph pruned with `weights`, the hand aimed at each
-  /// distinct aim of graph::Aim (CandidateWaypoints) at `speed_m_per_s`, and the explorer's
+  /// distinct aim of graph::kReplayAims (CandidateWaypoints) at `speed_m_per_s`, and the explorer's
   /// motion to the goal (CandidateTrajectories), each moved as a whole by up to
   /// `replay_offset_m`, with 0.1 mm tremor and 0.8-1.25x the speed (trajectories::Perturb). What
   /// an operator following a plan meets is then in the graph. None run before the goal is
@@ -125,8 +125,8 @@ ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& options,
 
 /// The hand's waypoints of the candidate plans of `graph` as `plans` makes them: for each of the
 /// `options.replay_paths` cheapest start -> goal paths of the graph pruned with
-/// `options.weights` (its explored states only), one list per distinct aim of graph::Aim. Empty
-/// when the graph has no goal or no path to it.
+/// `options.weights` (its explored states only), one list per distinct aim of
+/// graph::kReplayAims. Empty when the graph has no goal or no path to it.
 std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,
                                                                const ContactGraph& graph,
                                                                const ExploreOptions& options);

@@ -4,6 +4,7 @@
 // above the cheapest kept arc's, so every transition costs at least one (shorter plans first)
 // and the heuristics order plans of the same length.
 
+#include <array>
 #include <span>
 #include <utility>
 #include <vector>
@@ -33,6 +34,10 @@ enum class Aim : unsigned char {
   kHand,        ///< the hand's pose at the state's witness
   kHeld,        ///< the held end's pose there (the hand no longer pulling the coupling out)
   kLeastForce,  ///< the held end's pose at the state's stay of least operator force
+  /// As kLeastForce, and where the tube's end first meets a part (a state with an end PC after
+  /// one without), the hand first goes to that pose drawn back along the held end's axis by the
+  /// tube's radius and the contact threshold, then straight in: the end arrives along the tube.
+  kAlongAxis,
 };
 
 /// The hand's poses along a path: the scene's start, then one pose per later state as `aim`
@@ -41,11 +46,19 @@ enum class Aim : unsigned char {
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim);
 
-/// The path's waypoints for each aim, in the order of Aim, each distinct list once (an aim whose
-/// poses equal an earlier one's is left out): what a candidate plan tries.
+/// The aims the explorer's and the completeness check's replays of the candidate plans take.
+inline constexpr std::array<Aim, 3> kReplayAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce};
+/// The aims a candidate plan tries (`plans`): those, then the end brought in along the tube, a
+/// repair for a reach that slants onto a part.
+inline constexpr std::array<Aim, 4> kPlanAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce,
+                                                 Aim::kAlongAxis};
+
+/// The path's waypoints for each of `aims`, in that order, each distinct list once (an aim whose
+/// poses equal an earlier one's is left out).
 std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(const scene::Scene& scene,
                                                                          const ContactGraph& graph,
-                                                                         const Path& path);
+                                                                         const Path& path,
+                                                                         std::span<const Aim> aims);
 
 /// Whether two lists of poses are the same, bit for bit (two aims that coincide).
 bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b);
