@@ -73,11 +73,12 @@ void AddGraphOptions(CLI::App* sub, GraphOptions& o) {
                   "state and no transition (0: no random motions in them; docs/graph.md)")
       ->check(CLI::Range(0, 10000))
       ->capture_default_str();
-  sub->add_option("--replays", o.replays,
-                  "after each group of 16 probes and in each closing round, replay this many "
-                  "copies of each candidate plan's trajectory (as `plans` makes them from the "
-                  "graph so far), each moved by up to 4 mm, with tremor and 0.8-1.25x the speed; "
-                  "the plans' states are probed first (0: none; docs/graph.md)")
+  sub->add_option(
+         "--replays", o.replays,
+         "after each group of 16 probes and in each closing round, replay this many "
+         "copies of each candidate plan's trajectory (as `plans` first tries them from "
+         "the graph so far), each moved by up to 4 mm, with tremor and 0.8-1.25x the speed; "
+         "the plans' states are probed first (0: none; docs/graph.md)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   sub->add_option("--budget", o.budget,

@@ -130,7 +130,8 @@ std::vector<Path> KShortestPaths(const ContactGraph& graph, const std::vector<do
 
 namespace {
 
-// Whether a CF's text has a PC on the tube's end (its face or a rim).
+// Whether a CF's text has a PC on any element but the tube's outer side: the end's face or
+// rim, or the bore's.
 bool EndTouches(const std::string& cf) {
   const states::ParseResult parsed = states::ParseContactFormation(cf);
   if (!parsed.cf) return false;
@@ -147,7 +148,8 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
   const double back_m = scene.tube.outer_radius_m + scene.contact.threshold_m;
   for (std::size_t j = 1; j < path.nodes.size(); ++j) {
     const Node& node = graph.nodes[std::size_t(path.nodes[j])];
-    const Eigen::Isometry3d& least = std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH;
+    const Eigen::Isometry3d& X_WH_least =
+        std::isfinite(node.min_force_N) ? node.X_WH_least : node.X_WH;
     switch (aim) {
       case Aim::kHand:
         waypoints.push_back(node.X_W_hand);
@@ -156,15 +158,16 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
         waypoints.push_back(node.X_WH);
         break;
       case Aim::kLeastForce:
-        waypoints.push_back(least);
+        waypoints.push_back(X_WH_least);
         break;
       case Aim::kAlongAxis:
+        // Where the end comes to touch: first drawn back along the tube, then straight in.
         if (EndTouches(node.cf) && !EndTouches(graph.nodes[std::size_t(path.nodes[j - 1])].cf)) {
-          Eigen::Isometry3d back = least;
-          back.translation() -= back_m * least.linear().col(2);
-          waypoints.push_back(back);
+          Eigen::Isometry3d X_WH_back = X_WH_least;
+          X_WH_back.translation() -= back_m * X_WH_least.linear().col(2);
+          waypoints.push_back(X_WH_back);
         }
-        waypoints.push_back(least);
+        waypoints.push_back(X_WH_least);
         break;
     }
   }
@@ -173,15 +176,15 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
 
 std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> DistinctAims(
     const scene::Scene& scene, const ContactGraph& graph, const Path& path,
-    std::span<const Aim> wanted) {
-  std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> aims;
-  for (const Aim aim : wanted) {
+    std::span<const Aim> aims) {
+  std::vector<std::pair<Aim, std::vector<Eigen::Isometry3d>>> distinct;
+  for (const Aim aim : aims) {
     std::vector<Eigen::Isometry3d> w = PathWaypoints(scene, graph, path, aim);
-    if (std::none_of(aims.begin(), aims.end(),
+    if (std::none_of(distinct.begin(), distinct.end(),
                      [&](const auto& a) { return SamePoses(a.second, w); }))
-      aims.emplace_back(aim, std::move(w));
+      distinct.emplace_back(aim, std::move(w));
   }
-  return aims;
+  return distinct;
 }
 
 bool SamePoses(std::span<const Eigen::Isometry3d> a, std::span<const Eigen::Isometry3d> b) {

@@ -170,8 +170,10 @@ TEST_CASE("Candidates: a state's stay of least force is aimed at as another witn
         std::string::npos);
 }
 
-TEST_CASE("Candidates: an end brought in along the tube keeps the state a slanting reach bends",
-          "[plan]") {
+TEST_CASE(
+    "Candidates: an end brought in along the tube lies flat where a slanting reach lands "
+    "on its rim",
+    "[plan]") {
   const io::SceneLoadResult loaded =
       io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/scenes/ramp.yaml");
   REQUIRE(loaded.scene);
@@ -179,7 +181,7 @@ TEST_CASE("Candidates: an end brought in along the tube keeps the state a slanti
   // The goal's stay of least force as the explorer found it (`plans --budget 300 --time-limit 0`
   // on this scene): the held end 151 mm out along the ramp's normal n, 42 mm down the slope and
   // 2 mm aside from the origin. The start is 165 mm out, 20 mm the other way aside: a straight
-  // reach comes in at 72 deg to n.
+  // reach comes in at 73 deg to n.
   const Eigen::Vector3d n(0.0, -std::sin(kPi / 12.0), std::cos(kPi / 12.0));
   graph::ContactGraph g;
   g.nodes.resize(2);
@@ -193,8 +195,8 @@ TEST_CASE("Candidates: an end brought in along the tube keeps the state a slanti
   g.start = 0;
   g.goal = 1;
   const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
-  // The straight reach at the goal's pose: the end meets the ramp moving sideways, its rim
-  // first, and it never lies flat.
+  // The straight reach at the goal's pose: the end meets the ramp moving sideways, lands on its
+  // rim and never lies flat.
   const std::vector<Eigen::Isometry3d> straight =
       graph::PathWaypoints(scene, g, paths[0], graph::Aim::kLeastForce);
   const std::vector<Eigen::Isometry3d> along =
@@ -203,6 +205,17 @@ TEST_CASE("Candidates: an end brought in along the tube keeps the state a slanti
   REQUIRE(along.size() == 3);
   // Drawn back along the held end's axis by r1 + eps (9 mm), then straight in.
   CHECK((along[1].translation() - (X_goal.translation() + 9e-3 * n)).norm() < 1e-12);
+  CHECK(along[1].linear() == X_goal.linear());
+  // Only where the end comes to touch: not again into a state whose end touched already, nor
+  // into one where only the side does.
+  graph::ContactGraph longer = g;
+  longer.nodes.push_back(g.nodes[1]);
+  longer.nodes[2].cf = "{Fe - ramp.top, Fs - table.top}";
+  longer.nodes.push_back(g.nodes[1]);
+  longer.nodes[3].cf = "{Fs - table.top}";
+  CHECK(graph::PathWaypoints(scene, longer, {{0, 1, 2}, 1.0}, graph::Aim::kAlongAxis).size() == 4);
+  CHECK(graph::PathWaypoints(scene, longer, {{0, 3, 2}, 1.0}, graph::Aim::kAlongAxis).size() == 4);
+  CHECK(graph::PathWaypoints(scene, longer, {{0, 3}, 1.0}, graph::Aim::kAlongAxis).size() == 2);
   trajectories::SynthesisOptions synthesis;
   synthesis.peak_speed_m_per_s = 0.08;
   plan::Limits limits;

@@ -123,8 +123,8 @@ double ExploreForceLimit(const scene::Scene& scene, const ExploreOptions& option
 ContactGraph Explore(const scene::Scene& scene, const ExploreOptions& options,
                      const std::function<void(const SaturationPoint&)>& progress = {});
 
-/// The hand's waypoints of the candidate plans of `graph` as `plans` makes them: for each of the
-/// `options.replay_paths` cheapest start -> goal paths of the graph pruned with
+/// The hand's waypoints of the candidate plans of `graph` as `plans` first tries them: for each of
+/// the `options.replay_paths` cheapest start -> goal paths of the graph pruned with
 /// `options.weights` (its explored states only), one list per distinct aim of
 /// graph::kReplayAims. Empty when the graph has no goal or no path to it.
 std::vector<std::vector<Eigen::Isometry3d>> CandidateWaypoints(const scene::Scene& scene,

@@ -41,15 +41,16 @@ enum class Aim : unsigned char {
 };
 
 /// The hand's poses along a path: the scene's start, then one pose per later state as `aim`
-/// says (kLeastForce falls back to kHeld for a state with no stay of measured force). A candidate
-/// plan's trajectory goes through them.
+/// says, two where kAlongAxis draws the hand back first (kLeastForce and kAlongAxis fall back to
+/// kHeld's pose for a state with no stay of measured force). A candidate plan's trajectory goes
+/// through them.
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim);
 
 /// The aims the explorer's and the completeness check's replays of the candidate plans take.
 inline constexpr std::array<Aim, 3> kReplayAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce};
-/// The aims a candidate plan tries (`plans`): those, then the end brought in along the tube, a
-/// repair for a reach that slants onto a part.
+/// The aims a candidate plan tries (`plans`) at each speed: those, then the end brought in along
+/// the tube, for a reach that would slant onto a part.
 inline constexpr std::array<Aim, 4> kPlanAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce,
                                                  Aim::kAlongAxis};
 

@@ -1,10 +1,11 @@
 #pragma once
 // Candidate plans from paths through the contact-state graph: the hand moves by minimum jerk
 // through the witnesses of each path's states, and every candidate is replayed through the same
-// judge as `evaluate`, aimed at the witnesses' hand poses, at their held end's poses and at the
-// held end's poses of the stays of least force, slower while none is feasible; the feasible try
-// of least force is kept; and the explorer's own motion into the goal as one more candidate
-// (docs/graph.md, "Plans").
+// judge as `evaluate`, aimed at the witnesses' hand poses, at their held end's poses, at the
+// held end's poses of the stays of least force, and at those with the end brought in along the
+// tube (graph::kPlanAims), slower while none is feasible; the feasible try of least force is
+// kept; and the explorer's own motion into the goal as one more candidate (docs/graph.md,
+// "Plans").
 
 #include <functional>
 #include <optional>
@@ -29,11 +30,12 @@ struct CandidateOptions {
   std::string scene_ref;  ///< the scene as the plan files name it
   /// Each repair divides the peak speed by the next of these (a quasi-static reach overshoots
   /// less): the first tries are at the asked speed. At each speed the hand is aimed at the
-  /// witnesses' hand poses, at their held end's poses (Node::X_WH) and at the held end's poses
-  /// of each state's stay of least force (Node::X_WH_least, another witness of the same state):
-  /// a witness the explorer reached while the tube held back from the hand (the coupling
-  /// stretched, the tube pushed hard, or still moving) is then approached without the push that
-  /// carried the tube on.
+  /// witnesses' hand poses, at their held end's poses (Node::X_WH), at the held end's poses of
+  /// each state's stay of least force (Node::X_WH_least, another witness of the same state), and
+  /// at those with the end brought in along the tube (graph::Aim::kAlongAxis): a witness the
+  /// explorer reached while the tube held back from the hand (the coupling stretched, the tube
+  /// pushed hard, or still moving) is then approached without the push that carried the tube
+  /// on, and an end that a slanting reach would land on its rim comes in square.
   std::vector<double> slower = {2.0, 4.0};
 };
 
