@@ -226,7 +226,8 @@ std::optional<Motion> ApproachTogether(const scene::Scene& scene, core::Core& pr
     if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
     Motion m;
     m.kind = "aim goal";
-    const Eigen::Vector3d above = GoOver(f, X.translation() - travel * push, g.q, o, m);
+    // Straight down onto the clear pose (the way in to a hole), then in along push.
+    const Eigen::Vector3d above = GoOver(f, X.translation(), g.q, o, m);
     m.moves.push_back(MoveTo(X.translation(), g.q, 0.5 * o.speed_m_per_s, o.push_N, above));
     GuardedMoveAndHold(scene, travel * push, g.q, 0.1 * o.speed_m_per_s, kTouchGuard_N, m);
     m.moves.push_back(MoveBy(scene, 3e-3 * push, g.q, 0.5 * o.speed_m_per_s, o.push_N));
