@@ -1,6 +1,7 @@
 #include "graph/explorer_motions.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <optional>
@@ -352,7 +353,14 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
     const bool in_goal = std::any_of(
         scene.goal.contacts.begin(), scene.goal.contacts.end(),
         [&](const states::PrincipalContact& pc) { return pc.part_element == element.name; });
-    for (double phi_deg : {30.0, 60.0, 80.0, 0.0}) {
+    // The goal's end face flat on the element: the axis along its normal first.
+    const bool flat_in_goal = std::any_of(scene.goal.contacts.begin(), scene.goal.contacts.end(),
+                                          [&](const states::PrincipalContact& pc) {
+                                            return pc.part_element == element.name &&
+                                                   pc.tube == states::TubeElement::kEndFace;
+                                          });
+    const std::array<double, 4> leaning = {30.0, 60.0, 80.0, 0.0}, flat = {0.0, 30.0, 60.0, 80.0};
+    for (double phi_deg : flat_in_goal ? flat : leaning) {
       if (phi_deg == 0.0 && !in_goal) continue;
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
       const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
