@@ -15,8 +15,7 @@ namespace {
 // "strain 0.9263 > 0.2 at t = 1.000 s": the value with as many digits as it takes to differ
 // from the limit as written (8.500001 N > 8.5 N, never 8.5 N > 8.5 N), a unit only when there
 // is one.
-std::string Format(const char* what, double value, const char* unit, double limit, double t_s,
-                   const char* note = "") {
+std::string Format(const char* what, double value, const char* unit, double limit, double t_s) {
   const std::string space_unit = *unit != '\0' ? std::string(" ") + unit : std::string();
   char limit_text[32];
   std::snprintf(limit_text, sizeof limit_text, "%.4g", limit);
@@ -26,8 +25,8 @@ std::string Format(const char* what, double value, const char* unit, double limi
     if (std::string_view(value_text) != limit_text) break;
   }
   char buffer[256];
-  std::snprintf(buffer, sizeof buffer, "limit exceeded: %s %s%s%s > %s%s at t = %.3f s", what,
-                value_text, space_unit.c_str(), note, limit_text, space_unit.c_str(), t_s);
+  std::snprintf(buffer, sizeof buffer, "limit exceeded: %s %s%s > %s%s at t = %.3f s", what,
+                value_text, space_unit.c_str(), limit_text, space_unit.c_str(), t_s);
   return buffer;
 }
 
@@ -156,12 +155,20 @@ void Judging::Measure(double t_s, const core::StepOutput& out) {
     if (f.failure.empty()) f.failure = reason, f.t_failure_s = t_s;
   };
   // At the device's clamp the force is the most the device renders, which a plan's limit is
-  // often set to: said so, rather than "8.5 N > 8.5 N".
-  if (force_N > limits_.max_force_N)
-    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s,
-                    (out.flags & core::kForceClamped)
-                        ? " (the device's clamp was reached: it renders no more)"
-                        : ""));
+  // often set to: the motion asked more, so a clamp at the limit (within the rounding of the
+  // clamp's scaling) exceeds it too, and is said so rather than as "8.5 N > 8.5 N".
+  if (out.flags & core::kForceClamped) {
+    if (force_N >= limits_.max_force_N * (1.0 - 1e-12)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "limit exceeded: operator force %.4g N at the device's clamp (the motion "
+                    "asks more than it renders), limit %.4g N at t = %.3f s",
+                    force_N, limits_.max_force_N, t_s);
+      exceeded(text);
+    }
+  } else if (force_N > limits_.max_force_N) {
+    exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s));
+  }
   if (out.max_strain > limits_.max_strain)
     exceeded(Format("strain", out.max_strain, "", limits_.max_strain, t_s));
   for (const core::ContactState& c : out.Contacts()) {
