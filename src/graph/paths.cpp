@@ -160,6 +160,15 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
       case Aim::kLeastForce:
         waypoints.push_back(X_WH_least);
         break;
+      case Aim::kOver:
+        // From the start over the first state's pose, then down to it (and on as kAlongAxis).
+        if (j == 1) {
+          Eigen::Isometry3d X_WH_over = X_WH_least;
+          X_WH_over.translation().z() =
+              std::max(X_WH_least.translation().z(), scene.X_WH_start.translation().z());
+          if (!X_WH_over.isApprox(scene.X_WH_start)) waypoints.push_back(X_WH_over);
+        }
+        [[fallthrough]];
       case Aim::kAlongAxis:
         // Where the end comes to touch: first drawn back along the tube, then straight in.
         if (EndTouches(node.cf) && !EndTouches(graph.nodes[std::size_t(path.nodes[j - 1])].cf)) {

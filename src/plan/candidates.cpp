@@ -25,7 +25,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     // the witnesses' hand poses, at their held end's poses, at the held end's poses of the
     // stays of least force, and at those with the end brought in along the tube (each aim
     // once: those that coincide with an earlier one are left out), the feasible one of least
-    // peak force kept (else the last tried).
+    // peak force kept (else the last tried); where none holds, at those with the first reach
+    // over the parts.
     trajectories::SynthesisOptions synthesis = options.synthesis;
     synthesis.seed = options.synthesis.seed + i;
     const auto aims = graph::DistinctAims(scene, graph, c.path, graph::kPlanAims);
@@ -34,6 +35,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
       synthesis.peak_speed_m_per_s =
           options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
       for (const auto& [aim, waypoints] : aims) {
+        // A detour over the parts only where no straighter reach holds at this speed.
+        if (aim == graph::Aim::kOver && c.judgement.feasible) continue;
         Candidate t = c;
         t.trajectory = trajectories::SynthesizeTrajectory(waypoints, synthesis);
         t.duration_s = t.trajectory.samples.back().t_s;
@@ -142,12 +145,13 @@ std::string VerdictText(const Candidate& c) {
        << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
   if (c.tries > 1)
     text << " (try " << c.tries << ": "
-         << (c.from_motion                ? "the explorer's motion"
-             : c.aim == graph::Aim::kHand ? "the hand's"
-             : c.aim == graph::Aim::kHeld ? "the held end's poses"
-             : c.aim == graph::Aim::kLeastForce
-                 ? "the held end's poses of least force"
-                 : "the held end's poses of least force, the end brought in along the tube")
+         << (c.from_motion                      ? "the explorer's motion"
+             : c.aim == graph::Aim::kHand       ? "the hand's"
+             : c.aim == graph::Aim::kHeld       ? "the held end's poses"
+             : c.aim == graph::Aim::kLeastForce ? "the held end's poses of least force"
+             : c.aim == graph::Aim::kAlongAxis
+                 ? "the held end's poses of least force, the end brought in along the tube"
+                 : "the held end's poses of least force, over the parts first")
          << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";
   text << "; peak operator force " << c.judgement.peak_force_N << " N";
   return text.str();

@@ -91,13 +91,13 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   CHECK(c[1].aim == graph::Aim::kHand);
   CHECK(c[1].judgement.peak_force_N < scene.device.max_force_N);
   CHECK(c[1].plan.states == std::vector<std::string>{"{}", "{Fs - floor.top}"});
-  // The witness whose tube was pushed through the floor too (hand and held end at one pose,
-  // one aim) stays infeasible after all three speeds, at the device's limit, with the slowest
-  // try's longer trajectory.
+  // The witness whose tube was pushed through the floor too (hand and held end at one pose:
+  // one straight aim, then the detour over the parts) stays infeasible after all three speeds,
+  // at the device's limit, with the slowest try's longer trajectory.
   CHECK(c[2].path.nodes == paths[0].nodes);
   CHECK_FALSE(c[2].judgement.feasible);
-  CHECK(c[2].tries == 3);
-  CHECK(c[2].aim == graph::Aim::kHand);
+  CHECK(c[2].tries == 6);
+  CHECK(c[2].aim == graph::Aim::kOver);
   CHECK(c[2].peak_speed_m_per_s == Approx(0.02));
   CHECK(c[2].duration_s > 2.0 * c[1].duration_s);
   CHECK(c[2].judgement.peak_force_N == Approx(scene.device.max_force_N));
@@ -105,7 +105,7 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   // the goal's lying-flat state).
   const std::string failure = plan::FirstFailure(c[2].judgement);
   CHECK(failure.find("after the goal") != std::string::npos);
-  CHECK(replays == 2 + 1 + 3);
+  CHECK(replays == 2 + 1 + 6);
 }
 
 TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept", "[plan]") {
@@ -239,6 +239,66 @@ TEST_CASE(
   CHECK(c[0].judgement.peak_force_N < 1.0);
   CHECK(plan::VerdictText(c[0]).find("the end brought in along the tube at 80 mm/s") !=
         std::string::npos);
+}
+
+TEST_CASE("Candidates: a first reach over the parts goes round the rim a straight one runs into",
+          "[plan]") {
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/scenes/pocket-beside.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  // The goal's stay of least force as the explorer found it (`graph --budget 300 --time-limit 0`
+  // on this scene): the tube plumb over the pocket's middle, its held end 151 mm over the floor.
+  // The start is 180 mm up, 57 mm aside, the end 10 mm over the walls' tops.
+  graph::ContactGraph g;
+  g.nodes.resize(2);
+  g.nodes[0].cf = "{}";
+  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
+  g.nodes[1].cf = "{Fe - base.top}";
+  Eigen::Isometry3d X_goal = scene.X_WH_start;
+  X_goal.translation() = Eigen::Vector3d(0.0, 0.0, 0.151);
+  g.nodes[1].X_W_hand = g.nodes[1].X_WH = g.nodes[1].X_WH_least = X_goal;
+  g.nodes[1].min_force_N = 0.006;
+  g.start = 0;
+  g.goal = 1;
+  const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
+  const std::vector<Eigen::Isometry3d> straight =
+      graph::PathWaypoints(scene, g, paths[0], graph::Aim::kAlongAxis);
+  const std::vector<Eigen::Isometry3d> over =
+      graph::PathWaypoints(scene, g, paths[0], graph::Aim::kOver);
+  REQUIRE(straight.size() == 3);
+  REQUIRE(over.size() == 4);
+  // Over the goal's pose at the start's height, turned as there; then as the end brought in
+  // along the tube.
+  CHECK((over[1].translation() - Eigen::Vector3d(0.0, 0.0, 0.180)).norm() < 1e-12);
+  CHECK(over[1].linear() == X_goal.linear());
+  CHECK(over[2].matrix() == straight[1].matrix());
+  CHECK(over[3].matrix() == X_goal.matrix());
+  // Only the reach from the start goes over: a goal above the start is gone to straight.
+  graph::ContactGraph high = g;
+  high.nodes[1].X_WH_least.translation().z() = 0.2;
+  CHECK(graph::PathWaypoints(scene, high, paths[0], graph::Aim::kOver)[1].translation().z() == 0.2);
+  trajectories::SynthesisOptions synthesis;
+  synthesis.peak_speed_m_per_s = 0.08;
+  plan::Limits limits;
+  limits.max_force_N = scene.device.max_force_N;
+  limits.dwell_s = 0.02;
+  // The straight reach: the end comes down onto the walls' tops and never reaches the floor.
+  const plan::Judgement cut =
+      plan::Judge(scene, trajectories::SynthesizeTrajectory(straight, synthesis),
+                  {"{}", g.nodes[1].cf}, limits);
+  INFO(plan::FirstFailure(cut));
+  CHECK_FALSE(cut.feasible);
+  CHECK(plan::FirstFailure(cut).find("{Fe - base.top} never reached") != std::string::npos);
+  // The candidate tries every aim; only the one over the parts holds the goal.
+  int replays = 0;
+  const std::vector<plan::Candidate> c = CountedCandidates(scene, g, paths, replays);
+  REQUIRE(c.size() == 1);
+  INFO(plan::VerdictText(c[0]));
+  CHECK(c[0].judgement.feasible);
+  CHECK(c[0].aim == graph::Aim::kOver);
+  CHECK(c[0].judgement.peak_force_N < 0.1);
+  CHECK(plan::VerdictText(c[0]).find("over the parts first at 80 mm/s") != std::string::npos);
 }
 
 TEST_CASE("Candidates: the explorer's own motion to the goal is a feasible plan",

@@ -38,21 +38,26 @@ enum class Aim : unsigned char {
   /// one without), the hand first goes to that pose drawn back along the held end's axis by the
   /// tube's radius and the contact threshold, then straight in: the end arrives along the tube.
   kAlongAxis,
+  /// As kAlongAxis, and the reach from the start goes first over the first state's pose, at the
+  /// start's height or the pose's if higher, then straight down: a reach from the start that
+  /// would cut through a part's rim on its slant (into a pocket beside the start) goes round it.
+  kOver,
 };
 
 /// The hand's poses along a path: the scene's start, then one pose per later state as `aim`
-/// says, two where kAlongAxis draws the hand back first (kLeastForce and kAlongAxis fall back to
-/// kHeld's pose for a state with no stay of measured force). A candidate plan's trajectory goes
-/// through them.
+/// says, more where kAlongAxis draws the hand back first or kOver goes over the first state
+/// (kLeastForce, kAlongAxis and kOver fall back to kHeld's pose for a state with no stay of
+/// measured force). A candidate plan's trajectory goes through them.
 std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const ContactGraph& graph,
                                              const Path& path, Aim aim);
 
 /// The aims the explorer's and the completeness check's replays of the candidate plans take.
 inline constexpr std::array<Aim, 3> kReplayAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce};
 /// The aims a candidate plan tries (`plans`) at each speed: those, then the end brought in along
-/// the tube, for a reach that would slant onto a part.
-inline constexpr std::array<Aim, 4> kPlanAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce,
-                                                 Aim::kAlongAxis};
+/// the tube, for a reach that would slant onto a part, and, where none of those holds, that with
+/// the first reach going over the parts, for one that would cut through a part's rim.
+inline constexpr std::array<Aim, 5> kPlanAims = {Aim::kHand, Aim::kHeld, Aim::kLeastForce,
+                                                 Aim::kAlongAxis, Aim::kOver};
 
 /// The path's waypoints for each of `aims`, in that order, each distinct list once (an aim whose
 /// poses equal an earlier one's is left out).

@@ -3,9 +3,9 @@
 // through the witnesses of each path's states, and every candidate is replayed through the same
 // judge as `evaluate`, aimed at the witnesses' hand poses, at their held end's poses, at the
 // held end's poses of the stays of least force, and at those with the end brought in along the
-// tube (graph::kPlanAims), slower while none is feasible; the feasible try of least force is
-// kept; and the explorer's own motion into the goal as one more candidate (docs/graph.md,
-// "Plans").
+// tube, and where none of those holds, with the first reach over the parts (graph::kPlanAims),
+// slower while none is feasible; the feasible try of least force is kept; and the explorer's own
+// motion into the goal as one more candidate (docs/graph.md, "Plans").
 
 #include <functional>
 #include <optional>
@@ -35,7 +35,8 @@ struct CandidateOptions {
   /// at those with the end brought in along the tube (graph::Aim::kAlongAxis): a witness the
   /// explorer reached while the tube held back from the hand (the coupling stretched, the tube
   /// pushed hard, or still moving) is then approached without the push that carried the tube
-  /// on, and an end that a slanting reach would land on its rim comes in square.
+  /// on, and an end that a slanting reach would land on its rim comes in square. Where none of
+  /// those holds, the hand goes over the parts first (graph::Aim::kOver).
   std::vector<double> slower = {2.0, 4.0};
 };
 
