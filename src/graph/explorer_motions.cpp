@@ -381,12 +381,16 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         m.kind = "aim " + element.name;
         // Over the target at a safe height, down onto it (straight in: down to half a tube
         // length back along the axis, then along it), press, slide, back off.
+        // The entry is as far back along the axis as fits the workspace and is clear: half the
+        // tube's length, else a quarter, else an eighth.
         Eigen::Vector3d entry = aim.hand;
-        if (aim.along_axis) {
+        for (double back = 0.5 * l; aim.along_axis && back > 0.1 * l; back *= 0.5) {
           Eigen::Isometry3d X_entry = X;
-          X_entry.translation() = aim.hand - 0.5 * l * aim.axis;
-          if (InWorkspace(scene, X_entry.translation()) && FreePose(probe, X_entry))
+          X_entry.translation() = aim.hand - back * aim.axis;
+          if (InWorkspace(scene, X_entry.translation()) && FreePose(probe, X_entry)) {
             entry = X_entry.translation();
+            break;
+          }
         }
         const Eigen::Vector3d above = GoOver(f, entry, q, o, m);
         if (entry != aim.hand)

@@ -952,6 +952,12 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            // off it, as at other faces, the end lands on its rim and bends before it lies flat,
            // and no motion of a default exploration holds the goal.
            Case{"incline.yaml", 51, "{Fe - ramp.top}", 0.1, "aim ramp.top"},
+           // The steel tube's end into a hole pitched 20 deg, the tube hanging plumb: the aim at
+           // the hole's floor comes in along its axis from a quarter of the tube's length back,
+           // the farthest the workspace holds (measured 0.006 N). Lowered plumb from over the
+           // floor instead, the end runs into the hole's wall, and no motion of a default
+           // exploration holds the goal.
+           Case{"hole-tilted.yaml", 47, "{Fe - base.top}", 0.1, "aim base.top"},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
