@@ -87,9 +87,15 @@ Move MoveBy(const scene::Scene& scene, const Eigen::Vector3d& d, const Eigen::Qu
   return m;
 }
 
-// Whether the tube, straight and held at X, touches nothing: a tick of the core with the hand
-// there from a reset there.
-bool FreePose(core::Core& core, const Eigen::Isometry3d& X) {
+// Whether the tube, straight and held at X, touches nothing: its axis inside no part, and a tick
+// of the core with the hand there from a reset there. (Posed through a plate, a node inside it
+// sees the plate's faces along the tube, which a tick leaves to the neighbouring elements: a
+// tube that moved there would have met the plate first.)
+bool FreePose(const scene::Scene& scene, core::Core& core, const Eigen::Isometry3d& X) {
+  const double l = scene.tube.length_m, spacing = 0.5 * scene.tube.outer_radius_m;
+  const int points = static_cast<int>(std::ceil(l / spacing));
+  for (int k = 0; k <= points; ++k)
+    if (InsideAnyPart(scene, X * Eigen::Vector3d(0.0, 0.0, l * k / points))) return false;
   core.Reset(X);
   const core::StepOutput& out = core.Step(0.0, X);
   return out.contact_count == 0 && (out.flags & core::kPenetration) == 0;
@@ -224,7 +230,7 @@ std::optional<Motion> ApproachTogether(const scene::Scene& scene, core::Core& pr
   for (const double gap : {scene.contact.threshold_m + 3e-3, scene.contact.threshold_m + 1e-3}) {
     const double travel = gap / slowest;  // until the last element is within reach
     const Eigen::Isometry3d X = HandFor(scene, g, g.Tip(scene.tube.outer_radius_m, gap));
-    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    if (!InWorkspace(scene, X.translation()) || !FreePose(scene, probe, X)) continue;
     Motion m;
     m.kind = "aim goal";
     // Straight down onto the clear pose (the way in to a hole), then in along push.
@@ -256,7 +262,7 @@ std::optional<Motion> SlideIn(const scene::Scene& scene, core::Core& probe, cons
   const Eigen::Vector3d tip = g.Tip(r, 0.5 * eps);
   for (double back = r; back <= l; back += r) {
     const Eigen::Isometry3d X = HandFor(scene, g, tip - back * g.axis + gap * n_up);
-    if (!InWorkspace(scene, X.translation()) || !FreePose(probe, X)) continue;
+    if (!InWorkspace(scene, X.translation()) || !FreePose(scene, probe, X)) continue;
     Motion m;
     m.kind = "aim goal";
     const Eigen::Vector3d above = GoOver(f, X.translation(), g.q, o, m);
@@ -376,7 +382,7 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
         X.linear() = q.toRotationMatrix();
         X.translation() = aim.hand;
-        if (!InWorkspace(scene, aim.hand) || !FreePose(probe, X)) continue;
+        if (!InWorkspace(scene, aim.hand) || !FreePose(scene, probe, X)) continue;
         Motion m;
         m.kind = "aim " + element.name;
         // Over the target at a safe height, down onto it (straight in: down to half a tube
@@ -387,7 +393,7 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         for (double back = 0.5 * l; aim.along_axis && back > 0.1 * l; back *= 0.5) {
           Eigen::Isometry3d X_entry = X;
           X_entry.translation() = aim.hand - back * aim.axis;
-          if (InWorkspace(scene, X_entry.translation()) && FreePose(probe, X_entry)) {
+          if (InWorkspace(scene, X_entry.translation()) && FreePose(scene, probe, X_entry)) {
             entry = X_entry.translation();
             break;
           }

@@ -23,6 +23,7 @@
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/report/graph_json.hpp>
 #include <tubeplan/report/graph_report.hpp>
+#include <tubeplan/scene/geometry.hpp>
 #include <tubeplan/trajectories/synthesize.hpp>
 
 namespace {
@@ -961,6 +962,10 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
+    const io::SceneLoadResult loaded =
+        io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/tests/data/scenes/" + c.file);
+    REQUIRE(loaded.scene);
+    const scene::Scene& scene = *loaded.scene;
     // Every reach of an aim towards its target (past the lift at the start's height) stops
     // where the operator force pushes back along it with the explorer's push.
     for (const graph::Motion& m : g.motions) {
@@ -968,6 +973,7 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
       INFO(m.kind);
       REQUIRE(!m.moves.empty());
       Eigen::Vector3d at = m.moves.front().p_W_m;
+      Eigen::Quaterniond q = m.moves.front().q_W;
       for (std::size_t k = 1; k < m.moves.size() && !m.moves[k].relative; ++k) {
         const graph::Move& move = m.moves[k];
         if ((move.p_W_m - at).norm() > 1e-9) {
@@ -975,6 +981,15 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
           CHECK(move.guard_dir_W.dot(move.p_W_m - at) < 0.0);
         }
         at = move.p_W_m;
+        q = move.q_W;
+      }
+      // The pose the aim reaches down to was clear: the straight tube there crosses no part
+      // (its axis, every millimetre; a pose across a plate thinner than an element shows no
+      // contact to a tick of the core).
+      for (double s = 0.0; s <= scene.tube.length_m; s += 1e-3) {
+        const Eigen::Vector3d p_W = at + s * (q * Eigen::Vector3d::UnitZ());
+        CHECK(std::none_of(scene.parts.begin(), scene.parts.end(),
+                           [&](const scene::Part& part) { return scene::Contains(part, p_W); }));
       }
     }
     CHECK(g.goal >= 0);
