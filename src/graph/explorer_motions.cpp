@@ -372,7 +372,14 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
       const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
       tip_aims.push_back({a, tip - l * a, a, t, phi_deg == 0.0});
     }
-    for (const Eigen::Vector3d& a : {t, n_W.cross(t).normalized()}) {  // the side, along it
+    // The side along the element: along t, across it, and on an element of the goal where
+    // neither pose is clear, turned from t about the normal by 10 deg steps either way (along
+    // a trough that t crosses).
+    std::vector<Eigen::Vector3d> along = {t, n_W.cross(t).normalized()};
+    for (int k = 1; k < 9 && in_goal; ++k)
+      for (const double sign : {-1.0, 1.0})
+        along.push_back(Eigen::AngleAxisd(sign * k * 10.0 * kDeg, n_W) * t);
+    for (const Eigen::Vector3d& a : along) {
       const Eigen::Vector3d mid = c_W + (gap + r) * n_W;
       side_aims.push_back({a, mid - 0.5 * l * a, -n_W, a});
     }

@@ -959,6 +959,10 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            // floor instead, the end runs into the hole's wall, and no motion of a default
            // exploration holds the goal.
            Case{"hole-tilted.yaml", 47, "{Fe - base.top}", 0.1, "aim base.top"},
+           // The tube to lie along a trough that its start's axis crosses at 20 deg: laid along
+           // that axis, or square to it, the tube would cross the trough's walls; the aim at
+           // the goal's floor turns it 20 deg about the floor's normal (measured 0.006 N).
+           Case{"trough.yaml", 64, "{Fs - trough.floor}", 0.1, "aim trough.floor"},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
