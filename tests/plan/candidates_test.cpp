@@ -56,6 +56,36 @@ std::vector<plan::Candidate> CountedCandidates(const scene::Scene& scene,
   });
 }
 
+// The start and a goal witnessed (hand, held end and stay of least force) at X_goal, reached
+// with min_force_N at least.
+graph::ContactGraph StartAndGoal(const scene::Scene& scene, const std::string& goal_cf,
+                                 const Eigen::Isometry3d& X_goal, double min_force_N) {
+  graph::ContactGraph g;
+  g.nodes.resize(2);
+  g.nodes[0].cf = "{}";
+  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
+  g.nodes[1].cf = goal_cf;
+  g.nodes[1].X_W_hand = g.nodes[1].X_WH = g.nodes[1].X_WH_least = X_goal;
+  g.nodes[1].min_force_N = min_force_N;
+  g.start = 0;
+  g.goal = 1;
+  return g;
+}
+
+// The judge's verdict on a reach through `waypoints` from {} to `goal_cf` at 80 mm/s, with the
+// device's force and a 20 ms dwell.
+plan::Judgement JudgeReach(const scene::Scene& scene,
+                           const std::vector<Eigen::Isometry3d>& waypoints,
+                           const std::string& goal_cf) {
+  trajectories::SynthesisOptions synthesis;
+  synthesis.peak_speed_m_per_s = 0.08;
+  plan::Limits limits;
+  limits.max_force_N = scene.device.max_force_N;
+  limits.dwell_s = 0.02;
+  return plan::Judge(scene, trajectories::SynthesizeTrajectory(waypoints, synthesis),
+                     {"{}", goal_cf}, limits);
+}
+
 }  // namespace
 
 TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
@@ -183,17 +213,9 @@ TEST_CASE(
   // 2 mm aside from the origin. The start is 165 mm out, 20 mm the other way aside: a straight
   // reach comes in at 73 deg to n.
   const Eigen::Vector3d n(0.0, -std::sin(kPi / 12.0), std::cos(kPi / 12.0));
-  graph::ContactGraph g;
-  g.nodes.resize(2);
-  g.nodes[0].cf = "{}";
-  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
-  g.nodes[1].cf = "{Fe - ramp.top}";
   Eigen::Isometry3d X_goal = scene.X_WH_start;
   X_goal.translation() = Eigen::Vector3d(-1.855182e-3, -79.205638e-3, 135.090790e-3);
-  g.nodes[1].X_W_hand = g.nodes[1].X_WH = g.nodes[1].X_WH_least = X_goal;
-  g.nodes[1].min_force_N = 0.2;
-  g.start = 0;
-  g.goal = 1;
+  const graph::ContactGraph g = StartAndGoal(scene, "{Fe - ramp.top}", X_goal, 0.2);
   const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
   // The straight reach at the goal's pose: the end meets the ramp moving sideways, lands on its
   // rim and never lies flat.
@@ -216,14 +238,7 @@ TEST_CASE(
   CHECK(graph::PathWaypoints(scene, longer, {{0, 1, 2}, 1.0}, graph::Aim::kAlongAxis).size() == 4);
   CHECK(graph::PathWaypoints(scene, longer, {{0, 3, 2}, 1.0}, graph::Aim::kAlongAxis).size() == 4);
   CHECK(graph::PathWaypoints(scene, longer, {{0, 3}, 1.0}, graph::Aim::kAlongAxis).size() == 2);
-  trajectories::SynthesisOptions synthesis;
-  synthesis.peak_speed_m_per_s = 0.08;
-  plan::Limits limits;
-  limits.max_force_N = scene.device.max_force_N;
-  limits.dwell_s = 0.02;
-  const plan::Judgement slanting =
-      plan::Judge(scene, trajectories::SynthesizeTrajectory(straight, synthesis),
-                  {"{}", g.nodes[1].cf}, limits);
+  const plan::Judgement slanting = JudgeReach(scene, straight, g.nodes[1].cf);
   INFO(plan::FirstFailure(slanting));
   CHECK_FALSE(slanting.feasible);
   CHECK(plan::FirstFailure(slanting).find("{Fe - ramp.top} never reached") != std::string::npos);
@@ -250,17 +265,9 @@ TEST_CASE("Candidates: a first reach over the parts goes round the rim a straigh
   // The goal's stay of least force as the explorer found it (`graph --budget 300 --time-limit 0`
   // on this scene): the tube plumb over the pocket's middle, its held end 151 mm over the floor.
   // The start is 180 mm up, 57 mm aside, the end 10 mm over the walls' tops.
-  graph::ContactGraph g;
-  g.nodes.resize(2);
-  g.nodes[0].cf = "{}";
-  g.nodes[0].X_W_hand = g.nodes[0].X_WH = scene.X_WH_start;
-  g.nodes[1].cf = "{Fe - base.top}";
   Eigen::Isometry3d X_goal = scene.X_WH_start;
   X_goal.translation() = Eigen::Vector3d(0.0, 0.0, 0.151);
-  g.nodes[1].X_W_hand = g.nodes[1].X_WH = g.nodes[1].X_WH_least = X_goal;
-  g.nodes[1].min_force_N = 0.006;
-  g.start = 0;
-  g.goal = 1;
+  const graph::ContactGraph g = StartAndGoal(scene, "{Fe - base.top}", X_goal, 0.006);
   const std::vector<graph::Path> paths = {{{0, 1}, 1.0}};
   const std::vector<Eigen::Isometry3d> straight =
       graph::PathWaypoints(scene, g, paths[0], graph::Aim::kAlongAxis);
@@ -278,15 +285,8 @@ TEST_CASE("Candidates: a first reach over the parts goes round the rim a straigh
   graph::ContactGraph high = g;
   high.nodes[1].X_WH_least.translation().z() = 0.2;
   CHECK(graph::PathWaypoints(scene, high, paths[0], graph::Aim::kOver)[1].translation().z() == 0.2);
-  trajectories::SynthesisOptions synthesis;
-  synthesis.peak_speed_m_per_s = 0.08;
-  plan::Limits limits;
-  limits.max_force_N = scene.device.max_force_N;
-  limits.dwell_s = 0.02;
   // The straight reach: the end comes down onto the walls' tops and never reaches the floor.
-  const plan::Judgement cut =
-      plan::Judge(scene, trajectories::SynthesizeTrajectory(straight, synthesis),
-                  {"{}", g.nodes[1].cf}, limits);
+  const plan::Judgement cut = JudgeReach(scene, straight, g.nodes[1].cf);
   INFO(plan::FirstFailure(cut));
   CHECK_FALSE(cut.feasible);
   CHECK(plan::FirstFailure(cut).find("{Fe - base.top} never reached") != std::string::npos);
