@@ -92,8 +92,8 @@ Move MoveBy(const scene::Scene& scene, const Eigen::Vector3d& d, const Eigen::Qu
 // sees the plate's faces along the tube, which a tick leaves to the neighbouring elements: a
 // tube that moved there would have met the plate first.)
 bool FreePose(const scene::Scene& scene, core::Core& core, const Eigen::Isometry3d& X) {
-  const double l = scene.tube.length_m, spacing = 0.5 * scene.tube.outer_radius_m;
-  const int points = static_cast<int>(std::ceil(l / spacing));
+  const double l = scene.tube.length_m, spacing_m = 0.5 * scene.tube.outer_radius_m;
+  const int points = static_cast<int>(std::ceil(l / spacing_m));
   for (int k = 0; k <= points; ++k)
     if (InsideAnyPart(scene, X * Eigen::Vector3d(0.0, 0.0, l * k / points))) return false;
   core.Reset(X);
@@ -365,8 +365,9 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
                                             return pc.part_element == element.name &&
                                                    pc.tube == states::TubeElement::kEndFace;
                                           });
-    const std::array<double, 4> leaning = {30.0, 60.0, 80.0, 0.0}, flat = {0.0, 30.0, 60.0, 80.0};
-    for (double phi_deg : flat_in_goal ? flat : leaning) {
+    const std::array<double, 4> leaning_deg = {30.0, 60.0, 80.0, 0.0},
+                                flat_deg = {0.0, 30.0, 60.0, 80.0};
+    for (double phi_deg : flat_in_goal ? flat_deg : leaning_deg) {
       if (phi_deg == 0.0 && !in_goal) continue;
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
       const Eigen::Vector3d tip = c_W + gap * n_W + r * std::sin(phi_deg * kDeg) * n_W;
@@ -392,14 +393,14 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
         if (!InWorkspace(scene, aim.hand) || !FreePose(scene, probe, X)) continue;
         Motion m;
         m.kind = "aim " + element.name;
-        // Over the target at a safe height, down onto it (straight in: down to half a tube
-        // length back along the axis, then along it), press, slide, back off.
-        // The entry is as far back along the axis as fits the workspace and is clear: half the
-        // tube's length, else a quarter, else an eighth.
+        // Over the target at a safe height, down onto it (straight in: down to an entry back
+        // along the axis, as far as fits the workspace and is clear, then along it), press,
+        // slide, back off.
         Eigen::Vector3d entry = aim.hand;
-        for (double back = 0.5 * l; aim.along_axis && back > 0.1 * l; back *= 0.5) {
+        for (const double back_of_length : {0.5, 0.25, 0.125}) {
+          if (!aim.along_axis) break;
           Eigen::Isometry3d X_entry = X;
-          X_entry.translation() = aim.hand - back * aim.axis;
+          X_entry.translation() = aim.hand - back_of_length * l * aim.axis;
           if (InWorkspace(scene, X_entry.translation()) && FreePose(scene, probe, X_entry)) {
             entry = X_entry.translation();
             break;

@@ -161,11 +161,11 @@ std::vector<Eigen::Isometry3d> PathWaypoints(const scene::Scene& scene, const Co
         waypoints.push_back(X_WH_least);
         break;
       case Aim::kOver:
-        // From the start over the first state's pose, then down to it (and on as kAlongAxis).
-        if (j == 1) {
+        // From the start over the pose of the path's first state after it, where that is
+        // lower than the start, then down (and on as kAlongAxis).
+        if (j == 1 && X_WH_least.translation().z() < scene.X_WH_start.translation().z()) {
           Eigen::Isometry3d X_WH_over = X_WH_least;
-          X_WH_over.translation().z() =
-              std::max(X_WH_least.translation().z(), scene.X_WH_start.translation().z());
+          X_WH_over.translation().z() = scene.X_WH_start.translation().z();
           if (!X_WH_over.isApprox(scene.X_WH_start)) waypoints.push_back(X_WH_over);
         }
         [[fallthrough]];

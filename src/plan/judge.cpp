@@ -157,15 +157,14 @@ void Judging::Measure(double t_s, const core::StepOutput& out) {
   // At the device's clamp the force is the most the device renders, which a plan's limit is
   // often set to: the motion asked more, so a clamp at the limit (within the rounding of the
   // clamp's scaling) exceeds it too, and is said so rather than as "8.5 N > 8.5 N".
-  if (out.flags & core::kForceClamped) {
-    if (force_N >= limits_.max_force_N * (1.0 - 1e-12)) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "limit exceeded: operator force %.4g N at the device's clamp (the motion "
-                    "asks more than it renders), limit %.4g N at t = %.3f s",
-                    force_N, limits_.max_force_N, t_s);
-      exceeded(text);
-    }
+  const bool at_limit = std::abs(force_N - limits_.max_force_N) <= 1e-12 * limits_.max_force_N;
+  if ((out.flags & core::kForceClamped) && at_limit) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "limit exceeded: operator force %.4g N at the device's clamp (the motion asks "
+                  "more than it renders), limit %.4g N at t = %.3f s",
+                  force_N, limits_.max_force_N, t_s);
+    exceeded(text);
   } else if (force_N > limits_.max_force_N) {
     exceeded(Format("operator force", force_N, "N", limits_.max_force_N, t_s));
   }

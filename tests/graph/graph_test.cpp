@@ -3,6 +3,7 @@
 // replaying every witness, by --jobs independence and by independent random motions.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -990,8 +991,10 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
       // The pose the aim reaches down to was clear: the straight tube there crosses no part
       // (its axis, every millimetre; a pose across a plate thinner than an element shows no
       // contact to a tick of the core).
-      for (double s = 0.0; s <= scene.tube.length_m; s += 1e-3) {
-        const Eigen::Vector3d p_W = at + s * (q * Eigen::Vector3d::UnitZ());
+      const int millimetres = static_cast<int>(std::lround(scene.tube.length_m * 1e3));
+      for (int k = 0; k <= millimetres; ++k) {
+        const Eigen::Vector3d p_W =
+            at + (scene.tube.length_m * k / millimetres) * (q * Eigen::Vector3d::UnitZ());
         CHECK(std::none_of(scene.parts.begin(), scene.parts.end(),
                            [&](const scene::Part& part) { return scene::Contains(part, p_W); }));
       }

@@ -404,6 +404,12 @@ TEST_CASE("A limit's message reads right: one space a word, the device's clamp s
           o.force_W_N = Eigen::Vector3d(0.0, 0.0, 8.0);
           o.flags = core::kForceClamped;
         }).find("limit exceeded") == std::string::npos);
+  // The torque clamped (the same flag) with the force over a lower plan limit: the force's
+  // own message.
+  CHECK(reason([](core::StepOutput& o) {
+          o.force_W_N = Eigen::Vector3d(0.0, 0.0, 9.0);
+          o.flags = core::kForceClamped;
+        }) == "limit exceeded: operator force 9 N > 8.5 N at t = 0.002 s");
   // Unclamped, a force at the limit is within it.
   CHECK(reason([](core::StepOutput& o) {
           o.force_W_N = Eigen::Vector3d(0.0, 0.0, 8.5);

@@ -38,9 +38,10 @@ enum class Aim : unsigned char {
   /// one without), the hand first goes to that pose drawn back along the held end's axis by the
   /// tube's radius and the contact threshold, then straight in: the end arrives along the tube.
   kAlongAxis,
-  /// As kAlongAxis, and the reach from the start goes first over the first state's pose, at the
-  /// start's height or the pose's if higher, then straight down: a reach from the start that
-  /// would cut through a part's rim on its slant (into a pocket beside the start) goes round it.
+  /// As kAlongAxis, and where the pose of the path's first state after the start is lower than
+  /// the start, the hand goes first over it at the start's height, then down (to the pose, or
+  /// to kAlongAxis's pose drawn back along the tube): a reach from the start that would cut
+  /// through a part's rim on its slant (into a pocket beside the start) goes round it.
   kOver,
 };
 
