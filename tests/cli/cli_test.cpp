@@ -424,7 +424,7 @@ TEST_CASE("simulate: a strain beyond the material's elastic range gets evaluate'
   std::filesystem::remove_all(tubeplan::testing::ScratchDir("simulate-fold"));
 }
 
-TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli]") {
+TEST_CASE("graph: the printout says which limit stopped the exploration", "[cli][explore]") {
   Outcome r = RunTool({"graph", SourcePath("scenes/groove.yaml"), "--budget", "1", "--time-limit",
                        "0", "--jobs", "2"});
   CHECK(r.exit_code == 1);  // one sweep does not reach the goal
