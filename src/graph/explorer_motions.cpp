@@ -34,6 +34,8 @@ Eigen::Quaterniond TurnAxis(const Eigen::Quaterniond& q0, const Eigen::Vector3d&
 
 struct Frame {  // directions of the start pose
   Eigen::Vector3d p0, axis, up, lateral;
+  Eigen::Vector3d tip;    // a turn about it by a positive angle tips the free end down
+  Eigen::Vector3d swing;  // the free end swings sideways about it
   Eigen::Quaterniond q0;
 };
 
@@ -48,6 +50,12 @@ Frame StartFrame(const scene::Scene& scene) {
   f.lateral = f.up.cross(f.axis);
   if (f.lateral.norm() < 1e-6) f.lateral = X0.linear().col(0);
   f.lateral.normalize();
+  // The tube tips down about the level direction square to it and swings about up; a plumb
+  // tube, which neither turn moves, tips about its lateral direction and swings about the third.
+  f.tip = f.axis.cross(-f.up);
+  const bool plumb = f.tip.norm() < 1e-6;
+  f.tip = plumb ? f.lateral : f.tip.normalized();
+  f.swing = plumb ? Eigen::Vector3d(f.axis.cross(f.tip).normalized()) : f.up;
   return f;
 }
 
@@ -302,8 +310,7 @@ std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const Expl
   const int n = std::max(1, static_cast<int>(std::floor(half / r)));
   std::vector<Motion> motions;
   for (double tilt_deg : {0.0, 12.0}) {
-    const Eigen::Vector3d tipped =
-        Eigen::AngleAxisd(tilt_deg * kDeg, f.axis.cross(-f.up).normalized()) * f.axis;
+    const Eigen::Vector3d tipped = Eigen::AngleAxisd(tilt_deg * kDeg, f.tip) * f.axis;
     const Eigen::Quaterniond q = TurnAxis(f.q0, f.axis, tipped);
     for (int i = -n; i <= n; ++i) {
       Motion m;
@@ -448,12 +455,11 @@ std::vector<Move> Probes(const scene::Scene& scene, const Eigen::Isometry3d& X_W
   const int hold = 5 + static_cast<int>(std::lround(o.dwell_s / scene.model.time_step_s));
   const Eigen::Vector3d p = X_W_hand.translation();
   const Eigen::Quaterniond q(X_W_hand.linear());
-  const Eigen::Vector3d tip_axis = f.axis.cross(-f.up).normalized();
   std::vector<std::pair<Eigen::Vector3d, Eigen::Quaterniond>> targets;
   for (const Eigen::Vector3d& d : {f.lateral, f.axis, f.up})
     for (double sign : {1.0, -1.0})
       targets.push_back({ClampToWorkspace(scene, p + sign * o.probe_step_m * d), q});
-  for (const Eigen::Vector3d& axis : {tip_axis, f.up})
+  for (const Eigen::Vector3d& axis : {f.tip, f.swing})
     for (double sign : {1.0, -1.0})
       targets.push_back(
           {p, (Eigen::Quaterniond(Eigen::AngleAxisd(sign * o.probe_turn_rad, axis)) * q)
@@ -498,7 +504,6 @@ std::vector<Motion> RandomMotionsIn(const scene::Scene& scene, const Box& box, s
   const auto [up_lo, up_hi] = range(f.up);
   const double along_lo = 0.0, along_hi = 0.2 * l;
   const double up_top = up_hi + 0.25 * l;
-  const Eigen::Vector3d tip_axis = f.axis.cross(-f.up).normalized();
   std::vector<Motion> motions;
   for (int i = first; i < first + count; ++i) {
     // One generator per motion, seeded by (seed, index): motion i is the same whichever
@@ -518,8 +523,8 @@ std::vector<Motion> RandomMotionsIn(const scene::Scene& scene, const Box& box, s
                      uniform(along_lo, along_hi) * f.axis + uniform(up_lo, up_top) * f.up);
       if (unit(rng) < 0.7) {
         const Eigen::Vector3d tipped =
-            Eigen::AngleAxisd(uniform(-8.0, 8.0) * kDeg, f.up) *
-            (Eigen::AngleAxisd(uniform(-5.0, 30.0) * kDeg, tip_axis) * f.axis);
+            Eigen::AngleAxisd(uniform(-8.0, 8.0) * kDeg, f.swing) *
+            (Eigen::AngleAxisd(uniform(-5.0, 30.0) * kDeg, f.tip) * f.axis);
         q = TurnAxis(f.q0, f.axis, tipped);
       }
       const double guard = unit(rng) < 0.6 ? uniform(1.0, 4.0) : 0.0;

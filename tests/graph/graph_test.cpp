@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -411,6 +412,39 @@ void CheckSameGraph(const ContactGraph& a, const ContactGraph& b) {
     CHECK(a.arcs[i].to == b.arcs[i].to);
     CHECK(a.arcs[i].count == b.arcs[i].count);
     CHECK(a.arcs[i].simultaneous == b.arcs[i].simultaneous);
+  }
+}
+
+TEST_CASE("Random motions tip and swing a tube that starts plumb", "[graph]") {
+  // The shipped pocket's tube hangs plumb: no level direction square to it to tip about, and
+  // a turn about up leaves it where it is. Its random motions tip it -5..30 deg and swing it
+  // +-8 deg as they do a level tube, about two level directions square to each other.
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/pocket.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& s = *loaded.scene;
+  const Eigen::Vector3d axis0 = s.X_WH_start.linear().col(2);
+  REQUIRE(axis0.z() < -0.999999);
+  double most_deg = 0.0;
+  Eigen::Vector2d spread_lo(0.0, 0.0), spread_hi(0.0, 0.0);
+  for (const graph::Motion& m : graph::RandomMotions(s, 7, 0, 60, graph::ExploreOptions{})) {
+    for (const graph::Move& move : m.moves) {
+      const Eigen::Vector3d axis = move.q_W * Eigen::Vector3d::UnitZ();
+      most_deg = std::max(
+          most_deg, std::acos(std::clamp(axis.dot(axis0), -1.0, 1.0)) * 180.0 / std::numbers::pi);
+      spread_lo = spread_lo.cwiseMin(axis.head<2>());
+      spread_hi = spread_hi.cwiseMax(axis.head<2>());
+    }
+  }
+  // Up to the 30 deg tip and the 8 deg swing together (sqrt(30^2 + 8^2) = 31 deg).
+  CHECK(most_deg > 20.0);
+  CHECK(most_deg < 31.1);
+  // The end turned both ways in both level directions (the tip reaches -5 deg, the swing
+  // +-8 deg): by more than sin 3 deg off plumb each way.
+  for (int i = 0; i < 2; ++i) {
+    INFO("level direction " << i);
+    CHECK(spread_lo[i] < -0.052);
+    CHECK(spread_hi[i] > 0.052);
   }
 }
 
