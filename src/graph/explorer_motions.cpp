@@ -374,6 +374,16 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
                                           });
     const std::array<double, 4> leaning_deg = {30.0, 60.0, 80.0, 0.0},
                                 flat_deg = {0.0, 30.0, 60.0, 80.0};
+    // The goal's rim caught on an edge or a vertex: first the end along the normal, moved back
+    // along t by its radius so that one point of its rim comes down onto the element (leaning,
+    // the rim's lowest point meets it from beside).
+    const bool rim_on_point = element.kind != scene::ElementKind::kFace &&
+                              std::any_of(scene.goal.contacts.begin(), scene.goal.contacts.end(),
+                                          [&](const states::PrincipalContact& pc) {
+                                            return pc.part_element == element.name &&
+                                                   pc.tube == states::TubeElement::kEndRim;
+                                          });
+    if (rim_on_point) tip_aims.push_back({-n_W, c_W + gap * n_W - r * t - l * -n_W, -n_W, t, true});
     for (double phi_deg : flat_in_goal ? flat_deg : leaning_deg) {
       if (phi_deg == 0.0 && !in_goal) continue;
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);

@@ -998,6 +998,11 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            // that axis, or square to it, the tube would cross the trough's walls; the aim at
            // the goal's floor turns it 20 deg about the floor's normal (measured 0.006 N).
            Case{"trough.yaml", 64, "{Fs - trough.floor}", 0.1, "aim trough.floor"},
+           // The end's rim to catch on a ledge's edge, the tube bent by it: the aim at the goal's
+           // edge brings the end along the edge's normal, a radius back, so that one point of
+           // its rim lands on the edge, and its press bends the tube (measured 0.84 N). Leaning,
+           // the rim meets the edge from beside and slips off it down the front.
+           Case{"ledge.yaml", 51, "{Ee ~ block.top_xpos}", 1.5, "aim block.top_xpos"},
        }) {
     INFO(c.file);
     const ContactGraph g = SweepsAndAims(c.file, c.motions);
