@@ -107,6 +107,20 @@ bool StartsInGoal(const PlansRequest& request, const scene::Scene& scene, std::o
   return true;
 }
 
+std::string ExploreMoreHint(const graph::ContactGraph& graph) {
+  switch (graph.end) {
+    case graph::ExploreEnd::kTimeLimit:
+      return "a larger --time-limit (the exploration stopped at its time limit with " +
+             std::to_string(graph.probed) + " of " + std::to_string(graph.nodes.size()) +
+             " states probed)";
+    case graph::ExploreEnd::kBudget:
+      return "a larger --budget";
+    case graph::ExploreEnd::kSaturated:
+      break;
+  }
+  return "";
+}
+
 PlansEnd MakePlans(const PlansRequest& request, const scene::Scene& scene,
                    const graph::ContactGraph& graph, double dwell_s,
                    const graph::PruneWeights& weights, Plans& plans, std::ostream& err) {
@@ -117,10 +131,14 @@ PlansEnd MakePlans(const PlansRequest& request, const scene::Scene& scene,
   }
   if (graph.goal < 0) {
     const std::string near = graph::NearGoalText(graph, scene.goal, 4);
+    const std::string more = ExploreMoreHint(graph);
     err << request.scene_path << ": error: exploration never reached the goal "
         << states::ToString(scene.goal) << ", so there is no plan to extract; expected a "
-        << "goal the tube can reach (try a larger --budget"
-        << (near.empty() ? "" : ", or one of the nearest states reached: " + near) << ")\n";
+        << "goal the tube can reach";
+    if (!more.empty() || !near.empty())
+      err << " (try " << more << (more.empty() || near.empty() ? "" : ", or ")
+          << (near.empty() ? "" : "one of the nearest states reached: " + near) << ")";
+    err << "\n";
     return PlansEnd::kGoalNotReached;
   }
   plans.paths = graph::KShortestPaths(graph, graph::ArcCosts(graph, weights), request.k);

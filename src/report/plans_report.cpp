@@ -21,11 +21,15 @@ void PrintHeader(std::ostream& t, const batch::PlansRequest& request, const std:
     << (request.all || plans.feasible == 0 || plans.feasible == long(plans.candidates.size())
             ? ""
             : " (the others are not written; --all writes them, marked)")
-    << "; written to " << plans.out_dir.string() << ":\n";
+    << (request.all || plans.feasible > 0 ? "; written to " + plans.out_dir.string()
+                                          : std::string("; none written"))
+    << ":\n";
   // Fewer than asked: the pruned graph holds no more loopless paths to the goal.
+  const std::string more = batch::ExploreMoreHint(g);
   if (static_cast<int>(paths) < request.k)
     t << "  (the pruned graph has no other loopless path from the start to the goal: a larger "
-         "--tolerance keeps more arcs, a larger --budget explores more states)\n";
+         "--tolerance keeps more arcs"
+      << (more.empty() ? "" : ", " + more + " explores more states") << ")\n";
 }
 
 // One candidate's line: its name (or "(not written)"), cost, length, states and verdict.
@@ -52,9 +56,12 @@ void PrintPlans(std::ostream& out, const batch::PlansRequest& request,
   t << std::setprecision(3);
   PrintHeader(t, request, scene_name, graph, plans);
   for (const plan::Candidate& c : plans.candidates) PrintCandidate(t, c);
-  if (plans.feasible == 0)
-    t << "  no candidate replays feasible, each also tried at 1/2 and 1/4 of --speed: a larger "
-         "--budget or a larger --tolerance may give one; --all writes them for inspection\n";
+  if (plans.feasible == 0) {
+    const std::string more = batch::ExploreMoreHint(graph);
+    t << "  no candidate replays feasible, each also tried at 1/2 and 1/4 of --speed: "
+      << (more.empty() ? "" : more + " or ") << "a larger --tolerance may give one; --all writes "
+      << "them for inspection\n";
+  }
   out << t.str();
 }
 

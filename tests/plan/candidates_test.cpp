@@ -4,16 +4,19 @@
 // kept, and the feasible candidates come first.
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include <catch2/catch.hpp>
 
+#include <tubeplan/batch/plans.hpp>
 #include <tubeplan/graph/explore.hpp>
 #include <tubeplan/graph/motion.hpp>
 #include <tubeplan/graph/paths.hpp>
 #include <tubeplan/io/scene_yaml.hpp>
 #include <tubeplan/plan/candidates.hpp>
+#include <tubeplan/report/plans_report.hpp>
 
 namespace {
 
@@ -87,6 +90,37 @@ plan::Judgement JudgeReach(const scene::Scene& scene,
 }
 
 }  // namespace
+
+TEST_CASE("plans: the hints name the limit that stopped the exploration", "[plan]") {
+  graph::ContactGraph g;
+  g.nodes.resize(56);
+  g.probed = 0;
+  g.end = graph::ExploreEnd::kTimeLimit;
+  CHECK(batch::ExploreMoreHint(g) ==
+        "a larger --time-limit (the exploration stopped at its time limit with 0 of 56 states "
+        "probed)");
+  // No path and nothing feasible: nothing is written, and more time is what is hinted at.
+  batch::PlansRequest request;
+  batch::Plans plans;
+  plans.out_dir = "pin-plans";
+  std::ostringstream out;
+  report::PrintPlans(out, request, "pin", g, plans);
+  INFO(out.str());
+  CHECK(out.str().find("0 feasible; none written:") != std::string::npos);
+  CHECK(out.str().find("pin-plans") == std::string::npos);
+  CHECK(out.str().find("a larger --time-limit (the exploration stopped") != std::string::npos);
+  CHECK(out.str().find("--budget") == std::string::npos);
+  // --all writes them all, whatever their verdicts.
+  request.all = true;
+  std::ostringstream all;
+  report::PrintPlans(all, request, "pin", g, plans);
+  CHECK(all.str().find("; written to pin-plans:") != std::string::npos);
+  g.end = graph::ExploreEnd::kBudget;
+  CHECK(batch::ExploreMoreHint(g) == "a larger --budget");
+  // Saturated: exploring on finds nothing new, so it is not hinted at.
+  g.end = graph::ExploreEnd::kSaturated;
+  CHECK(batch::ExploreMoreHint(g).empty());
+}
 
 TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
           "[plan]") {

@@ -57,6 +57,11 @@ struct Plans {
   long feasible = 0;  ///< candidates that replay feasible
 };
 
+/// What more exploration would take, for a hint: "a larger --time-limit (...)" where the time
+/// limit stopped it unsaturated, "a larger --budget" where the budget did, empty where it
+/// saturated (exploring on finds nothing new).
+std::string ExploreMoreHint(const graph::ContactGraph& graph);
+
 enum class PlansEnd {
   kWritten,         ///< the candidates made and the feasible (or all) written
   kNothingToPlan,   ///< the explorer's start state is the goal
