@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <iomanip>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -8,6 +9,22 @@
 #include <tubeplan/plan/candidates.hpp>
 
 namespace tubeplan::plan {
+namespace {
+
+// Cuts `hand` in the middle of the replay's first stay in `goal` (if another state followed it),
+// so that a plan of those poses ends in its goal.
+void CutInGoalStay(const Judgement& run, const std::string& goal,
+                   std::vector<trajectories::HandSample>& hand) {
+  const auto first = std::find_if(run.observed.begin(), run.observed.end(),
+                                  [&](const Observation& o) { return o.cf == goal; });
+  if (first == run.observed.end() || first + 1 == run.observed.end()) return;
+  const double cut_s = 0.5 * (first->t_s + (first + 1)->t_s);
+  const auto end =
+      std::find_if(hand.begin(), hand.end(), [&](const auto& h) { return h.t_s >= cut_s; });
+  hand.erase(end == hand.end() ? end : end + 1, hand.end());
+}
+
+}  // namespace
 
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
@@ -31,6 +48,8 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     synthesis.seed = options.synthesis.seed + i;
     const auto aims = graph::DistinctAims(scene, graph, c.path, graph::kPlanAims);
     int tried = 0;
+    // The first try whose replay got to the goal by other states than the path's.
+    std::optional<Candidate> reached;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =
           options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
@@ -45,12 +64,30 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
         t.tries = ++tried;
         const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
         t.judgement = read ? Judge(scene, *read, t.plan.states, t.plan.limits) : Judgement{};
+        if (!reached && read && !StatesToGoal(t.judgement, c.plan.states.back()).empty())
+          reached = t;
         const bool better =
             t.judgement.feasible &&
             (!c.judgement.feasible || t.judgement.peak_force_N < c.judgement.peak_force_N);
         if (better || !c.judgement.feasible) c = std::move(t);
       }
       if (c.judgement.feasible) break;
+    }
+    // Where no try holds the path's states, the one that got to the goal is judged on the states
+    // its replay passed through: a plan that works, said as it goes.
+    if (!c.judgement.feasible && reached) {
+      Candidate t = std::move(*reached);
+      t.plan.states = StatesToGoal(t.judgement, c.plan.states.back());
+      t.restated = true;
+      CutInGoalStay(t.judgement, t.plan.states.back(), t.trajectory.samples);
+      t.duration_s = t.trajectory.samples.back().t_s;
+      if (const auto read = as_written(t.trajectory))
+        t.judgement = Judge(scene, *read, t.plan.states, t.plan.limits);
+      if (t.judgement.feasible) {
+        t.path.nodes.clear();
+        for (const std::string& cf : t.plan.states) t.path.nodes.push_back(graph.FindNode(cf));
+        c = std::move(t);
+      }
     }
     candidates.push_back(std::move(c));
   }
@@ -89,18 +126,9 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
   Limits limits;
   limits.max_force_N = scene.device.max_force_N;
   limits.dwell_s = options.dwell_s;
-  // Cut in the middle of the goal's first stay, so that the plan ends in its goal.
   trajectories::Trajectory own;
   own.samples = hand;
-  const Judgement run = Judge(scene, own, ends, limits);
-  const auto first = std::find_if(run.observed.begin(), run.observed.end(),
-                                  [&](const Observation& o) { return o.cf == goal.cf; });
-  if (first != run.observed.end() && first + 1 != run.observed.end()) {
-    const double cut_s = 0.5 * (first->t_s + (first + 1)->t_s);
-    const auto end =
-        std::find_if(hand.begin(), hand.end(), [&](const auto& h) { return h.t_s >= cut_s; });
-    hand.erase(end == hand.end() ? end : end + 1, hand.end());
-  }
+  CutInGoalStay(Judge(scene, own, ends, limits), goal.cf, hand);
   Candidate c;
   c.from_motion = true;
   c.plan.scene = options.scene_ref;
@@ -153,6 +181,7 @@ std::string VerdictText(const Candidate& c) {
                  ? "the held end's poses of least force, the end brought in along the tube"
                  : "the held end's poses of least force, over the parts first")
          << " at " << c.peak_speed_m_per_s * 1e3 << " mm/s)";
+  if (c.restated) text << ", its states those its replay passed through";
   text << "; peak operator force " << c.judgement.peak_force_N << " N";
   return text.str();
 }

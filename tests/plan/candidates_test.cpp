@@ -122,6 +122,46 @@ TEST_CASE("plans: the hints name the limit that stopped the exploration", "[plan
   CHECK(batch::ExploreMoreHint(g).empty());
 }
 
+TEST_CASE("Candidates: a path whose replays reach the goal by other states is planned on those",
+          "[plan]") {
+  const io::SceneLoadResult loaded =
+      io::LoadSceneFile(std::string(TUBEPLAN_SOURCE_DIR) + "/scenes/groove.yaml");
+  REQUIRE(loaded.scene);
+  const scene::Scene& scene = *loaded.scene;
+  // The lay-flat goal behind a state witnessed at the start pose, where the tube touches
+  // nothing: no replay of the path passes that state, and every one lays the tube flat.
+  graph::ContactGraph g = LayFlatGraph(scene, 0.00816, 0.00816);
+  graph::Node passed_by = g.nodes[0];
+  passed_by.cf = "{Fs - left.top}";
+  g.nodes.insert(g.nodes.begin() + 1, passed_by);
+  g.goal = 2;
+  const std::vector<graph::Path> paths = {{{0, 1, 2}, 1.0}};
+  int replays = 0;
+  const std::vector<plan::Candidate> c = CountedCandidates(scene, g, paths, replays);
+  REQUIRE(c.size() == 1);
+  INFO(plan::VerdictText(c[0]));
+  CHECK(c[0].judgement.feasible);
+  CHECK(c[0].restated);
+  REQUIRE(c[0].plan.states.size() >= 2);
+  CHECK(c[0].plan.states.front() == "{}");
+  CHECK(c[0].plan.states.back() == "{Fs - floor.top}");
+  CHECK(std::find(c[0].plan.states.begin(), c[0].plan.states.end(), "{Fs - left.top}") ==
+        c[0].plan.states.end());
+  CHECK(c[0].path.nodes.front() == 0);
+  CHECK(c[0].path.nodes.back() == 2);
+  CHECK(plan::VerdictText(c[0]).find("its states those its replay passed through") !=
+        std::string::npos);
+  // The path's one distinct aim at each of the three speeds, then the first, which reached the
+  // goal, once more on the states it passed.
+  CHECK(c[0].tries == 1);
+  CHECK(replays == 3 + 1);
+  // The trajectory ends in the goal's stay: judged again on the written states, it holds.
+  plan::Limits limits;
+  limits.max_force_N = scene.device.max_force_N;
+  limits.dwell_s = 0.02;
+  CHECK(plan::Judge(scene, c[0].trajectory, c[0].plan.states, limits).feasible);
+}
+
 TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
           "[plan]") {
   const io::SceneLoadResult loaded =
@@ -169,7 +209,10 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   // the goal's lying-flat state).
   const std::string failure = plan::FirstFailure(c[2].judgement);
   CHECK(failure.find("after the goal") != std::string::npos);
-  CHECK(replays == 2 + 1 + 6);
+  // The tries, and the deep path's first to lay the tube flat once more, on the states it passed
+  // and cut in its first stay in the goal: still infeasible (it is kept as it was).
+  CHECK_FALSE(c[2].restated);
+  CHECK(replays == 2 + 1 + 6 + 1);
 }
 
 TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept", "[plan]") {

@@ -52,6 +52,9 @@ struct Candidate {
   double peak_speed_m_per_s = 0.0;     ///< of the try kept
   graph::Aim aim = graph::Aim::kHand;  ///< where the try kept aims the hand
   int tries = 0;                       ///< which try was kept, in the order tried (from 1)
+  /// No try held the path's states: the plan's are those the kept try's replay passed through
+  /// on its way to the goal (its path's nodes those states', -1 for one the graph lacks).
+  bool restated = false;
   Judgement judgement;
 };
 
@@ -61,8 +64,10 @@ using AsWritten =
     std::function<std::optional<trajectories::Trajectory>(const trajectories::Trajectory&)>;
 
 /// One candidate for each path (in order): of the tries (one per distinct aim) at the fastest
-/// speed where one replays feasible, the feasible one of least peak operator force, or else the
-/// last try; the feasible come first, each kind in the paths' order.
+/// speed where one replays feasible, the feasible one of least peak operator force; else the
+/// first try that got to the goal by other states, cut in its first stay there and restated
+/// (Candidate::restated), where it replays feasible on those; else the last try. The feasible
+/// come first, each kind in the paths' order.
 std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::ContactGraph& graph,
                                       std::span<const graph::Path> paths,
                                       const CandidateOptions& options, const AsWritten& as_written);
