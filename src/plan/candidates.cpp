@@ -171,6 +171,14 @@ std::string VerdictText(const Candidate& c) {
   std::ostringstream text;
   text << std::setprecision(3)
        << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
+  // As `evaluate` says it: the first transition that passed unplanned states, and those.
+  const auto detour = std::find_if(
+      c.judgement.transitions.begin(), c.judgement.transitions.end(),
+      [](const TransitionVerdict& v) { return v.verdict == Verdict::kFeasibleWithDetour; });
+  if (c.judgement.feasible && detour != c.judgement.transitions.end()) {
+    text << "-with-detour: " << detour->from << " -> " << detour->to << " via";
+    for (const std::string& cf : detour->detour) text << " " << cf;
+  }
   if (c.tries > 1)
     text << " (try " << c.tries << ": "
          << (c.from_motion                      ? "the explorer's motion"

@@ -91,6 +91,25 @@ plan::Judgement JudgeReach(const scene::Scene& scene,
 
 }  // namespace
 
+TEST_CASE("plans: a feasible candidate that passed unplanned states says so as evaluate does",
+          "[plan]") {
+  plan::Candidate c;
+  c.judgement.feasible = true;
+  c.judgement.transitions.resize(2);
+  c.judgement.transitions[0] = {
+      .from = "{}", .to = "{Fs n post.top}", .verdict = plan::Verdict::kFeasible};
+  c.judgement.transitions[1] = {.from = "{Fs n post.top}",
+                                .to = "{Fe - post.top}",
+                                .verdict = plan::Verdict::kFeasibleWithDetour,
+                                .detour = {"{Fs n post.side}", "{}"}};
+  const std::string text = plan::VerdictText(c);
+  CHECK(text.rfind("feasible-with-detour: {Fs n post.top} -> {Fe - post.top} via {Fs n "
+                   "post.side} {}; peak operator force",
+                   0) == 0);
+  c.judgement.transitions[1].verdict = plan::Verdict::kFeasible;
+  CHECK(plan::VerdictText(c).rfind("feasible; peak operator force", 0) == 0);
+}
+
 TEST_CASE("plans: the hints name the limit that stopped the exploration", "[plan]") {
   graph::ContactGraph g;
   g.nodes.resize(56);
