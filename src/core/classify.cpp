@@ -98,7 +98,7 @@ void Classify(const Model& model, Data& data) {
   bool truncated = s.samples_truncated;
   for (int k = 0; k < s.sample_count; ++k) {
     const Sample& smp = s.samples[std::size_t(k)];
-    if (!(smp.distance_m < eps)) continue;
+    if (!(smp.distance_m < eps) || !OnSurface(smp)) continue;
     const TubeElement te = TubeElementOf(model, data, smp);
     int at = -1;
     for (int i = 0; i < count && at < 0; ++i)

@@ -98,7 +98,7 @@ void WriteOutput(const Model& model, Data& data) {
     const Sample& smp = data.scratch.samples[std::size_t(k)];
     if (!(smp.distance_m < eps)) continue;
     torque += ContactMoment(model, smp, st.x_W[0]);
-    penetration = penetration || smp.distance_m < 0.0;
+    penetration = penetration || (smp.distance_m < 0.0 && OnSurface(smp));
   }
   if (c.saturated) out.flags |= kProxySeparated;
   if (force.norm() > model.coupling.max_force_N) {

@@ -399,6 +399,46 @@ TEST_CASE("A soft tube pushed slowly onto an edge converges in every tick", "[co
   CHECK(tally.unconverged == 0);
 }
 
+TEST_CASE("A block's corner in the bore at the tube's end is no contact and no penetration",
+          "[core]") {
+  // The rubber tube 45 deg down and yawed, lowered 4.4 mm onto a block's top corner: the corner
+  // passes the end's plane inside the bore, at the bore's wall. The end face's annulus and the
+  // side, whose shares there fade out to a millionth, bear nothing; the corner is not on the
+  // tube's surface, so it names no PC and is no penetration (the judge would fail a plan on a
+  // 4.4 mm one).
+  scene::Scene s = RubberScene();
+  s.parts.push_back(Box("block", {0.1, 0.12, 0.04}, {-0.05, 0.0, 0.02}));
+  s.X_WH_start.linear() = Eigen::Quaterniond(-0.24041300595169718, -0.03268109499343384,
+                                             0.9669066438057329, -0.0788991429841479)
+                              .toRotationMatrix();
+  s.X_WH_start.translation() = Eigen::Vector3d(0.0706027, 0.0892312, 0.1734);
+  core::Core c(s);
+  Eigen::Isometry3d X = s.X_WH_start;
+  X.translation().z() = 0.1690;
+  double t = 0.0;
+  const Eigen::Isometry3d from = s.X_WH_start;
+  int penetrating = 0, touching = 0;
+  for (int i = 1; i <= 1200; ++i) {
+    Eigen::Isometry3d Y = X;
+    const double u = std::min(1.0, i / 800.0);
+    Y.translation() = (1.0 - u) * from.translation() + u * X.translation();
+    const core::StepOutput& out = c.Step(t += 1e-3, Y);
+    penetrating += (out.flags & core::kPenetration) != 0;
+    touching += out.contact_count > 0;
+  }
+  CHECK(penetrating == 0);
+  CHECK(touching == 0);
+  // The corner is where it was meant to be: at the end, within a millimetre of the bore's wall.
+  const Eigen::Vector3d axis = c.last().X_WH.linear().col(2);
+  const Eigen::Vector3d end = c.last().X_WH.translation() + s.tube.length_m * axis;
+  const Eigen::Vector3d corner(0.0, 0.06, 0.04);
+  const double along_m = (corner - end).dot(axis);
+  const double radial_m = ((corner - end) - along_m * axis).norm();
+  INFO("along " << along_m * 1e3 << " mm, radial " << radial_m * 1e3 << " mm");
+  CHECK(along_m < 0.0);
+  CHECK(std::abs(radial_m - s.tube.inner_radius_m) < 1e-3);
+}
+
 TEST_CASE("The force on an edge is smooth in where the edge meets the tube", "[core]") {
   // The rubber tube's side pressed on a frictionless edge across it, the hand moved to the same
   // place for edges 0.25 mm apart over one element's length about 0.6 l. A tube has no edges at
