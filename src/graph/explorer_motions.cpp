@@ -383,7 +383,10 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
                                             return pc.part_element == element.name &&
                                                    pc.tube == states::TubeElement::kEndRim;
                                           });
-    if (rim_on_point) tip_aims.push_back({-n_W, c_W + gap * n_W - r * t - l * -n_W, -n_W, t, true});
+    if (rim_on_point) {
+      const Eigen::Vector3d tip = c_W + gap * n_W - r * t;
+      tip_aims.push_back({-n_W, tip + l * n_W, -n_W, t, true});
+    }
     for (double phi_deg : flat_in_goal ? flat_deg : leaning_deg) {
       if (phi_deg == 0.0 && !in_goal) continue;
       const Eigen::Vector3d a = -n_W * std::cos(phi_deg * kDeg) + t * std::sin(phi_deg * kDeg);
