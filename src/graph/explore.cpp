@@ -110,8 +110,10 @@ void MarkStartGoalAndReach(const scene::Scene& scene, const core::Core& probe,
   MarkStartAndGoal(scene, graph);
   const std::set<std::string> reached = ReachedElements(graph);
   graph.reached_elements.assign(reached.begin(), reached.end());
-  for (const scene::PartElement& e : probe.elements())
-    if (!reached.contains(e.name)) graph.unreached_elements.push_back(e.name);
+  const auto& elements = probe.elements();
+  for (std::size_t e = 0; e < elements.size(); ++e)
+    if (!reached.contains(elements[e].name) && !explorer::Covered(scene, probe, int(e)))
+      graph.unreached_elements.push_back(elements[e].name);
 }
 
 }  // namespace

@@ -286,6 +286,11 @@ std::optional<Motion> SlideIn(const scene::Scene& scene, core::Core& probe, cons
 
 }  // namespace
 
+bool Covered(const scene::Scene& scene, const core::Core& probe, int e) {
+  const scene::ElementPoint at = PointFacingStart(scene, probe, e, StartFrame(scene));
+  return InsideAnyPart(scene, at.p_W + 0.5 * scene.contact.threshold_m * at.n_W);
+}
+
 Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts) {
   Box box;
   for (std::uint32_t p : parts) {
@@ -343,13 +348,11 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
   const double gap = scene.contact.threshold_m + 3e-3;  // start clear of epsilon
   std::vector<Motion> motions;
   for (int e : elements) {
+    if (Covered(scene, probe, e)) continue;
     const scene::PartElement& element = probe.elements()[std::size_t(e)];
     const scene::ElementPoint at = PointFacingStart(scene, probe, e, f);
     const Eigen::Vector3d& c_W = at.p_W;
     const Eigen::Vector3d& n_W = at.n_W;
-    // An element whose outside is inside another part (a wall's bottom on the floor) cannot be
-    // touched: not aimed at.
-    if (InsideAnyPart(scene, c_W + 0.5 * scene.contact.threshold_m * n_W)) continue;
     // A direction along the element, leaning down and along the start axis where it can.
     Eigen::Vector3d t = f.axis - f.up;
     t -= t.dot(n_W) * n_W;

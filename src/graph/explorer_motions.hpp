@@ -26,6 +26,10 @@ struct Box {
 // The box around the given parts (indices into scene.parts).
 Box PartsBox(const scene::Scene& scene, const std::vector<std::uint32_t>& parts);
 
+// Whether element e (an index into probe's elements) is covered: its outside, at its point
+// facing the start, lies inside another part (a box's bottom on the floor), so nothing touches it.
+bool Covered(const scene::Scene& scene, const core::Core& probe, int e);
+
 // The sweeps across the parts' box: the tube level and tipped down, a tube radius apart.
 std::vector<Motion> Sweeps(const scene::Scene& scene, const Box& box, const ExploreOptions& o);
 

@@ -80,11 +80,13 @@ struct ContactGraph {
   int start = -1;  ///< node of the start pose (-1: no motion ended within the time limit)
   int goal = -1;   ///< node of the scene's goal CF, -1 when exploration never reached it
   std::vector<Motion> motions;  ///< every motion explored, in order (witnesses index it)
-  std::vector<SaturationPoint> saturation;      ///< after each motion
-  std::vector<std::string> reached_elements;    ///< part elements seen in some PC
-  std::vector<std::string> unreached_elements;  ///< reachable parts' elements never seen
-  long ticks = 0;                               ///< core ticks run, refinements included
-  int refinements = 0;                          ///< multi-PC steps that were sub-stepped
+  std::vector<SaturationPoint> saturation;    ///< after each motion
+  std::vector<std::string> reached_elements;  ///< part elements seen in some PC
+  /// Reachable parts' elements never seen, but those covered by another part (nothing can
+  /// touch a box's bottom on the floor).
+  std::vector<std::string> unreached_elements;
+  long ticks = 0;       ///< core ticks run, refinements included
+  int refinements = 0;  ///< multi-PC steps that were sub-stepped
   /// Motions ended where the operator force passed the explorer's limit (ExploreForceLimit) or
   /// the coupling reached the device's force (kProxySeparated: the tube no longer followed).
   int held_back = 0;
