@@ -111,13 +111,15 @@ inline bool IsSideSection(const Sample& s) {
   return s.kind == SampleKind::kNode || (s.kind == SampleKind::kSide && s.feature == kHeldFeature);
 }
 
-/// Whether a contact point bears on the tube's surface, so that it names a PC and its depth is a
-/// penetration: its share of K is a thousandth or more. A share fades out where the part lies off
-/// the surface the point stands for (a vertex in the bore or beyond the rim, for the end face; a
-/// part beyond the tube's end, for the side): faded out, the point bears nothing, and its depth
-/// is not the tube's (a block's corner 2.5 mm into a rubber tube's bore, 1e-8 of its share).
+/// Whether a contact point lies on the tube's surface, so that it names a PC and its depth is a
+/// penetration: all but a point that bears alone (not one of the side's sections, which share
+/// their contact's force by their softmin whatever their share) whose share of K has faded below
+/// a thousandth. A share fades where the part lies off the surface the point stands for (a
+/// vertex in the bore, for the end face; a part past the tube's end, for the side's end pieces):
+/// such a point bears at most a thousandth of K (eps - d), and its depth is not the tube's (a
+/// block's corner passing a rubber tube's end plane inside the bore, 4.4 mm deep in the capsule).
 inline constexpr double kLeastShare = 1e-3;
-inline bool OnSurface(const Sample& s) { return s.weight >= kLeastShare; }
+inline bool OnSurface(const Sample& s) { return IsSideSection(s) || s.weight >= kLeastShare; }
 
 /// The side's sections on one part: samples side_members[first, first + count).
 struct SideGroup {
