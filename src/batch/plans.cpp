@@ -42,7 +42,10 @@ std::string WriteCandidate(plan::Candidate& c, int number, const PlansRequest& r
                "stretched if it moved faster than the asked speed.";
   else
     comment << "cost " << c.path.cost
-            << ": the hand moves by minimum jerk through the witnesses of its states.";
+            << (c.restated ? ": the hand moves by minimum jerk through the witnesses of the "
+                             "searched path's states, and its states are those it passed."
+                           : ": the hand moves by minimum jerk through the witnesses of its "
+                             "states.");
   comment << " Replayed when made: " << plan::VerdictText(c) << ".";
   c.plan.comment = comment.str();
   for (const auto& [file, text] :

@@ -11,14 +11,24 @@
 namespace tubeplan::plan {
 namespace {
 
+// The graph's node of each state (-1 for one it lacks).
+std::vector<int> NodesOf(const graph::ContactGraph& graph, const std::vector<std::string>& states) {
+  std::vector<int> nodes;
+  for (const std::string& cf : states) nodes.push_back(graph.FindNode(cf));
+  return nodes;
+}
+
 // Cuts `hand` in the middle of the replay's first stay in `goal` (if another state followed it),
-// so that a plan of those poses ends in its goal.
-void CutInGoalStay(const Judgement& run, const std::string& goal,
+// and not before the goal counts (its entry, the dwell and two steps), so that a plan of those
+// poses ends in its goal.
+void CutInGoalStay(const Judgement& run, const std::string& goal, double dwell_s,
                    std::vector<trajectories::HandSample>& hand) {
   const auto first = std::find_if(run.observed.begin(), run.observed.end(),
                                   [&](const Observation& o) { return o.cf == goal; });
-  if (first == run.observed.end() || first + 1 == run.observed.end()) return;
-  const double cut_s = 0.5 * (first->t_s + (first + 1)->t_s);
+  if (first == run.observed.end() || first + 1 == run.observed.end() || hand.size() < 2) return;
+  const double step_s = hand[1].t_s - hand[0].t_s;
+  const double counted_s = std::min(first->t_s + dwell_s + 2.0 * step_s, (first + 1)->t_s);
+  const double cut_s = std::max(0.5 * (first->t_s + (first + 1)->t_s), counted_s);
   const auto end =
       std::find_if(hand.begin(), hand.end(), [&](const auto& h) { return h.t_s >= cut_s; });
   hand.erase(end == hand.end() ? end : end + 1, hand.end());
@@ -64,8 +74,10 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
         t.tries = ++tried;
         const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
         t.judgement = read ? Judge(scene, *read, t.plan.states, t.plan.limits) : Judgement{};
-        if (!reached && read && !StatesToGoal(t.judgement, c.plan.states.back()).empty())
-          reached = t;
+        if (!reached && read) {
+          const std::vector<std::string> passed = StatesToGoal(t.judgement, c.plan.states.back());
+          if (!passed.empty() && passed != c.plan.states) reached = t;
+        }
         const bool better =
             t.judgement.feasible &&
             (!c.judgement.feasible || t.judgement.peak_force_N < c.judgement.peak_force_N);
@@ -79,13 +91,12 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
       Candidate t = std::move(*reached);
       t.plan.states = StatesToGoal(t.judgement, c.plan.states.back());
       t.restated = true;
-      CutInGoalStay(t.judgement, t.plan.states.back(), t.trajectory.samples);
+      CutInGoalStay(t.judgement, t.plan.states.back(), options.dwell_s, t.trajectory.samples);
       t.duration_s = t.trajectory.samples.back().t_s;
       if (const auto read = as_written(t.trajectory))
         t.judgement = Judge(scene, *read, t.plan.states, t.plan.limits);
       if (t.judgement.feasible) {
-        t.path.nodes.clear();
-        for (const std::string& cf : t.plan.states) t.path.nodes.push_back(graph.FindNode(cf));
+        t.path.nodes = NodesOf(graph, t.plan.states);
         c = std::move(t);
       }
     }
@@ -128,7 +139,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
   limits.dwell_s = options.dwell_s;
   trajectories::Trajectory own;
   own.samples = hand;
-  CutInGoalStay(Judge(scene, own, ends, limits), goal.cf, hand);
+  CutInGoalStay(Judge(scene, own, ends, limits), goal.cf, options.dwell_s, hand);
   Candidate c;
   c.from_motion = true;
   c.plan.scene = options.scene_ref;
@@ -155,7 +166,7 @@ std::optional<Candidate> MotionCandidate(const scene::Scene& scene,
     c = std::move(t);
     if (c.judgement.feasible) break;
   }
-  for (const std::string& cf : c.plan.states) c.path.nodes.push_back(graph.FindNode(cf));
+  c.path.nodes = NodesOf(graph, c.plan.states);
   return c;
 }
 
@@ -171,14 +182,12 @@ std::string VerdictText(const Candidate& c) {
   std::ostringstream text;
   text << std::setprecision(3)
        << (c.judgement.feasible ? "feasible" : "infeasible: " + FirstFailure(c.judgement));
-  // As `evaluate` says it: the first transition that passed unplanned states, and those.
+  // Evaluate's word, and the first transition that passed unplanned states with them.
   const auto detour = std::find_if(
       c.judgement.transitions.begin(), c.judgement.transitions.end(),
       [](const TransitionVerdict& v) { return v.verdict == Verdict::kFeasibleWithDetour; });
-  if (c.judgement.feasible && detour != c.judgement.transitions.end()) {
-    text << "-with-detour: " << detour->from << " -> " << detour->to << " via";
-    for (const std::string& cf : detour->detour) text << " " << cf;
-  }
+  if (c.judgement.feasible && detour != c.judgement.transitions.end())
+    text << "-with-detour (" << detour->from << " -> " << detour->to << DetourText(*detour) << ")";
   if (c.tries > 1)
     text << " (try " << c.tries << ": "
          << (c.from_motion                      ? "the explorer's motion"

@@ -65,6 +65,12 @@ Verdict Overall(const Judgement& judgement) {
                                                            : Verdict::kNotJudged;
 }
 
+std::string DetourText(const TransitionVerdict& v) {
+  std::string text = v.detour.empty() ? "" : " via";
+  for (const std::string& d : v.detour) text += " " + d;
+  return text;
+}
+
 std::string FlagWarning(std::size_t i, double seconds) {
   char buffer[48];
   std::snprintf(buffer, sizeof buffer, "for %.3g s ", seconds);

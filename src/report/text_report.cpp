@@ -17,11 +17,7 @@ namespace {
 void PrintSpan(std::ostream& t, const std::string& title, const plan::TransitionVerdict& v,
                const std::string& robust,
                const std::function<std::string(plan::Verdict, const std::string&)>& paint) {
-  t << "  " << title << ": " << paint(v.verdict, plan::ToString(v.verdict));
-  if (!v.detour.empty()) {
-    t << " via";
-    for (const std::string& d : v.detour) t << " " << d;
-  }
+  t << "  " << title << ": " << paint(v.verdict, plan::ToString(v.verdict)) << plan::DetourText(v);
   if (!v.reason.empty()) t << " (" << v.reason << ")";
   t << robust;
   if (!v.started) {

@@ -91,7 +91,7 @@ plan::Judgement JudgeReach(const scene::Scene& scene,
 
 }  // namespace
 
-TEST_CASE("plans: a feasible candidate that passed unplanned states says so as evaluate does",
+TEST_CASE("plans: a feasible candidate that passed unplanned states says which, in evaluate's word",
           "[plan]") {
   plan::Candidate c;
   c.judgement.feasible = true;
@@ -103,8 +103,8 @@ TEST_CASE("plans: a feasible candidate that passed unplanned states says so as e
                                 .verdict = plan::Verdict::kFeasibleWithDetour,
                                 .detour = {"{Fs n post.side}", "{}"}};
   const std::string text = plan::VerdictText(c);
-  CHECK(text.rfind("feasible-with-detour: {Fs n post.top} -> {Fe - post.top} via {Fs n "
-                   "post.side} {}; peak operator force",
+  CHECK(text.rfind("feasible-with-detour ({Fs n post.top} -> {Fe - post.top} via {Fs n "
+                   "post.side} {}); peak operator force",
                    0) == 0);
   c.judgement.transitions[1].verdict = plan::Verdict::kFeasible;
   CHECK(plan::VerdictText(c).rfind("feasible; peak operator force", 0) == 0);
@@ -174,11 +174,13 @@ TEST_CASE("Candidates: a path whose replays reach the goal by other states is pl
   // goal, once more on the states it passed.
   CHECK(c[0].tries == 1);
   CHECK(replays == 3 + 1);
-  // The trajectory ends in the goal's stay: judged again on the written states, it holds.
-  plan::Limits limits;
-  limits.max_force_N = scene.device.max_force_N;
-  limits.dwell_s = 0.02;
-  CHECK(plan::Judge(scene, c[0].trajectory, c[0].plan.states, limits).feasible);
+  // The trajectory is cut in its stay in the goal, after the goal counts: the goal is the last
+  // state the replay counted, entered a dwell (20 ms) or more before the trajectory's end.
+  const std::vector<plan::Observation>& seen = c[0].judgement.observed;
+  REQUIRE(!seen.empty());
+  CHECK(seen.back().cf == "{Fs - floor.top}");
+  CHECK(c[0].trajectory.samples.back().t_s >= seen.back().t_s + 0.02);
+  CHECK(c[0].duration_s == c[0].trajectory.samples.back().t_s);
 }
 
 TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, least force first",
@@ -228,10 +230,9 @@ TEST_CASE("Candidates: each distinct aim at each speed, slower until feasible, l
   // the goal's lying-flat state).
   const std::string failure = plan::FirstFailure(c[2].judgement);
   CHECK(failure.find("after the goal") != std::string::npos);
-  // The tries, and the deep path's first to lay the tube flat once more, on the states it passed
-  // and cut in its first stay in the goal: still infeasible (it is kept as it was).
+  // Its tries passed the path's own states, {} then the goal: none is judged again on others.
   CHECK_FALSE(c[2].restated);
-  CHECK(replays == 2 + 1 + 6 + 1);
+  CHECK(replays == 2 + 1 + 6);
 }
 
 TEST_CASE("Candidates: of two feasible aims, the one of least peak force is kept", "[plan]") {

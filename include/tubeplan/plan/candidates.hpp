@@ -42,7 +42,7 @@ struct CandidateOptions {
 
 struct Candidate {
   /// The searched path; for a motion candidate, its states' nodes (-1: a state the graph lacks)
-  /// and no cost.
+  /// and no cost; for a restated one, its states' nodes and the searched path's cost.
   graph::Path path;
   /// The explorer's own motion to the goal (MotionCandidate), not a path through the graph.
   bool from_motion = false;
@@ -94,8 +94,10 @@ std::vector<std::string> StatesToGoal(const Judgement& seen, const std::string& 
 /// "FROM -> TO: reason" of the first infeasible transition, or what stopped the judgement.
 std::string FirstFailure(const Judgement& judgement);
 
-/// "feasible" or "infeasible: " and FirstFailure, the try kept when not the first, and the peak
-/// operator force: what `plans` says of a candidate and its plan file's comment repeats.
+/// "feasible" (with "-with-detour (FROM -> TO via ...)" for the first transition that passed
+/// unplanned states) or "infeasible: " and FirstFailure, the try kept when not the first, that
+/// its states are those its replay passed (Candidate::restated), and the peak operator force:
+/// what `plans` says of a candidate and its plan file's comment repeats.
 std::string VerdictText(const Candidate& candidate);
 
 }  // namespace tubeplan::plan

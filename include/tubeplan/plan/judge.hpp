@@ -80,6 +80,10 @@ struct TransitionVerdict {
   double FlaggedSeconds(std::uint32_t flag) const;
 };
 
+/// " via S1 S2 ...": the unplanned states a span passed (empty for none), as reports print them
+/// after its verdict.
+std::string DetourText(const TransitionVerdict& v);
+
 struct Observation {
   double t_s = 0.0;  ///< when the core entered it (it counted `dwell` later)
   std::string cf;
