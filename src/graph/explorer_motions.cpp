@@ -34,8 +34,10 @@ Eigen::Quaterniond TurnAxis(const Eigen::Quaterniond& q0, const Eigen::Vector3d&
 
 struct Frame {  // directions of the start pose
   Eigen::Vector3d p0, axis, up, lateral;
-  Eigen::Vector3d tip;    // a turn about it by a positive angle tips the free end down
+  Eigen::Vector3d tip;    // a turn about it by a positive angle tips the free end down (across,
+                          // for a plumb tube)
   Eigen::Vector3d swing;  // the free end swings sideways about it
+  bool plumb = false;     // the tube starts along up, or against it
   Eigen::Quaterniond q0;
 };
 
@@ -53,9 +55,9 @@ Frame StartFrame(const scene::Scene& scene) {
   // The tube tips down about the level direction square to it and swings about up; a plumb
   // tube, which neither turn moves, tips about its lateral direction and swings about the third.
   f.tip = f.axis.cross(-f.up);
-  const bool plumb = f.tip.norm() < 1e-6;
-  f.tip = plumb ? f.lateral : f.tip.normalized();
-  f.swing = plumb ? Eigen::Vector3d(f.axis.cross(f.tip).normalized()) : f.up;
+  f.plumb = f.tip.norm() < 1e-6;
+  f.tip = f.plumb ? f.lateral : f.tip.normalized();
+  f.swing = f.plumb ? Eigen::Vector3d(f.axis.cross(f.tip).normalized()) : f.up;
   return f;
 }
 
@@ -121,6 +123,16 @@ scene::ElementPoint PointFacingStart(const scene::Scene& scene, const core::Core
   const scene::Part& part = scene.parts[part_index];
   return scene::PointOnElement(part, e - first,
                                f.p0 - part.X_WP * scene::BoundsInPart(part).center());
+}
+
+// Whether a PC of the scene's goal is on the part element named `element` (by the tube element
+// `tube`, if given).
+bool InGoal(const scene::Scene& scene, const std::string& element,
+            std::optional<states::TubeElement> tube = std::nullopt) {
+  return std::any_of(scene.goal.contacts.begin(), scene.goal.contacts.end(),
+                     [&](const states::PrincipalContact& pc) {
+                       return pc.part_element == element && (!tube || pc.tube == *tube);
+                     });
 }
 
 // From the start to over p at a safe height, turned to q; returns where the hand is then.
@@ -366,29 +378,19 @@ std::vector<Motion> Aims(const scene::Scene& scene, core::Core& probe,
     // The tip, its axis leaning off the normal; where no leaning pose is free on an element of
     // the goal (the floor of a hole to insert into), straight along the normal, end first,
     // coming in along its axis.
-    const bool in_goal = std::any_of(
-        scene.goal.contacts.begin(), scene.goal.contacts.end(),
-        [&](const states::PrincipalContact& pc) { return pc.part_element == element.name; });
+    const bool in_goal = InGoal(scene, element.name);
     // The goal's end face flat on the element: the axis along its normal first.
-    const bool flat_in_goal = std::any_of(scene.goal.contacts.begin(), scene.goal.contacts.end(),
-                                          [&](const states::PrincipalContact& pc) {
-                                            return pc.part_element == element.name &&
-                                                   pc.tube == states::TubeElement::kEndFace;
-                                          });
+    const bool flat_in_goal = InGoal(scene, element.name, states::TubeElement::kEndFace);
     const std::array<double, 4> leaning_deg = {30.0, 60.0, 80.0, 0.0},
                                 flat_deg = {0.0, 30.0, 60.0, 80.0};
     // The goal's rim caught on an edge or a vertex: first the end along the normal, moved back
     // along t by its radius so that one point of its rim comes down onto the element (leaning,
     // the rim's lowest point meets it from beside).
     const bool rim_on_point = element.kind != scene::ElementKind::kFace &&
-                              std::any_of(scene.goal.contacts.begin(), scene.goal.contacts.end(),
-                                          [&](const states::PrincipalContact& pc) {
-                                            return pc.part_element == element.name &&
-                                                   pc.tube == states::TubeElement::kEndRim;
-                                          });
+                              InGoal(scene, element.name, states::TubeElement::kEndRim);
     if (rim_on_point) {
-      const Eigen::Vector3d tip = c_W + gap * n_W - r * t;
-      tip_aims.push_back({-n_W, tip + l * n_W, -n_W, t, true});
+      const Eigen::Vector3d p_W_end = c_W + gap * n_W - r * t;
+      tip_aims.push_back({-n_W, p_W_end + l * n_W, -n_W, t, true});
     }
     for (double phi_deg : flat_in_goal ? flat_deg : leaning_deg) {
       if (phi_deg == 0.0 && !in_goal) continue;
@@ -472,7 +474,8 @@ std::vector<Move> Probes(const scene::Scene& scene, const Eigen::Isometry3d& X_W
   const Eigen::Vector3d p = X_W_hand.translation();
   const Eigen::Quaterniond q(X_W_hand.linear());
   std::vector<std::pair<Eigen::Vector3d, Eigen::Quaterniond>> targets;
-  for (const Eigen::Vector3d& d : {f.lateral, f.axis, f.up})
+  // Along the tube's axis, or for a plumb tube (whose axis is up) along the third direction.
+  for (const Eigen::Vector3d& d : {f.lateral, f.plumb ? f.swing : f.axis, f.up})
     for (double sign : {1.0, -1.0})
       targets.push_back({ClampToWorkspace(scene, p + sign * o.probe_step_m * d), q});
   for (const Eigen::Vector3d& axis : {f.tip, f.swing})

@@ -436,7 +436,8 @@ TEST_CASE("Random motions tip and swing a tube that starts plumb", "[graph]") {
       spread_hi = spread_hi.cwiseMax(axis.head<2>());
     }
   }
-  // Up to the 30 deg tip and the 8 deg swing together (sqrt(30^2 + 8^2) = 31 deg).
+  // Up to the 30 deg tip and the 8 deg swing together (sqrt(30^2 + 8^2) = 31 deg); of some 170
+  // turns drawn uniformly, one within the top third of the tip's range is all but certain.
   CHECK(most_deg > 20.0);
   CHECK(most_deg < 31.1);
   // The end turned both ways in both level directions (the tip reaches -5 deg, the swing
@@ -960,8 +961,8 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
     int motions;  // the sweeps and the first aims (the goal's first), or all and the first probes
     const char* goal;
     // The goal's least operator force at most: set down, not pushed in (the aims stop at the
-    // first touch of 0.02 N); and the kind of motion whose stay is its witness, where it must be
-    // the aim at the goal as a whole.
+    // first touch of 0.02 N), or pressed no more than the goal needs; and the kind of motion
+    // whose stay is its witness, where it must be the aim at the goal as a whole.
     double gentle_N;
     const char* witness_kind;
     // An element another part covers (nothing can touch it): not aimed at, and not listed among
@@ -1005,7 +1006,8 @@ TEST_CASE("Aims reach goals the sweeps do not", "[graph][explore]") {
            Case{"trough.yaml", 64, "{Fs - trough.floor}", 0.1, "aim trough.floor"},
            // The end's rim to catch on a ledge's edge, the tube bent by it: the aim at the goal's
            // edge brings the end along the edge's normal, a radius back, so that one point of
-           // its rim lands on the edge, and its press bends the tube (measured 0.84 N). Leaning,
+           // its rim lands on the edge, and its press bends the tube (measured 0.84 N; bound:
+           // the press, not the device's 8.5 N, under twice that). Leaning,
            // the rim meets the edge from beside and slips off it down the front.
            Case{"ledge.yaml", 51, "{Ee ~ block.top_xpos}", 1.5, "aim block.top_xpos"},
        }) {
