@@ -58,8 +58,9 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     synthesis.seed = options.synthesis.seed + i;
     const auto aims = graph::DistinctAims(scene, graph, c.path, graph::kPlanAims);
     int tried = 0;
-    // The first try whose replay got to the goal by other states than the path's.
+    // The first try whose replay got to the goal by other states than the path's, and those.
     std::optional<Candidate> reached;
+    std::vector<std::string> passed;
     for (std::size_t k = 0; k <= options.slower.size(); ++k) {
       synthesis.peak_speed_m_per_s =
           options.synthesis.peak_speed_m_per_s / (k > 0 ? options.slower[k - 1] : 1.0);
@@ -75,7 +76,7 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
         const std::optional<trajectories::Trajectory> read = as_written(t.trajectory);
         t.judgement = read ? Judge(scene, *read, t.plan.states, t.plan.limits) : Judgement{};
         if (!reached && read) {
-          const std::vector<std::string> passed = StatesToGoal(t.judgement, c.plan.states.back());
+          passed = StatesToGoal(t.judgement, c.plan.states.back());
           if (!passed.empty() && passed != c.plan.states) reached = t;
         }
         const bool better =
@@ -89,7 +90,7 @@ std::vector<Candidate> MakeCandidates(const scene::Scene& scene, const graph::Co
     // its replay passed through: a plan that works, said as it goes.
     if (!c.judgement.feasible && reached) {
       Candidate t = std::move(*reached);
-      t.plan.states = StatesToGoal(t.judgement, c.plan.states.back());
+      t.plan.states = std::move(passed);
       t.restated = true;
       CutInGoalStay(t.judgement, t.plan.states.back(), options.dwell_s, t.trajectory.samples);
       t.duration_s = t.trajectory.samples.back().t_s;
